@@ -1,0 +1,86 @@
+//! The crate's error type: every failure caused by input data or configuration is a value
+//! that names what was wrong and where (file, line, field). Library code never panics on input.
+
+use std::path::PathBuf;
+
+/// Errors returned by the library.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A value handed to the library is unusable (NaN, negative variance, wrong dimension, ...).
+    #[error("invalid {what}: {reason}")]
+    InvalidInput {
+        /// What was invalid, e.g. `measurement 3 of frame 12`.
+        what: String,
+        /// Why.
+        reason: String,
+    },
+    /// A text file could not be parsed.
+    #[error("{}:{line}: {field}: {reason}", path.display())]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// One-based line number (0 when the whole file is concerned).
+        line: usize,
+        /// The field or element that was wrong.
+        field: String,
+        /// Why.
+        reason: String,
+    },
+    /// Reading or writing a file failed.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error.
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+impl Error {
+    /// Shorthand for [`Error::InvalidInput`].
+    pub fn invalid(what: impl Into<String>, reason: impl Into<String>) -> Self {
+        Error::InvalidInput {
+            what: what.into(),
+            reason: reason.into(),
+        }
+    }
+
+    /// Shorthand for [`Error::Parse`].
+    pub fn parse(
+        path: impl Into<PathBuf>,
+        line: usize,
+        field: impl Into<String>,
+        reason: impl Into<String>,
+    ) -> Self {
+        Error::Parse {
+            path: path.into(),
+            line,
+            field: field.into(),
+            reason: reason.into(),
+        }
+    }
+
+    /// Shorthand for [`Error::Io`].
+    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Io {
+            path: path.into(),
+            source,
+        }
+    }
+}
+
+/// The library's result type.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Checks that every value is finite; names the first offender.
+pub fn ensure_finite(what: &str, values: &[f64]) -> Result<()> {
+    match values.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(Error::invalid(
+            what,
+            format!("component {i} is {} (must be finite)", values[i]),
+        )),
+    }
+}

@@ -1,0 +1,403 @@
+//! Weighted particle sets — the single-object densities of the filter.
+//!
+//! States are stored as a structure of arrays: component `c` of all particles is one
+//! contiguous slice (`component(c)`), so transition and likelihood loops stream through memory
+//! and vectorise. Weights are kept normalised in the linear domain; every reweighting goes
+//! through the log domain ([`ParticleSet::reweight_log`]) so that likelihoods that underflow
+//! never empty a set. Resampling is systematic, followed by optional roughening or a
+//! regularised Gaussian kernel ([`Jitter`]). Not for: the association or existence logic.
+
+use crate::rng::FilterRng;
+use rand::RngExt;
+use rand_distr::{Distribution, StandardNormal};
+
+/// A weighted particle set of fixed state dimension.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParticleSet {
+    dim: usize,
+    len: usize,
+    /// Component-major: `states[c * len + i]` is component `c` of particle `i`.
+    states: Vec<f64>,
+    /// Normalised weights (sum 1).
+    weights: Vec<f64>,
+}
+
+/// What is added to resampled particles to restore diversity.
+#[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Jitter {
+    /// Nothing: duplicates stay duplicates (the transition noise spreads them).
+    None,
+    /// Gordon's roughening: component `c` gets N(0, (k·E_c·N^(−1/d))²), where E_c is the
+    /// spread (max − min) of that component after resampling.
+    Roughening {
+        /// Tuning constant `k` (typically 0.01 … 0.2).
+        k: f64,
+    },
+    /// Regularised particle filter with a diagonal Gaussian kernel: component `c` gets
+    /// N(0, (scale·h_opt·σ_c)²) with h_opt = (4 / (N (d + 2)))^(1/(d + 4)) and σ_c the weighted
+    /// standard deviation before resampling.
+    Regularised {
+        /// Multiplier of the optimal bandwidth (1 = optimal for a Gaussian).
+        scale: f64,
+    },
+}
+
+impl Default for Jitter {
+    fn default() -> Self {
+        Jitter::Regularised { scale: 0.2 }
+    }
+}
+
+impl ParticleSet {
+    /// `len` particles of dimension `dim`, all at the origin, equally weighted.
+    pub fn zeros(dim: usize, len: usize) -> Self {
+        assert!(dim > 0, "particle dimension must be positive");
+        let w = if len > 0 { 1.0 / len as f64 } else { 0.0 };
+        ParticleSet {
+            dim,
+            len,
+            states: vec![0.0; dim * len],
+            weights: vec![w; len],
+        }
+    }
+
+    /// `len` equally weighted particles drawn from N(mean, diag(std²)).
+    pub fn gaussian(mean: &[f64], std: &[f64], len: usize, rng: &mut FilterRng) -> Self {
+        assert_eq!(
+            mean.len(),
+            std.len(),
+            "mean and std must have the same dimension"
+        );
+        let mut set = Self::zeros(mean.len(), len);
+        for (c, (&m, &s)) in mean.iter().zip(std).enumerate() {
+            for v in set.component_mut(c) {
+                let e: f64 = StandardNormal.sample(rng);
+                *v = m + s * e;
+            }
+        }
+        set
+    }
+
+    /// Builds a set from particle-major rows (`rows[i]` is particle `i`) and weights, which
+    /// are normalised here. Returns `None` if shapes disagree or no weight is positive.
+    pub fn from_rows(rows: &[Vec<f64>], weights: &[f64]) -> Option<Self> {
+        let len = rows.len();
+        let dim = rows.first()?.len();
+        if dim == 0 || weights.len() != len || rows.iter().any(|r| r.len() != dim) {
+            return None;
+        }
+        let mut set = Self::zeros(dim, len);
+        for (i, row) in rows.iter().enumerate() {
+            for (c, &v) in row.iter().enumerate() {
+                set.states[c * len + i] = v;
+            }
+        }
+        let total: f64 = weights.iter().sum();
+        if !(total > 0.0 && total.is_finite()) || weights.iter().any(|w| *w < 0.0) {
+            return None;
+        }
+        for (dst, &w) in set.weights.iter_mut().zip(weights) {
+            *dst = w / total;
+        }
+        Some(set)
+    }
+
+    /// State dimension.
+    pub fn dim(&self) -> usize {
+        self.dim
+    }
+
+    /// Number of particles.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// True when the set holds no particle.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Component `c` of every particle.
+    pub fn component(&self, c: usize) -> &[f64] {
+        &self.states[c * self.len..(c + 1) * self.len]
+    }
+
+    /// Component `c` of every particle, mutable.
+    pub fn component_mut(&mut self, c: usize) -> &mut [f64] {
+        let len = self.len;
+        &mut self.states[c * len..(c + 1) * len]
+    }
+
+    /// All components as mutable slices, in order (for transitions that couple components).
+    pub fn components_mut(&mut self) -> Vec<&mut [f64]> {
+        if self.len == 0 {
+            return (0..self.dim).map(|_| &mut [][..]).collect();
+        }
+        self.states.chunks_mut(self.len).collect()
+    }
+
+    /// All components as slices, in order.
+    pub fn components(&self) -> Vec<&[f64]> {
+        if self.len == 0 {
+            return (0..self.dim).map(|_| &[][..]).collect();
+        }
+        self.states.chunks(self.len).collect()
+    }
+
+    /// Copies particle `i` into `out` (length `dim`).
+    pub fn state_into(&self, i: usize, out: &mut [f64]) {
+        for (c, o) in out.iter_mut().enumerate().take(self.dim) {
+            *o = self.states[c * self.len + i];
+        }
+    }
+
+    /// Particle `i` as a new vector.
+    pub fn state(&self, i: usize) -> Vec<f64> {
+        let mut v = vec![0.0; self.dim];
+        self.state_into(i, &mut v);
+        v
+    }
+
+    /// Normalised weights.
+    pub fn weights(&self) -> &[f64] {
+        &self.weights
+    }
+
+    /// Multiplies weight `i` by `exp(log_factor[i])` and renormalises, in the log domain.
+    ///
+    /// Returns the log of Σᵢ wᵢ·exp(log_factor[i]) (the normalising constant, possibly far below
+    /// `f64::MIN_POSITIVE` without underflowing). If every factor is −∞ (or NaN) the weights
+    /// are left unchanged and −∞ is returned: the set is never emptied.
+    pub fn reweight_log(&mut self, log_factor: &[f64]) -> f64 {
+        debug_assert_eq!(log_factor.len(), self.len);
+        let mut max = f64::NEG_INFINITY;
+        for (w, l) in self.weights.iter().zip(log_factor) {
+            if *w > 0.0 && *l > max {
+                max = *l;
+            }
+        }
+        if !max.is_finite() {
+            return if max == f64::INFINITY {
+                f64::INFINITY
+            } else {
+                f64::NEG_INFINITY
+            };
+        }
+        let mut total = 0.0;
+        for (w, l) in self.weights.iter_mut().zip(log_factor) {
+            let f = if l.is_nan() { 0.0 } else { (l - max).exp() };
+            *w *= f;
+            total += *w;
+        }
+        // total ≥ the weight of the maximising particle (> 0), so this division is safe.
+        let inv = 1.0 / total;
+        for w in &mut self.weights {
+            *w *= inv;
+        }
+        max + total.ln()
+    }
+
+    /// Weighted mean of every component into `out`.
+    pub fn mean_into(&self, out: &mut [f64]) {
+        for (c, o) in out.iter_mut().enumerate().take(self.dim) {
+            *o = self
+                .component(c)
+                .iter()
+                .zip(&self.weights)
+                .map(|(x, w)| x * w)
+                .sum();
+        }
+    }
+
+    /// Weighted mean as a new vector.
+    pub fn mean(&self) -> Vec<f64> {
+        let mut m = vec![0.0; self.dim];
+        self.mean_into(&mut m);
+        m
+    }
+
+    /// Weighted standard deviation of every component.
+    pub fn std_dev(&self) -> Vec<f64> {
+        let mean = self.mean();
+        (0..self.dim)
+            .map(|c| {
+                let m = mean[c];
+                let var: f64 = self
+                    .component(c)
+                    .iter()
+                    .zip(&self.weights)
+                    .map(|(x, w)| w * (x - m) * (x - m))
+                    .sum();
+                var.max(0.0).sqrt()
+            })
+            .collect()
+    }
+
+    /// Weighted covariance matrix (dim × dim).
+    pub fn covariance(&self) -> nalgebra::DMatrix<f64> {
+        let mean = self.mean();
+        let mut cov = nalgebra::DMatrix::zeros(self.dim, self.dim);
+        for a in 0..self.dim {
+            for b in a..self.dim {
+                let (xa, xb) = (self.component(a), self.component(b));
+                let s: f64 = (0..self.len)
+                    .map(|i| self.weights[i] * (xa[i] - mean[a]) * (xb[i] - mean[b]))
+                    .sum();
+                cov[(a, b)] = s;
+                cov[(b, a)] = s;
+            }
+        }
+        cov
+    }
+
+    /// Effective sample size 1 / Σ wᵢ².
+    pub fn effective_sample_size(&self) -> f64 {
+        let s: f64 = self.weights.iter().map(|w| w * w).sum();
+        if s > 0.0 {
+            1.0 / s
+        } else {
+            0.0
+        }
+    }
+
+    /// Systematic resampling to `n` equally weighted particles.
+    pub fn resample_systematic(&mut self, n: usize, rng: &mut FilterRng) {
+        if self.len == 0 || n == 0 {
+            *self = Self::zeros(self.dim, 0);
+            return;
+        }
+        let step = 1.0 / n as f64;
+        let u0: f64 = rng.random::<f64>() * step;
+        let mut idx = Vec::with_capacity(n);
+        let mut cum = self.weights[0];
+        let mut i = 0;
+        for k in 0..n {
+            let u = u0 + k as f64 * step;
+            while u > cum && i + 1 < self.len {
+                i += 1;
+                cum += self.weights[i];
+            }
+            idx.push(i);
+        }
+        let mut states = vec![0.0; self.dim * n];
+        for c in 0..self.dim {
+            let src = self.component(c);
+            let dst = &mut states[c * n..(c + 1) * n];
+            for (d, &j) in dst.iter_mut().zip(&idx) {
+                *d = src[j];
+            }
+        }
+        self.states = states;
+        self.len = n;
+        self.weights = vec![step; n];
+    }
+
+    /// Resamples to `n` particles and applies `jitter`.
+    pub fn resample(&mut self, n: usize, jitter: Jitter, rng: &mut FilterRng) {
+        let sigma_before = match jitter {
+            Jitter::Regularised { .. } => self.std_dev(),
+            _ => Vec::new(),
+        };
+        self.resample_systematic(n, rng);
+        if self.len == 0 {
+            return;
+        }
+        let d = self.dim as f64;
+        let nf = self.len as f64;
+        for c in 0..self.dim {
+            let sigma = match jitter {
+                Jitter::None => 0.0,
+                Jitter::Roughening { k } => {
+                    let comp = self.component(c);
+                    let (lo, hi) = comp
+                        .iter()
+                        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
+                            (lo.min(x), hi.max(x))
+                        });
+                    k * (hi - lo) * nf.powf(-1.0 / d)
+                }
+                Jitter::Regularised { scale } => {
+                    let h = (4.0 / (nf * (d + 2.0))).powf(1.0 / (d + 4.0));
+                    scale * h * sigma_before[c]
+                }
+            };
+            if sigma > 0.0 && sigma.is_finite() {
+                for v in self.component_mut(c) {
+                    let e: f64 = StandardNormal.sample(rng);
+                    *v += sigma * e;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::seeded;
+    use proptest::prelude::*;
+
+    #[test]
+    fn reweight_survives_total_underflow() {
+        let mut rng = seeded(1);
+        let mut p = ParticleSet::gaussian(&[0.0, 0.0], &[1.0, 1.0], 100, &mut rng);
+        let logs: Vec<f64> = (0..100).map(|i| -5000.0 - i as f64).collect();
+        let lz = p.reweight_log(&logs);
+        assert!(lz.is_finite());
+        assert!((lz - (-5000.0 + (p.len() as f64).recip().ln())).abs() < 1.0);
+        let s: f64 = p.weights().iter().sum();
+        assert!((s - 1.0).abs() < 1e-12);
+        assert!(p.weights()[0] > p.weights()[1]);
+        // every factor −∞: weights unchanged, never emptied
+        let before = p.weights().to_vec();
+        assert_eq!(
+            p.reweight_log(&vec![f64::NEG_INFINITY; 100]),
+            f64::NEG_INFINITY
+        );
+        assert_eq!(p.weights(), &before[..]);
+    }
+
+    #[test]
+    fn mean_and_covariance_match_hand_computation() {
+        let rows = vec![vec![0.0, 1.0], vec![2.0, 3.0], vec![4.0, -1.0]];
+        let p = ParticleSet::from_rows(&rows, &[1.0, 2.0, 1.0]).unwrap();
+        // mean x = (0 + 4 + 4)/4 = 2, y = (1 + 6 - 1)/4 = 1.5
+        assert_eq!(p.mean(), vec![2.0, 1.5]);
+        let c = p.covariance();
+        // var x = (4 + 0 + 4)/4 = 2; cov = (−2·−0.5 + 0 + 2·−2.5)/4 = −1
+        assert!((c[(0, 0)] - 2.0).abs() < 1e-12);
+        assert!((c[(0, 1)] + 1.0).abs() < 1e-12);
+        assert!((p.std_dev()[0] - 2f64.sqrt()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn systematic_resampling_copies_in_proportion() {
+        let rows = vec![vec![0.0], vec![1.0], vec![2.0], vec![3.0]];
+        let mut p = ParticleSet::from_rows(&rows, &[0.5, 0.25, 0.25, 0.0]).unwrap();
+        p.resample_systematic(8, &mut seeded(3));
+        let comp = p.component(0);
+        assert_eq!(comp.iter().filter(|&&x| x == 0.0).count(), 4);
+        assert_eq!(comp.iter().filter(|&&x| x == 1.0).count(), 2);
+        assert_eq!(comp.iter().filter(|&&x| x == 2.0).count(), 2);
+        assert_eq!(comp.iter().filter(|&&x| x == 3.0).count(), 0);
+        assert!((p.effective_sample_size() - 8.0).abs() < 1e-9);
+    }
+
+    proptest! {
+        #[test]
+        fn weights_stay_normalised(logs in proptest::collection::vec(-1e4f64..1e4, 1..64), n in 1usize..200, seed in 0u64..1000) {
+            let mut rng = seeded(seed);
+            let mut p = ParticleSet::gaussian(&[1.0, -2.0, 0.5], &[1.0, 2.0, 0.1], logs.len(), &mut rng);
+            p.reweight_log(&logs);
+            let s: f64 = p.weights().iter().sum();
+            prop_assert!((s - 1.0).abs() < 1e-9);
+            prop_assert!(p.weights().iter().all(|w| *w >= 0.0));
+            p.resample(n, Jitter::Regularised { scale: 1.0 }, &mut rng);
+            prop_assert_eq!(p.len(), n);
+            let s: f64 = p.weights().iter().sum();
+            prop_assert!((s - 1.0).abs() < 1e-9);
+            prop_assert!(p.component(1).iter().all(|x| x.is_finite()));
+        }
+    }
+}

@@ -1,0 +1,17 @@
+//! # smc-lmb
+//!
+//! Multi-object tracking with a labelled multi-Bernoulli (LMB) filter whose single-object
+//! densities are particle sets.
+#![warn(missing_docs)]
+
+pub mod assignment;
+pub mod error;
+pub mod filter;
+pub mod metrics;
+pub mod models;
+pub mod rng;
+pub mod sim;
+
+pub use error::{Error, Result};
+pub use filter::{Label, ParticleSet};
+pub use rng::FilterRng;

@@ -1,0 +1,115 @@
+//! The plug-in points of the filter: how objects move ([`TransitionModel`], [`SurvivalModel`]),
+//! how they are seen ([`MeasurementModel`], [`DetectionModel`]) and what else is seen
+//! ([`ClutterModel`]). Each trait has one verb and works on a whole [`ParticleSet`] at a time,
+//! so a user's own model is a small struct and the per-call cost of dynamic dispatch is paid
+//! once per track, not once per particle. Built-in models live in the sub-modules.
+//!
+//! Not for: the filter recursion itself (see [`crate::filter`]).
+
+use crate::filter::ParticleSet;
+use crate::rng::FilterRng;
+use nalgebra::Isometry3;
+
+/// What the models may know about the current step.
+///
+/// `platform` is the pose of the sensing platform (robot, vehicle) in the world frame at this
+/// step; `previous_platform` the pose at the previous step. Planar platforms use a rotation
+/// about z. Both are `None` for a static sensor at the world origin.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct StepContext {
+    /// Filter step index (0 for the first frame).
+    pub step: u32,
+    /// Time stamp of this step, seconds.
+    pub time: f64,
+    /// Time since the previous step, seconds.
+    pub dt: f64,
+    /// Platform pose at this step (world frame).
+    pub platform: Option<Isometry3<f64>>,
+    /// Platform pose at the previous step (world frame).
+    pub previous_platform: Option<Isometry3<f64>>,
+}
+
+impl StepContext {
+    /// A context for a static sensor.
+    pub fn new(step: u32, time: f64, dt: f64) -> Self {
+        StepContext {
+            step,
+            time,
+            dt,
+            platform: None,
+            previous_platform: None,
+        }
+    }
+
+    /// Planar platform pose (x, y, heading) at this step; the origin when none is set.
+    pub fn platform_xy_heading(&self) -> (f64, f64, f64) {
+        match &self.platform {
+            None => (0.0, 0.0, 0.0),
+            Some(p) => {
+                let t = p.translation.vector;
+                let (_, _, yaw) = p.rotation.euler_angles();
+                (t.x, t.y, yaw)
+            }
+        }
+    }
+}
+
+/// Per-track summary handed to gates: weighted mean and per-component standard deviation of
+/// the predicted particle set.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TrackSummary {
+    /// Weighted mean state.
+    pub mean: Vec<f64>,
+    /// Weighted standard deviation of each state component.
+    pub std: Vec<f64>,
+}
+
+/// Moves a whole particle set one step forward (Markov transition density f(x' | x)).
+///
+/// Implementations sample the process noise themselves, from `rng`, so that a user's model
+/// can be any simulator: linear, nonlinear, or driven by the ego motion in `ctx`.
+pub trait TransitionModel: Send + Sync {
+    /// Dimension of the state vector this model moves.
+    fn state_dim(&self) -> usize;
+    /// Replaces every particle by a draw from f(· | particle).
+    fn predict(&self, particles: &mut ParticleSet, ctx: &StepContext, rng: &mut FilterRng);
+}
+
+/// Probability p_S(x) that an object survives from the previous step to this one.
+pub trait SurvivalModel: Send + Sync {
+    /// Writes p_S of every particle into `out` (values in [0, 1]).
+    fn survival_probability(&self, particles: &ParticleSet, ctx: &StepContext, out: &mut [f64]);
+}
+
+/// The single-object likelihood g(z | x).
+pub trait MeasurementModel: Send + Sync {
+    /// Dimension of one measurement vector.
+    fn measurement_dim(&self) -> usize;
+    /// Writes log g(z | xᵢ) of every particle into `out`. Must be finite or −∞, never NaN.
+    fn log_likelihood(
+        &self,
+        z: &[f64],
+        particles: &ParticleSet,
+        ctx: &StepContext,
+        out: &mut [f64],
+    );
+    /// A cheap test whether `z` could come from a track summarised by `track`; pairs that fail
+    /// are never evaluated by [`MeasurementModel::log_likelihood`]. The default admits all.
+    fn gate(&self, z: &[f64], track: &TrackSummary, ctx: &StepContext) -> bool {
+        let _ = (z, track, ctx);
+        true
+    }
+}
+
+/// The detection probability p_D(x).
+pub trait DetectionModel: Send + Sync {
+    /// Writes p_D of every particle into `out` (values in [0, 1]).
+    fn detection_probability(&self, particles: &ParticleSet, ctx: &StepContext, out: &mut [f64]);
+}
+
+/// The clutter intensity κ(z) = λ_c · c(z): expected number of false measurements times their
+/// spatial density.
+pub trait ClutterModel: Send + Sync {
+    /// log κ(z).
+    fn log_intensity(&self, z: &[f64], ctx: &StepContext) -> f64;
+}
