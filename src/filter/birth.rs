@@ -1,0 +1,245 @@
+//! Where new tracks come from: the birth LMB of each step.
+//!
+//! Two models are built in. [`StaticBirth`] is a fixed list of Gaussian birth terms, for
+//! scenes where objects appear at known places (the standard benchmarks). [`AdaptiveBirth`] is
+//! the measurement-driven birth of Reuter, Vo, Vo & Dietmayer (IEEE TSP 2014, Sec. IV): every
+//! measurement of the previous step that the existing tracks explained poorly proposes a new
+//! track, with an existence probability that grows with how unexplained it was. Not for:
+//! assigning labels (the filter does that).
+
+use super::{Measurements, ParticleSet};
+use crate::error::{ensure_finite, Error, Result};
+use crate::models::StepContext;
+use crate::rng::FilterRng;
+
+/// A proposed new track, before it gets its label.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BirthTrack {
+    /// Existence probability r_B ∈ (0, 1].
+    pub existence: f64,
+    /// The state density.
+    pub particles: ParticleSet,
+    /// True when `particles` describe the object at the *previous* step (adaptive birth
+    /// from last step's measurements): the filter then applies the transition to it.
+    pub at_previous_step: bool,
+}
+
+/// What the previous step saw, handed to birth models that learn from measurements.
+#[derive(Clone, Debug)]
+pub struct BirthEvidence<'a> {
+    /// The previous step's measurements.
+    pub measurements: &'a Measurements,
+    /// For each of them, the probability r_A(z) that an existing track generated it.
+    pub assigned: &'a [f64],
+    /// The previous step's context (platform pose there).
+    pub context: &'a StepContext,
+}
+
+/// Produces the birth LMB of a step.
+pub trait BirthModel: Send + Sync {
+    /// The birth tracks of the step described by `ctx`. `evidence` holds the previous step's
+    /// measurements and their association probabilities (`None` at the first step).
+    fn birth(
+        &self,
+        ctx: &StepContext,
+        evidence: Option<&BirthEvidence<'_>>,
+        rng: &mut FilterRng,
+    ) -> Vec<BirthTrack>;
+}
+
+/// One Gaussian birth term: existence probability, mean and per-component standard deviation.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct BirthTerm {
+    /// Existence probability.
+    pub existence: f64,
+    /// Mean state.
+    pub mean: Vec<f64>,
+    /// Standard deviation of each state component.
+    pub std: Vec<f64>,
+}
+
+/// A fixed list of Gaussian birth terms, proposed at every step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StaticBirth {
+    terms: Vec<BirthTerm>,
+    particles: usize,
+}
+
+impl StaticBirth {
+    /// A birth list; each term is sampled with `particles` particles.
+    pub fn new(terms: Vec<BirthTerm>, particles: usize) -> Result<Self> {
+        for (i, t) in terms.iter().enumerate() {
+            let what = format!("birth term {i}");
+            if !(t.existence > 0.0 && t.existence <= 1.0) {
+                return Err(Error::invalid(what, format!("existence {} outside (0, 1]", t.existence)));
+            }
+            if t.mean.is_empty() || t.mean.len() != t.std.len() {
+                return Err(Error::invalid(what, "mean and std must have the same, positive length"));
+            }
+            ensure_finite(&format!("mean of {what}"), &t.mean)?;
+            ensure_finite(&format!("std of {what}"), &t.std)?;
+            if t.std.iter().any(|s| *s < 0.0) {
+                return Err(Error::invalid(what, "negative standard deviation"));
+            }
+        }
+        if particles == 0 {
+            return Err(Error::invalid("birth particle count", "must be positive"));
+        }
+        Ok(StaticBirth { terms, particles })
+    }
+
+    /// The terms.
+    pub fn terms(&self) -> &[BirthTerm] {
+        &self.terms
+    }
+}
+
+impl BirthModel for StaticBirth {
+    fn birth(&self, _: &StepContext, _: Option<&BirthEvidence<'_>>, rng: &mut FilterRng) -> Vec<BirthTrack> {
+        self.terms
+            .iter()
+            .map(|t| BirthTrack {
+                existence: t.existence,
+                particles: ParticleSet::gaussian(&t.mean, &t.std, self.particles, rng),
+                at_previous_step: false,
+            })
+            .collect()
+    }
+}
+
+/// Draws a particle set of object states consistent with one measurement (an inverse
+/// measurement model with a prior on what the measurement does not see, e.g. velocity).
+pub trait BirthSampler: Send + Sync {
+    /// `n` particles for an object that produced `z` at the step described by `ctx`.
+    fn sample(&self, z: &[f64], ctx: &StepContext, n: usize, rng: &mut FilterRng) -> ParticleSet;
+}
+
+impl<F> BirthSampler for F
+where
+    F: Fn(&[f64], &StepContext, usize, &mut FilterRng) -> ParticleSet + Send + Sync,
+{
+    fn sample(&self, z: &[f64], ctx: &StepContext, n: usize, rng: &mut FilterRng) -> ParticleSet {
+        self(z, ctx, n, rng)
+    }
+}
+
+/// Birth sampler for Cartesian position measurements and interleaved constant-velocity states
+/// `[x, ẋ, y, ẏ(, z, ż)]`: position ~ N(z, σ_p²), velocity ~ N(0, σ_v²) per axis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PositionBirthSampler {
+    /// Standard deviation of the position around the measurement.
+    pub position_std: f64,
+    /// Standard deviation of each velocity component around zero.
+    pub velocity_std: f64,
+}
+
+impl BirthSampler for PositionBirthSampler {
+    fn sample(&self, z: &[f64], _: &StepContext, n: usize, rng: &mut FilterRng) -> ParticleSet {
+        let mean: Vec<f64> = z.iter().flat_map(|&p| [p, 0.0]).collect();
+        let std: Vec<f64> = z.iter().flat_map(|_| [self.position_std, self.velocity_std]).collect();
+        ParticleSet::gaussian(&mean, &std, n, rng)
+    }
+}
+
+/// Measurement-driven birth (Reuter et al. 2014, Sec. IV).
+///
+/// A measurement z of the previous step with association probability r_A(z) proposes a track
+/// with r_B(z) = min(r_B,max, λ_B · (1 − r_A(z)) / Σ_ξ (1 − r_A(ξ))), where λ_B is the expected
+/// number of births per step. Proposals below `min_existence` are dropped.
+pub struct AdaptiveBirth {
+    sampler: Box<dyn BirthSampler>,
+    /// Expected number of births per step, λ_B.
+    pub expected_births: f64,
+    /// Upper bound r_B,max on a proposal's existence probability.
+    pub max_existence: f64,
+    /// Proposals with smaller existence are not created.
+    pub min_existence: f64,
+    /// Particles per proposed track.
+    pub particles: usize,
+}
+
+impl AdaptiveBirth {
+    /// Adaptive birth drawing each proposal's particles from `sampler`.
+    pub fn new(sampler: impl BirthSampler + 'static, expected_births: f64, max_existence: f64, particles: usize) -> Result<Self> {
+        if !(expected_births > 0.0 && expected_births.is_finite()) {
+            return Err(Error::invalid("expected births per step", format!("{expected_births} must be positive")));
+        }
+        if !(max_existence > 0.0 && max_existence <= 1.0) {
+            return Err(Error::invalid("maximum birth existence", format!("{max_existence} outside (0, 1]")));
+        }
+        if particles == 0 {
+            return Err(Error::invalid("birth particle count", "must be positive"));
+        }
+        Ok(AdaptiveBirth { sampler: Box::new(sampler), expected_births, max_existence, min_existence: 1e-5, particles })
+    }
+
+    /// The existence probabilities r_B(z) for association probabilities `assigned`.
+    pub fn birth_existence(&self, assigned: &[f64]) -> Vec<f64> {
+        let total: f64 = assigned.iter().map(|a| 1.0 - a.clamp(0.0, 1.0)).sum();
+        assigned
+            .iter()
+            .map(|a| {
+                if total <= 0.0 {
+                    0.0
+                } else {
+                    (self.expected_births * (1.0 - a.clamp(0.0, 1.0)) / total).min(self.max_existence)
+                }
+            })
+            .collect()
+    }
+}
+
+impl BirthModel for AdaptiveBirth {
+    fn birth(&self, _: &StepContext, evidence: Option<&BirthEvidence<'_>>, rng: &mut FilterRng) -> Vec<BirthTrack> {
+        let Some(ev) = evidence else { return Vec::new() };
+        self.birth_existence(ev.assigned)
+            .into_iter()
+            .zip(ev.measurements.iter())
+            .filter(|(r, _)| *r >= self.min_existence)
+            .map(|(r, z)| BirthTrack {
+                existence: r,
+                particles: self.sampler.sample(z, ev.context, self.particles, rng),
+                at_previous_step: true,
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::seeded;
+
+    #[test]
+    fn adaptive_existence_follows_reuter_rule() {
+        let b = AdaptiveBirth::new(PositionBirthSampler { position_std: 1.0, velocity_std: 1.0 }, 0.2, 0.05, 10).unwrap();
+        // unexplained masses 1, 0.5, 0 → total 1.5; λ_B = 0.2 → 0.1333 (capped 0.05), 0.0667 (capped), 0
+        let r = b.birth_existence(&[0.0, 0.5, 1.0]);
+        assert_eq!(r, vec![0.05, 0.05, 0.0]);
+        let b = AdaptiveBirth::new(PositionBirthSampler { position_std: 1.0, velocity_std: 1.0 }, 0.03, 0.05, 10).unwrap();
+        let r = b.birth_existence(&[0.0, 0.5, 1.0]);
+        assert!((r[0] - 0.02).abs() < 1e-12 && (r[1] - 0.01).abs() < 1e-12 && r[2] == 0.0);
+    }
+
+    #[test]
+    fn adaptive_birth_places_particles_at_unexplained_measurements() {
+        let b = AdaptiveBirth::new(PositionBirthSampler { position_std: 0.5, velocity_std: 1.0 }, 1.0, 0.5, 2000).unwrap();
+        let m = Measurements::from_rows(2, &[[10.0, -4.0], [0.0, 0.0]]).unwrap();
+        let ctx = StepContext::new(0, 0.0, 1.0);
+        let ev = BirthEvidence { measurements: &m, assigned: &[0.0, 1.0], context: &ctx };
+        let births = b.birth(&ctx, Some(&ev), &mut seeded(4));
+        assert_eq!(births.len(), 1);
+        let mean = births[0].particles.mean();
+        assert!((mean[0] - 10.0).abs() < 0.1 && (mean[2] + 4.0).abs() < 0.1 && mean[1].abs() < 0.1);
+        assert!(births[0].at_previous_step);
+        assert!(b.birth(&ctx, None, &mut seeded(4)).is_empty());
+    }
+
+    #[test]
+    fn static_birth_validates_terms() {
+        let bad = BirthTerm { existence: 1.5, mean: vec![0.0], std: vec![1.0] };
+        assert!(StaticBirth::new(vec![bad], 10).is_err());
+        let nan = BirthTerm { existence: 0.1, mean: vec![f64::NAN], std: vec![1.0] };
+        assert!(StaticBirth::new(vec![nan], 10).unwrap_err().to_string().contains("birth term 0"));
+    }
+}

@@ -1,0 +1,559 @@
+//! The LMB filter: one call of [`LmbFilter::step`] per frame runs the recursion of Reuter, Vo,
+//! Vo & Dietmayer (IEEE TSP 2014) with particle densities (as in the SMC implementation of the
+//! planar-feature LMB paper, Sec. 4):
+//!
+//! predict → birth → gate → likelihoods → associate → update → resample → prune → estimate.
+//!
+//! Each stage is one function below. Work per track and per association group runs in parallel
+//! with rayon; every track draws from its own random stream derived from the step seed and its
+//! label, so results are bit-identical whatever the number of threads. Not for: models
+//! (see [`crate::models`]), association algorithms (see [`super::association`]).
+
+use super::association::{AssociationMethod, AssociationProblem, Associator, Marginals};
+use super::birth::{BirthEvidence, BirthModel};
+use super::estimate::map_estimates;
+use super::groups::partition;
+use super::track::{Estimate, Track};
+use super::{Jitter, Label, Measurements};
+use crate::error::{Error, Result};
+use crate::models::{
+    ClutterModel, ConstantSurvival, DetectionModel, MeasurementModel, StepContext, SurvivalModel,
+    TrackSummary, TransitionModel,
+};
+use crate::rng::{stream, FilterRng};
+use nalgebra::Isometry3;
+use rand::Rng;
+use rayon::prelude::*;
+
+/// Tuning of the recursion. Every field has a documented default.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LmbConfig {
+    /// Particles per track after resampling. Default 1000.
+    pub particles: usize,
+    /// Resample a track when its effective sample size falls below this fraction of
+    /// `particles` (1.0 resamples after every update that changed the weights). Default 0.5.
+    pub resample_threshold: f64,
+    /// Diversity added after resampling. Default: regularised kernel at 0.2 × optimal bandwidth.
+    pub jitter: Jitter,
+    /// Tracks whose existence probability falls below this are removed. Default 1e-3.
+    pub prune_threshold: f64,
+    /// At most this many tracks (those with the highest existence) are kept. Default 100.
+    pub max_tracks: usize,
+}
+
+impl Default for LmbConfig {
+    fn default() -> Self {
+        LmbConfig {
+            particles: 1000,
+            resample_threshold: 0.5,
+            jitter: Jitter::default(),
+            prune_threshold: 1e-3,
+            max_tracks: 100,
+        }
+    }
+}
+
+impl LmbConfig {
+    /// Checks ranges; names the first bad field.
+    pub fn validate(&self) -> Result<()> {
+        if self.particles == 0 {
+            return Err(Error::invalid("config field `particles`", "must be positive"));
+        }
+        if !(0.0..=1.0).contains(&self.resample_threshold) {
+            return Err(Error::invalid("config field `resample_threshold`", format!("{} outside [0, 1]", self.resample_threshold)));
+        }
+        if !(0.0..1.0).contains(&self.prune_threshold) {
+            return Err(Error::invalid("config field `prune_threshold`", format!("{} outside [0, 1)", self.prune_threshold)));
+        }
+        if self.max_tracks == 0 {
+            return Err(Error::invalid("config field `max_tracks`", "must be positive"));
+        }
+        match self.jitter {
+            Jitter::Roughening { k: s } | Jitter::Regularised { scale: s } if !(s >= 0.0 && s.is_finite()) => {
+                Err(Error::invalid("config field `jitter`", format!("scale {s} must be finite and ≥ 0")))
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+/// One frame handed to the filter.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    /// Time stamp, seconds (must not decrease).
+    pub time: f64,
+    /// The frame's measurements.
+    pub measurements: Measurements,
+    /// Pose of the sensing platform in the world frame, if it moves.
+    pub platform: Option<Isometry3<f64>>,
+}
+
+impl Frame {
+    /// A frame from a static sensor.
+    pub fn new(time: f64, measurements: Measurements) -> Self {
+        Frame { time, measurements, platform: None }
+    }
+}
+
+/// Collects the models and settings of an [`LmbFilter`].
+#[derive(Default)]
+pub struct LmbFilterBuilder {
+    transition: Option<Box<dyn TransitionModel>>,
+    survival: Option<Box<dyn SurvivalModel>>,
+    measurement: Option<Box<dyn MeasurementModel>>,
+    detection: Option<Box<dyn DetectionModel>>,
+    clutter: Option<Box<dyn ClutterModel>>,
+    birth: Option<Box<dyn BirthModel>>,
+    associator: Option<Box<dyn Associator>>,
+    config: LmbConfig,
+}
+
+impl LmbFilterBuilder {
+    /// The transition model (required).
+    pub fn transition(mut self, m: impl TransitionModel + 'static) -> Self {
+        self.transition = Some(Box::new(m));
+        self
+    }
+    /// The survival model (default: p_S = 0.99 everywhere).
+    pub fn survival(mut self, m: impl SurvivalModel + 'static) -> Self {
+        self.survival = Some(Box::new(m));
+        self
+    }
+    /// The measurement model (required).
+    pub fn measurement(mut self, m: impl MeasurementModel + 'static) -> Self {
+        self.measurement = Some(Box::new(m));
+        self
+    }
+    /// The detection model (required).
+    pub fn detection(mut self, m: impl DetectionModel + 'static) -> Self {
+        self.detection = Some(Box::new(m));
+        self
+    }
+    /// The clutter model (required).
+    pub fn clutter(mut self, m: impl ClutterModel + 'static) -> Self {
+        self.clutter = Some(Box::new(m));
+        self
+    }
+    /// The birth model (required).
+    pub fn birth(mut self, m: impl BirthModel + 'static) -> Self {
+        self.birth = Some(Box::new(m));
+        self
+    }
+    /// The association method (default: [`AssociationMethod::default`]).
+    pub fn associator(mut self, a: impl Associator + 'static) -> Self {
+        self.associator = Some(Box::new(a));
+        self
+    }
+    /// Tuning (default: [`LmbConfig::default`]).
+    pub fn config(mut self, c: LmbConfig) -> Self {
+        self.config = c;
+        self
+    }
+
+    /// Checks that every required model is present and the config is valid.
+    pub fn build(self) -> Result<LmbFilter> {
+        self.config.validate()?;
+        let missing = |what: &str| Error::invalid("filter", format!("no {what} model given"));
+        let transition = self.transition.ok_or_else(|| missing("transition"))?;
+        let measurement = self.measurement.ok_or_else(|| missing("measurement"))?;
+        Ok(LmbFilter {
+            models: Models {
+                transition,
+                survival: self.survival.unwrap_or_else(|| Box::new(ConstantSurvival(0.99))),
+                measurement,
+                detection: self.detection.ok_or_else(|| missing("detection"))?,
+                clutter: self.clutter.ok_or_else(|| missing("clutter"))?,
+                birth: self.birth.ok_or_else(|| missing("birth"))?,
+                associator: self.associator.unwrap_or_else(|| Box::new(AssociationMethod::default())),
+            },
+            config: self.config,
+            tracks: Vec::new(),
+            step: 0,
+            previous: None,
+        })
+    }
+}
+
+struct Models {
+    transition: Box<dyn TransitionModel>,
+    survival: Box<dyn SurvivalModel>,
+    measurement: Box<dyn MeasurementModel>,
+    detection: Box<dyn DetectionModel>,
+    clutter: Box<dyn ClutterModel>,
+    birth: Box<dyn BirthModel>,
+    associator: Box<dyn Associator>,
+}
+
+/// What the previous step leaves for the next: its context and, for adaptive birth, its
+/// measurements and their association probabilities.
+struct Previous {
+    context: StepContext,
+    measurements: Measurements,
+    assigned: Vec<f64>,
+}
+
+/// Per-track quantities of one update: detection probabilities and the likelihood of every
+/// gated measurement, all in the log domain.
+struct TrackLikelihoods {
+    /// ln p_D(xᵢ).
+    log_pd: Vec<f64>,
+    /// ln (1 − p_D(xᵢ)).
+    log_qd: Vec<f64>,
+    /// ln η_miss = ln Σ wᵢ (1 − p_D(xᵢ)).
+    log_eta_miss: f64,
+    /// Gated measurement indices.
+    gated: Vec<usize>,
+    /// For each gated measurement: ln Σ wᵢ p_D(xᵢ) g(z | xᵢ) (without κ).
+    log_eta: Vec<f64>,
+    /// For each gated measurement: ln g(z | xᵢ) per particle.
+    log_g: Vec<Vec<f64>>,
+}
+
+/// A track's row of association marginals, in its own terms.
+struct TrackMarginals {
+    miss: f64,
+    /// (index into `TrackLikelihoods::gated`, probability).
+    detect: Vec<(usize, f64)>,
+}
+
+/// Stream keys, combined with a label key or group key, for each random stage.
+const KEY_PREDICT: u64 = 0x01 << 60;
+const KEY_BIRTH: u64 = 0x02 << 60;
+const KEY_ASSOCIATE: u64 = 0x03 << 60;
+const KEY_RESAMPLE: u64 = 0x04 << 60;
+
+/// The labelled multi-Bernoulli filter with particle densities.
+pub struct LmbFilter {
+    models: Models,
+    config: LmbConfig,
+    tracks: Vec<Track>,
+    step: u32,
+    previous: Option<Previous>,
+}
+
+impl LmbFilter {
+    /// Starts building a filter.
+    pub fn builder() -> LmbFilterBuilder {
+        LmbFilterBuilder::default()
+    }
+
+    /// The current tracks (after the last step's pruning).
+    pub fn tracks(&self) -> &[Track] {
+        &self.tracks
+    }
+
+    /// The tuning in use.
+    pub fn config(&self) -> &LmbConfig {
+        &self.config
+    }
+
+    /// Number of steps run so far.
+    pub fn steps(&self) -> u32 {
+        self.step
+    }
+
+    /// Forgets every track and the previous step.
+    pub fn reset(&mut self) {
+        self.tracks.clear();
+        self.step = 0;
+        self.previous = None;
+    }
+
+    /// Runs one frame and returns the MAP multi-object estimate.
+    pub fn step(&mut self, frame: &Frame, rng: &mut FilterRng) -> Result<Vec<Estimate>> {
+        let ctx = self.context(frame)?;
+        let z = &frame.measurements;
+        if !z.is_empty() && z.dim() != self.models.measurement.measurement_dim() {
+            return Err(Error::invalid(
+                format!("measurements of step {}", self.step),
+                format!("have dimension {}, the measurement model expects {}", z.dim(), self.models.measurement.measurement_dim()),
+            ));
+        }
+        let seed = rng.next_u64();
+
+        self.predict(&ctx, seed);
+        self.add_births(&ctx, seed);
+        let likelihoods = self.likelihoods(z, &ctx);
+        let marginals = self.associate(z, &ctx, &likelihoods, seed);
+        let assigned = self.update(&likelihoods, &marginals, z.len(), seed);
+        self.prune();
+        let estimates = map_estimates(&self.tracks);
+
+        self.previous = Some(Previous { context: ctx, measurements: z.clone(), assigned });
+        self.step += 1;
+        Ok(estimates)
+    }
+
+    /// The step context: time step from the previous frame, platform poses.
+    fn context(&self, frame: &Frame) -> Result<StepContext> {
+        let what = || format!("frame of step {}", self.step);
+        if !frame.time.is_finite() {
+            return Err(Error::invalid(what(), format!("time stamp {} is not finite", frame.time)));
+        }
+        if let Some(p) = &frame.platform {
+            let v = p.to_homogeneous();
+            if v.iter().any(|x| !x.is_finite()) {
+                return Err(Error::invalid(what(), "platform pose is not finite"));
+            }
+        }
+        let (dt, previous_platform) = match &self.previous {
+            None => (0.0, None),
+            Some(p) => (frame.time - p.context.time, p.context.platform),
+        };
+        if dt < 0.0 {
+            return Err(Error::invalid(what(), format!("time goes backwards by {} s", -dt)));
+        }
+        Ok(StepContext { step: self.step, time: frame.time, dt, platform: frame.platform, previous_platform })
+    }
+
+    /// Prediction: survival reweighting r₊ = r·Σ wᵢ p_S(xᵢ), then the transition, per track.
+    fn predict(&mut self, ctx: &StepContext, seed: u64) {
+        if self.previous.is_none() {
+            return;
+        }
+        let m = &self.models;
+        self.tracks.par_iter_mut().for_each(|t| {
+            let mut rng = stream(seed, KEY_PREDICT ^ t.label.key());
+            let mut ps = vec![0.0; t.particles.len()];
+            m.survival.survival_probability(&t.particles, ctx, &mut ps);
+            ps.iter_mut().for_each(|p| *p = p.clamp(0.0, 1.0).ln());
+            let log_eta_s = t.particles.reweight_log(&ps);
+            t.existence *= log_eta_s.exp().min(1.0);
+            m.transition.predict(&mut t.particles, ctx, &mut rng);
+            t.age += 1;
+        });
+    }
+
+    /// Appends the birth tracks of this step, labelled (step, index).
+    fn add_births(&mut self, ctx: &StepContext, seed: u64) {
+        let evidence = self.previous.as_ref().map(|p| BirthEvidence {
+            measurements: &p.measurements,
+            assigned: &p.assigned,
+            context: &p.context,
+        });
+        let births = self.models.birth.birth(ctx, evidence.as_ref(), &mut stream(seed, KEY_BIRTH));
+        let step = self.step;
+        let transition = &self.models.transition;
+        let new: Vec<Track> = births
+            .into_par_iter()
+            .enumerate()
+            .filter(|(_, b)| b.existence > 0.0 && !b.particles.is_empty())
+            .map(|(i, b)| {
+                let label = Label::new(step, i as u32);
+                let mut particles = b.particles;
+                if b.at_previous_step && ctx.dt > 0.0 {
+                    transition.predict(&mut particles, ctx, &mut stream(seed, KEY_PREDICT ^ label.key()));
+                }
+                Track::new(label, b.existence.min(1.0), particles)
+            })
+            .collect();
+        self.tracks.extend(new);
+    }
+
+    /// Gating and the particle sums η_j(ℓ) and η_miss(ℓ) for every track, in parallel.
+    fn likelihoods(&self, z: &Measurements, ctx: &StepContext) -> Vec<TrackLikelihoods> {
+        let m = &self.models;
+        self.tracks
+            .par_iter()
+            .map(|t| {
+                let p = &t.particles;
+                let n = p.len();
+                let mut pd = vec![0.0; n];
+                m.detection.detection_probability(p, ctx, &mut pd);
+                let log_pd: Vec<f64> = pd.iter().map(|d| d.clamp(0.0, 1.0).ln()).collect();
+                let log_qd: Vec<f64> = pd.iter().map(|d| (1.0 - d.clamp(0.0, 1.0)).ln()).collect();
+                let log_w: Vec<f64> = p.weights().iter().map(|w| w.ln()).collect();
+                let log_eta_miss = log_sum_exp2(&log_w, &log_qd);
+                let summary = TrackSummary { mean: p.mean(), std: p.std_dev() };
+                let mut gated = Vec::new();
+                let mut log_eta = Vec::new();
+                let mut log_g = Vec::new();
+                let mut wd: Vec<f64> = log_w.iter().zip(&log_pd).map(|(a, b)| a + b).collect();
+                if wd.iter().all(|v| *v == f64::NEG_INFINITY) {
+                    wd.clear();
+                }
+                for (j, zj) in z.iter().enumerate() {
+                    if wd.is_empty() || !m.measurement.gate(zj, &summary, ctx) {
+                        continue;
+                    }
+                    let mut g = vec![0.0; n];
+                    m.measurement.log_likelihood(zj, p, ctx, &mut g);
+                    let eta = log_sum_exp2(&wd, &g);
+                    if eta == f64::NEG_INFINITY || eta.is_nan() {
+                        continue;
+                    }
+                    gated.push(j);
+                    log_eta.push(eta);
+                    log_g.push(g);
+                }
+                TrackLikelihoods { log_pd, log_qd, log_eta_miss, gated, log_eta, log_g }
+            })
+            .collect()
+    }
+
+    /// Association: independent groups, each solved by the associator, in parallel.
+    fn associate(
+        &self,
+        z: &Measurements,
+        ctx: &StepContext,
+        lik: &[TrackLikelihoods],
+        seed: u64,
+    ) -> Vec<TrackMarginals> {
+        let log_kappa: Vec<f64> = z.iter().map(|zj| self.models.clutter.log_intensity(zj, ctx)).collect();
+        let gated: Vec<Vec<usize>> = lik.iter().map(|l| l.gated.clone()).collect();
+        let groups = partition(&gated, z.len());
+        let tracks = &self.tracks;
+        let associator = &self.models.associator;
+        let solved: Vec<Vec<(usize, TrackMarginals)>> = groups
+            .par_iter()
+            .map(|g| {
+                let n = g.tracks.len();
+                let m = g.measurements.len();
+                let mut problem = AssociationProblem {
+                    n_tracks: n,
+                    n_meas: m,
+                    log_miss: Vec::with_capacity(n),
+                    log_detect: vec![f64::NEG_INFINITY; n * m],
+                };
+                for (row, &ti) in g.tracks.iter().enumerate() {
+                    let r = tracks[ti].existence;
+                    let l = &lik[ti];
+                    problem.log_miss.push(log_miss_weight(r, l.log_eta_miss));
+                    for (k, &j) in l.gated.iter().enumerate() {
+                        let col = g.measurements.binary_search(&j).expect("gated measurement in its group");
+                        problem.log_detect[row * m + col] = r.ln() + l.log_eta[k] - log_kappa[j];
+                    }
+                }
+                let marg: Marginals = if m == 0 {
+                    Marginals { n_tracks: n, n_meas: 0, miss: vec![1.0; n], detect: Vec::new() }
+                } else {
+                    let key = tracks[g.tracks[0]].label.key();
+                    associator.marginals(&problem, &mut stream(seed, KEY_ASSOCIATE ^ key))
+                };
+                g.tracks
+                    .iter()
+                    .enumerate()
+                    .map(|(row, &ti)| {
+                        let detect = lik[ti]
+                            .gated
+                            .iter()
+                            .enumerate()
+                            .map(|(k, &j)| {
+                                let col = g.measurements.binary_search(&j).expect("gated measurement in its group");
+                                (k, marg.detect[row * m + col])
+                            })
+                            .collect();
+                        (ti, TrackMarginals { miss: marg.miss[row], detect })
+                    })
+                    .collect()
+            })
+            .collect();
+        let mut out: Vec<Option<TrackMarginals>> = (0..self.tracks.len()).map(|_| None).collect();
+        for (ti, tm) in solved.into_iter().flatten() {
+            out[ti] = Some(tm);
+        }
+        out.into_iter().map(|o| o.expect("every track is in one group")).collect()
+    }
+
+    /// The GLMB → LMB update of existence and particle weights, then resampling. Returns, for
+    /// every measurement, the probability that some track generated it.
+    fn update(&mut self, lik: &[TrackLikelihoods], marg: &[TrackMarginals], n_meas: usize, seed: u64) -> Vec<f64> {
+        let cfg = &self.config;
+        self.tracks.par_iter_mut().zip(lik.par_iter()).zip(marg.par_iter()).for_each(|((t, l), mg)| {
+            update_track(t, l, mg);
+            let n = t.particles.len();
+            if n != cfg.particles || t.particles.effective_sample_size() < cfg.resample_threshold * cfg.particles as f64 {
+                let mut rng = stream(seed, KEY_RESAMPLE ^ t.label.key());
+                t.particles.resample(cfg.particles, cfg.jitter, &mut rng);
+            }
+        });
+        let mut assigned = vec![0.0; n_meas];
+        for (l, mg) in lik.iter().zip(marg) {
+            for &(k, p) in &mg.detect {
+                assigned[l.gated[k]] += p;
+            }
+        }
+        assigned.iter_mut().for_each(|a| *a = a.min(1.0));
+        assigned
+    }
+
+    /// Removes tracks below the existence threshold and keeps at most `max_tracks`.
+    fn prune(&mut self) {
+        let threshold = self.config.prune_threshold;
+        self.tracks.retain(|t| t.existence >= threshold && t.existence > 0.0);
+        if self.tracks.len() > self.config.max_tracks {
+            self.tracks.sort_by(|a, b| b.existence.total_cmp(&a.existence).then(a.label.cmp(&b.label)));
+            self.tracks.truncate(self.config.max_tracks);
+            self.tracks.sort_by_key(|t| t.label);
+        }
+    }
+}
+
+/// ln(1 − r + r·η_miss), stable for r → 1 and η_miss → 0.
+fn log_miss_weight(r: f64, log_eta_miss: f64) -> f64 {
+    let absent = 1.0 - r;
+    let missed = r * log_eta_miss.exp();
+    if absent + missed > 0.0 {
+        (absent + missed).ln()
+    } else {
+        r.ln() + log_eta_miss
+    }
+}
+
+/// ln Σᵢ exp(aᵢ + bᵢ), safe against overflow and underflow; −∞ for an empty or all-−∞ sum.
+fn log_sum_exp2(a: &[f64], b: &[f64]) -> f64 {
+    let max = a.iter().zip(b).map(|(x, y)| x + y).fold(f64::NEG_INFINITY, f64::max);
+    if !max.is_finite() {
+        return max;
+    }
+    let s: f64 = a.iter().zip(b).map(|(x, y)| (x + y - max).exp()).sum();
+    max + s.ln()
+}
+
+/// ln(eᵃ + eᵇ).
+fn log_add_exp(a: f64, b: f64) -> f64 {
+    let (hi, lo) = if a > b { (a, b) } else { (b, a) };
+    if lo == f64::NEG_INFINITY {
+        hi
+    } else {
+        hi + (lo - hi).exp().ln_1p()
+    }
+}
+
+/// Posterior existence and particle weights of one track from its association marginals
+/// (the LMB approximation of the GLMB posterior, Reuter et al. 2014, eqs. 20–21, with the
+/// miss/absence hypotheses split as in the marginal form of the fast LMB update).
+fn update_track(t: &mut Track, l: &TrackLikelihoods, mg: &TrackMarginals) {
+    let r = t.existence;
+    let eta_miss = l.log_eta_miss.exp();
+    let denom = 1.0 - r + r * eta_miss;
+    // Probability that the track exists and was missed.
+    let p_missed = if denom > 0.0 { mg.miss * (r * eta_miss / denom) } else { 0.0 };
+    let p_detected: f64 = mg.detect.iter().map(|(_, p)| p).sum();
+    let r_post = (p_missed + p_detected).clamp(0.0, 1.0);
+    t.existence = r_post;
+    t.expected_detections += p_detected;
+    if r_post <= 0.0 {
+        return;
+    }
+    let detected: Vec<(usize, f64)> = mg.detect.iter().copied().filter(|(_, p)| *p > 0.0).collect();
+    if detected.is_empty() && l.log_qd.windows(2).all(|w| w[0] == w[1]) {
+        return; // only the miss term, constant over particles: weights unchanged
+    }
+    let n = t.particles.len();
+    let mut factor = vec![f64::NEG_INFINITY; n];
+    if p_missed > 0.0 && l.log_eta_miss.is_finite() {
+        let c = p_missed.ln() - l.log_eta_miss;
+        for (f, q) in factor.iter_mut().zip(&l.log_qd) {
+            *f = c + q;
+        }
+    }
+    for (k, p) in detected {
+        let c = p.ln() - l.log_eta[k];
+        for ((f, d), g) in factor.iter_mut().zip(&l.log_pd).zip(&l.log_g[k]) {
+            *f = log_add_exp(*f, c + d + g);
+        }
+    }
+    t.particles.reweight_log(&factor);
+}
