@@ -1,1 +1,22 @@
-//! Multi-object performance metrics.
+//! Multi-object performance metrics for judging a tracker against ground truth.
+//!
+//! Everything here is a pure function of truth and estimates (plus one small frame-by-frame
+//! accumulator for label statistics); nothing here runs or steers a filter.
+//!
+//! | Module | Measures |
+//! |---|---|
+//! | [`ospa`](mod@ospa) | OSPA distance between two point sets, split into localisation and cardinality |
+//!
+//! Points are slices of `f64` coordinates of any (common) dimension; all distances between
+//! points are Euclidean. Functions accept anything that derefs to `[f64]` per point, so a
+//! `Vec<Vec<f64>>` can be passed as `&v`.
+//!
+//! Inputs that would make a metric meaningless (a cut-off that is not positive and finite, an
+//! order below one, non-finite coordinates, points of different dimensions) are reported as
+//! [`Error::InvalidInput`](crate::Error::InvalidInput) values; empty inputs are never errors
+//! for the set metrics.
+
+pub mod ospa;
+mod points;
+
+pub use ospa::{ospa, Ospa};
