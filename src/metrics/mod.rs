@@ -6,6 +6,7 @@
 //! | Module | Measures |
 //! |---|---|
 //! | [`ospa`](mod@ospa) | OSPA distance between two point sets, split into localisation and cardinality |
+//! | [`gospa`](mod@gospa) | GOSPA (α = 2) with localisation / missed / false-alarm parts |
 //!
 //! Points are slices of `f64` coordinates of any (common) dimension; all distances between
 //! points are Euclidean. Functions accept anything that derefs to `[f64]` per point, so a
@@ -16,7 +17,9 @@
 //! [`Error::InvalidInput`](crate::Error::InvalidInput) values; empty inputs are never errors
 //! for the set metrics.
 
+pub mod gospa;
 pub mod ospa;
 mod points;
 
+pub use gospa::{gospa, Gospa};
 pub use ospa::{ospa, Ospa};
