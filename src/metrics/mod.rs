@@ -8,6 +8,7 @@
 //! | [`ospa`](mod@ospa) | OSPA distance between two point sets, split into localisation and cardinality |
 //! | [`gospa`](mod@gospa) | GOSPA (α = 2) with localisation / missed / false-alarm parts |
 //! | [`ospa2`](mod@ospa2) | OSPA(2) between sets of tracks over a time window (and a sliding series) |
+//! | [`cardinality`] | Per-step and mean error in the number of objects |
 //!
 //! Points are slices of `f64` coordinates of any (common) dimension; all distances between
 //! points are Euclidean. Functions accept anything that derefs to `[f64]` per point, so a
@@ -18,11 +19,13 @@
 //! [`Error::InvalidInput`](crate::Error::InvalidInput) values; empty inputs are never errors
 //! for the set metrics.
 
+pub mod cardinality;
 pub mod gospa;
 pub mod ospa;
 pub mod ospa2;
 mod points;
 
+pub use cardinality::{cardinality_error, CardinalityError};
 pub use gospa::{gospa, Gospa};
 pub use ospa::{ospa, Ospa};
 pub use ospa2::{ospa2, ospa2_parts, ospa2_series, tracks_from_frames, TrackHistory};
