@@ -10,6 +10,7 @@
 //! | [`ospa2`](mod@ospa2) | OSPA(2) between sets of tracks over a time window (and a sliding series) |
 //! | [`cardinality`] | Per-step and mean error in the number of objects |
 //! | [`labels`] | Label switches and label persistence of estimates matched to truth |
+//! | [`rmse`] | RMS error of error vectors and the averaged-NIS consistency check |
 //!
 //! Points are slices of `f64` coordinates of any (common) dimension; all distances between
 //! points are Euclidean. Functions accept anything that derefs to `[f64]` per point, so a
@@ -26,9 +27,11 @@ pub mod labels;
 pub mod ospa;
 pub mod ospa2;
 mod points;
+pub mod rmse;
 
 pub use cardinality::{cardinality_error, CardinalityError};
 pub use gospa::{gospa, Gospa};
 pub use labels::{LabelConsistency, LabelStats, TruthLabels};
 pub use ospa::{ospa, Ospa};
 pub use ospa2::{ospa2, ospa2_parts, ospa2_series, tracks_from_frames, TrackHistory};
+pub use rmse::{average_nis, chi_square_quantile, rms_error, NisCheck};
