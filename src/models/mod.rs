@@ -4,6 +4,20 @@
 //! so a user's own model is a small struct and the per-call cost of dynamic dispatch is paid
 //! once per track, not once per particle. Built-in models live in the sub-modules.
 //!
+//! # State layout of the built-in models
+//!
+//! Position and velocity are interleaved per axis, as in the standard RFS benchmarks:
+//!
+//! | model | state |
+//! |---|---|
+//! | planar constant velocity ([`ConstantVelocity`] with 2 axes) | `[x, ẋ, y, ẏ]` |
+//! | spatial constant velocity ([`ConstantVelocity`] with 3 axes) | `[x, ẋ, y, ẏ, z, ż]` |
+//! | coordinated turn ([`CoordinatedTurn`]) | `[x, ẋ, y, ẏ, ω]` |
+//!
+//! So the position of every built-in state is found in components 0, 2 (and 4 in 3-D); the
+//! measurement and detection models read it from there and ignore the rest. A user's model
+//! may use any layout, as long as its transition, measurement and detection models agree.
+//!
 //! Not for: the filter recursion itself (see [`crate::filter`]).
 
 use crate::filter::ParticleSet;
@@ -113,3 +127,19 @@ pub trait ClutterModel: Send + Sync {
     /// log κ(z).
     fn log_intensity(&self, z: &[f64], ctx: &StepContext) -> f64;
 }
+
+pub mod clutter;
+pub mod ct;
+pub mod cv;
+pub mod detection;
+pub mod position;
+pub mod range_bearing;
+pub mod survival;
+
+pub use clutter::UniformClutter;
+pub use ct::CoordinatedTurn;
+pub use cv::ConstantVelocity;
+pub use detection::{ConstantDetection, FieldOfViewDetection, GaussianRangeDetection};
+pub use position::PositionMeasurement;
+pub use range_bearing::{wrap_angle, BearingConvention, RangeBearing};
+pub use survival::ConstantSurvival;

@@ -1,0 +1,429 @@
+//! Range and bearing to an object from a sensor mounted on a (possibly moving) platform.
+//!
+//! The platform pose (x, y, φ) comes from [`StepContext::platform_xy_heading`] (the world
+//! origin with φ = 0 when no platform is set). The sensor is mounted at (a, b) in the platform
+//! frame, so in the world it sits at
+//!
+//! ```text
+//! x_s = x + a cos φ − b sin φ
+//! y_s = y + a sin φ + b cos φ
+//! ```
+//!
+//! and looks along the platform heading. An object at world position (p_x, p_y) — components
+//! 0 and 2 of the state — has offset (d_x, d_y) = (p_x − x_s, p_y − y_s), which in the sensor
+//! frame reads l_x = cos φ d_x + sin φ d_y, l_y = −sin φ d_x + cos φ d_y. Then
+//!
+//! ```text
+//! range   ρ = √(d_x² + d_y²)
+//! bearing θ = atan2(l_y, l_x)   (BearingConvention::FromXAxis: counter-clockwise from the
+//!                                heading, = atan2(d_y, d_x) − φ wrapped to (−π, π])
+//! bearing θ = atan2(l_x, l_y)   (BearingConvention::FromYAxis: clockwise from the sensor's
+//!                                y axis; with no platform this is the benchmark's atan2(x, y))
+//! ```
+//!
+//! z = (ρ, θ) + w with w ~ N(0, diag(σ_ρ², σ_θ²)), and
+//! log g(z | x) = −(ρ_z − ρ)²/(2σ_ρ²) − wrap(θ_z − θ)²/(2σ_θ²) − ln(2π σ_ρ σ_θ), the bearing
+//! residual wrapped to (−π, π].
+//!
+//! Not for: three-dimensional (elevation) measurements or sensors that rotate independently of
+//! the platform.
+
+use super::{MeasurementModel, StepContext, TrackSummary};
+use crate::error::{Error, Result};
+use crate::filter::ParticleSet;
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
+
+/// Default gate half-width, in standard deviations (see [`RangeBearing::gate`]).
+pub const DEFAULT_GATE_SIGMAS: f64 = 5.0;
+
+/// Wraps an angle to (−π, π].
+pub fn wrap_angle(a: f64) -> f64 {
+    if a > -PI && a <= PI {
+        a
+    } else {
+        a - TAU * ((a - PI) / TAU).ceil()
+    }
+}
+
+/// Where the bearing is measured from.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BearingConvention {
+    /// Counter-clockwise from the sensor's x axis (its boresight): θ = atan2(l_y, l_x). The
+    /// usual robotics convention.
+    #[default]
+    FromXAxis,
+    /// Clockwise from the sensor's y axis: θ = atan2(l_x, l_y). The nonlinear RFS benchmark
+    /// uses this with the sensor at the origin, θ = atan2(x, y).
+    FromYAxis,
+}
+
+/// Range-bearing measurement model, z = [range, bearing].
+#[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct RangeBearing {
+    sigma_range: f64,
+    sigma_bearing: f64,
+    offset: (f64, f64),
+    convention: BearingConvention,
+    gate_sigmas: f64,
+}
+
+/// Sensor position and heading in the world frame.
+#[derive(Copy, Clone, Debug)]
+struct Sensor {
+    x: f64,
+    y: f64,
+    cos: f64,
+    sin: f64,
+}
+
+impl RangeBearing {
+    /// Range noise `sigma_range` (m) and bearing noise `sigma_bearing` (rad), both finite and
+    /// positive; no mounting offset, [`BearingConvention::FromXAxis`], gate of
+    /// [`DEFAULT_GATE_SIGMAS`].
+    pub fn new(sigma_range: f64, sigma_bearing: f64) -> Result<Self> {
+        for (name, v) in [
+            ("sigma_range", sigma_range),
+            ("sigma_bearing", sigma_bearing),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::invalid(
+                    format!("range-bearing {name}"),
+                    format!("{v} (must be finite and positive)"),
+                ));
+            }
+        }
+        Ok(RangeBearing {
+            sigma_range,
+            sigma_bearing,
+            offset: (0.0, 0.0),
+            convention: BearingConvention::FromXAxis,
+            gate_sigmas: DEFAULT_GATE_SIGMAS,
+        })
+    }
+
+    /// The nonlinear benchmark's sensor: σ_ρ = 10 m, σ_θ = 2°, bearing from the y axis,
+    /// sensor at the origin.
+    pub fn benchmark() -> Self {
+        RangeBearing {
+            sigma_range: 10.0,
+            sigma_bearing: 2.0f64.to_radians(),
+            offset: (0.0, 0.0),
+            convention: BearingConvention::FromYAxis,
+            gate_sigmas: DEFAULT_GATE_SIGMAS,
+        }
+    }
+
+    /// The same model with the sensor mounted at (a, b) in the platform frame.
+    pub fn with_offset(mut self, a: f64, b: f64) -> Result<Self> {
+        crate::error::ensure_finite("range-bearing mounting offset", &[a, b])?;
+        self.offset = (a, b);
+        Ok(self)
+    }
+
+    /// The same model with another bearing convention.
+    pub fn with_convention(mut self, convention: BearingConvention) -> Self {
+        self.convention = convention;
+        self
+    }
+
+    /// The same model with gate half-width `k` > 0 (+∞ disables gating).
+    pub fn with_gate_sigmas(mut self, k: f64) -> Result<Self> {
+        if k.is_nan() || k <= 0.0 {
+            return Err(Error::invalid(
+                "range-bearing gate",
+                format!("{k} standard deviations (must be positive)"),
+            ));
+        }
+        self.gate_sigmas = k;
+        Ok(self)
+    }
+
+    /// Range noise standard deviation.
+    pub fn sigma_range(&self) -> f64 {
+        self.sigma_range
+    }
+
+    /// Bearing noise standard deviation (radians).
+    pub fn sigma_bearing(&self) -> f64 {
+        self.sigma_bearing
+    }
+
+    /// Mounting offset (a, b) in the platform frame.
+    pub fn offset(&self) -> (f64, f64) {
+        self.offset
+    }
+
+    /// The bearing convention.
+    pub fn convention(&self) -> BearingConvention {
+        self.convention
+    }
+
+    /// Gate half-width in standard deviations.
+    pub fn gate_sigmas(&self) -> f64 {
+        self.gate_sigmas
+    }
+
+    /// −ln(2π σ_ρ σ_θ), the log-likelihood at zero residual.
+    pub fn log_normaliser(&self) -> f64 {
+        -(TAU * self.sigma_range * self.sigma_bearing).ln()
+    }
+
+    /// The sensor's world pose (x_s, y_s, φ) at this step.
+    pub fn sensor_pose(&self, ctx: &StepContext) -> (f64, f64, f64) {
+        let (_, _, phi) = ctx.platform_xy_heading();
+        let s = self.sensor(ctx);
+        (s.x, s.y, phi)
+    }
+
+    fn sensor(&self, ctx: &StepContext) -> Sensor {
+        let (px, py, phi) = ctx.platform_xy_heading();
+        let (sin, cos) = phi.sin_cos();
+        let (a, b) = self.offset;
+        Sensor {
+            x: px + a * cos - b * sin,
+            y: py + a * sin + b * cos,
+            cos,
+            sin,
+        }
+    }
+
+    #[inline]
+    fn measure(&self, s: &Sensor, px: f64, py: f64) -> (f64, f64) {
+        let dx = px - s.x;
+        let dy = py - s.y;
+        let lx = s.cos * dx + s.sin * dy;
+        let ly = -s.sin * dx + s.cos * dy;
+        let bearing = match self.convention {
+            BearingConvention::FromXAxis => ly.atan2(lx),
+            BearingConvention::FromYAxis => lx.atan2(ly),
+        };
+        (dx.hypot(dy), bearing)
+    }
+
+    /// The noiseless measurement [range, bearing] of `state` (position in components 0
+    /// and 2). States with fewer than three components give [NaN, NaN].
+    pub fn predict_measurement(&self, state: &[f64], ctx: &StepContext) -> [f64; 2] {
+        match (state.first(), state.get(2)) {
+            (Some(&x), Some(&y)) => {
+                let (r, b) = self.measure(&self.sensor(ctx), x, y);
+                [r, b]
+            }
+            _ => [f64::NAN, f64::NAN],
+        }
+    }
+
+    /// The world point (x, y) at which a noiseless measurement would read `z` = [range,
+    /// bearing] — the inverse of [`RangeBearing::predict_measurement`] on positions.
+    pub fn to_cartesian(&self, z: [f64; 2], ctx: &StepContext) -> [f64; 2] {
+        let s = self.sensor(ctx);
+        let [range, bearing] = z;
+        let local_angle = match self.convention {
+            BearingConvention::FromXAxis => bearing,
+            BearingConvention::FromYAxis => FRAC_PI_2 - bearing,
+        };
+        let (sa, ca) = local_angle.sin_cos();
+        let (lx, ly) = (range * ca, range * sa);
+        [s.x + s.cos * lx - s.sin * ly, s.y + s.sin * lx + s.cos * ly]
+    }
+}
+
+impl MeasurementModel for RangeBearing {
+    fn measurement_dim(&self) -> usize {
+        2
+    }
+
+    fn log_likelihood(
+        &self,
+        z: &[f64],
+        particles: &ParticleSet,
+        ctx: &StepContext,
+        out: &mut [f64],
+    ) {
+        let (zr, zb) = match z {
+            [r, b] if r.is_finite() && b.is_finite() => (*r, *b),
+            _ => {
+                out.fill(f64::NEG_INFINITY);
+                return;
+            }
+        };
+        if particles.dim() < 3 {
+            out.fill(f64::NEG_INFINITY);
+            return;
+        }
+        let s = self.sensor(ctx);
+        let norm = self.log_normaliser();
+        let inv_r = 1.0 / self.sigma_range;
+        let inv_b = 1.0 / self.sigma_bearing;
+        let xs = particles.component(0);
+        let ys = particles.component(2);
+        for ((o, &x), &y) in out.iter_mut().zip(xs).zip(ys) {
+            let (r, b) = self.measure(&s, x, y);
+            let er = (zr - r) * inv_r;
+            let eb = wrap_angle(zb - b) * inv_b;
+            let l = norm - 0.5 * (er * er + eb * eb);
+            *o = if l.is_nan() { f64::NEG_INFINITY } else { l };
+        }
+    }
+
+    /// Admits `z` when its Cartesian point lies within
+    /// k · (σ_ρ + σ_θ · ρ_max + √(s_x² + s_y²)) of the track's mean position, where k is the
+    /// gate width, ρ_max the larger of the measured range and the sensor's distance to the
+    /// mean, and s the track's position standard deviations. Since a bearing error Δθ at range
+    /// ρ displaces the point by at most ρ·|Δθ|, this is a conservative region.
+    fn gate(&self, z: &[f64], track: &TrackSummary, ctx: &StepContext) -> bool {
+        let [zr, zb] = match z {
+            [r, b] if r.is_finite() && b.is_finite() => [*r, *b],
+            _ => return false,
+        };
+        if track.mean.len() < 3 || track.std.len() < 3 {
+            return true;
+        }
+        let [cx, cy] = self.to_cartesian([zr, zb], ctx);
+        let (mx, my) = (track.mean[0], track.mean[2]);
+        let s = self.sensor(ctx);
+        let rho = zr.abs().max((mx - s.x).hypot(my - s.y));
+        let spread = track.std[0].hypot(track.std[2]);
+        let allowed = self.gate_sigmas * (self.sigma_range + self.sigma_bearing * rho + spread);
+        let d = (cx - mx).hypot(cy - my);
+        // NaN in the summary: admit rather than silently drop.
+        d.is_nan() || allowed.is_nan() || d <= allowed
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Isometry3, Vector3};
+
+    fn ctx() -> StepContext {
+        StepContext::new(0, 0.0, 1.0)
+    }
+
+    fn with_pose(x: f64, y: f64, phi: f64) -> StepContext {
+        let mut c = ctx();
+        c.platform = Some(Isometry3::new(
+            Vector3::new(x, y, 0.0),
+            Vector3::new(0.0, 0.0, phi),
+        ));
+        c
+    }
+
+    fn one(x: f64, y: f64) -> ParticleSet {
+        ParticleSet::from_rows(&[vec![x, 0.0, y, 0.0]], &[1.0]).unwrap()
+    }
+
+    #[test]
+    fn wrap_angle_lands_in_half_open_interval() {
+        assert!((wrap_angle(358f64.to_radians()) - (-2f64).to_radians()).abs() < 1e-12);
+        assert_eq!(wrap_angle(PI), PI);
+        assert!((wrap_angle(-PI) - PI).abs() < 1e-15);
+        assert!((wrap_angle(3.0 * PI) - PI).abs() < 1e-12);
+        assert!((wrap_angle(-7.0) - (-7.0 + TAU)).abs() < 1e-12);
+        assert_eq!(wrap_angle(0.5), 0.5);
+    }
+
+    #[test]
+    fn zero_residual_log_likelihood_is_the_normaliser() {
+        let m = RangeBearing::new(10.0, 0.02).unwrap();
+        let p = one(30.0, 40.0);
+        let z = m.predict_measurement(&p.state(0), &ctx());
+        assert!((z[0] - 50.0).abs() < 1e-12);
+        assert!((z[1] - (40.0f64).atan2(30.0)).abs() < 1e-12);
+        let mut out = vec![0.0];
+        m.log_likelihood(&z, &p, &ctx(), &mut out);
+        assert!((out[0] + (TAU * 10.0 * 0.02).ln()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bearing_residual_wraps_across_pi() {
+        let sb = 1f64.to_radians();
+        let m = RangeBearing::new(1.0, sb).unwrap();
+        // object at bearing −179° (range 100): behind-left, just below the negative x axis
+        let h = (-179f64).to_radians();
+        let p = one(100.0 * h.cos(), 100.0 * h.sin());
+        let mut out = vec![0.0];
+        m.log_likelihood(&[100.0, 179f64.to_radians()], &p, &ctx(), &mut out);
+        // residual is 2°, i.e. two standard deviations: −0.5·4 = −2
+        let expected = m.log_normaliser() - 2.0;
+        assert!((out[0] - expected).abs() < 1e-9, "{} vs {expected}", out[0]);
+    }
+
+    #[test]
+    fn mounting_offset_with_heading_quarter_turn() {
+        // platform at (1, 2) facing +y; sensor mounted 3 ahead, 1 to the left:
+        // x_s = 1 + 3·cos(π/2) − 1·sin(π/2) = 0, y_s = 2 + 3·sin(π/2) + 1·cos(π/2) = 5
+        let m = RangeBearing::new(1.0, 0.01)
+            .unwrap()
+            .with_offset(3.0, 1.0)
+            .unwrap();
+        let c = with_pose(1.0, 2.0, FRAC_PI_2);
+        let (sx, sy, phi) = m.sensor_pose(&c);
+        assert!(sx.abs() < 1e-12 && (sy - 5.0).abs() < 1e-12 && (phi - FRAC_PI_2).abs() < 1e-12);
+        // straight ahead of the sensor (along +y) → bearing 0
+        let z = m.predict_measurement(&[0.0, 0.0, 15.0, 0.0], &c);
+        assert!((z[0] - 10.0).abs() < 1e-12 && z[1].abs() < 1e-12);
+        // world −x is to the sensor's left → bearing +π/2
+        let z = m.predict_measurement(&[-10.0, 0.0, 5.0, 0.0], &c);
+        assert!((z[0] - 10.0).abs() < 1e-12 && (z[1] - FRAC_PI_2).abs() < 1e-12);
+    }
+
+    #[test]
+    fn from_y_axis_is_the_benchmark_convention() {
+        let m = RangeBearing::benchmark();
+        let z = m.predict_measurement(&[1.0, 0.0, 0.0, 0.0, 0.0], &ctx());
+        assert!((z[1] - FRAC_PI_2).abs() < 1e-12);
+        let z = m.predict_measurement(&[-300.0, 0.0, 400.0, 0.0, 0.0], &ctx());
+        assert!((z[0] - 500.0).abs() < 1e-12);
+        assert!((z[1] - (-300.0f64).atan2(400.0)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn to_cartesian_inverts_prediction() {
+        for conv in [BearingConvention::FromXAxis, BearingConvention::FromYAxis] {
+            let m = RangeBearing::new(1.0, 0.01)
+                .unwrap()
+                .with_offset(0.5, -0.25)
+                .unwrap()
+                .with_convention(conv);
+            let c = with_pose(-3.0, 7.0, 2.5);
+            for &(x, y) in &[(10.0, 3.0), (-40.0, -2.0), (0.0, 100.0), (-3.0, -50.0)] {
+                let z = m.predict_measurement(&[x, 0.0, y, 0.0], &c);
+                let [cx, cy] = m.to_cartesian(z, &c);
+                assert!((cx - x).abs() < 1e-9 && (cy - y).abs() < 1e-9, "{conv:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn gate_is_conservative_and_rejects_far_measurements() {
+        let m = RangeBearing::benchmark();
+        let track = TrackSummary {
+            mean: vec![0.0, 0.0, 1000.0, 0.0, 0.0],
+            std: vec![20.0, 5.0, 20.0, 5.0, 0.01],
+        };
+        // 3σ in range and 3σ in bearing away from the mean: inside a 5σ gate
+        let z = [1030.0, 6f64.to_radians()];
+        assert!(m.gate(&z, &track, &ctx()));
+        // the opposite side of the sensor
+        assert!(!m.gate(&[1000.0, PI], &track, &ctx()));
+        assert!(!m.gate(&[1.0], &track, &ctx()));
+        assert!(RangeBearing::new(0.0, 1.0).is_err());
+        assert!(RangeBearing::new(1.0, 1.0)
+            .unwrap()
+            .with_gate_sigmas(0.0)
+            .is_err());
+    }
+
+    #[test]
+    fn bad_input_gives_minus_infinity() {
+        let m = RangeBearing::new(1.0, 0.1).unwrap();
+        let p = one(1.0, 1.0);
+        let mut out = vec![0.0];
+        m.log_likelihood(&[1.0, f64::NAN], &p, &ctx(), &mut out);
+        assert_eq!(out[0], f64::NEG_INFINITY);
+        m.log_likelihood(&[1.0, 0.0, 0.0], &p, &ctx(), &mut out);
+        assert_eq!(out[0], f64::NEG_INFINITY);
+        assert!(m.predict_measurement(&[1.0], &ctx())[0].is_nan());
+    }
+}
