@@ -66,7 +66,12 @@ pub fn read_frames(path: &Path) -> Result<Vec<DetectionFrame>> {
         "json" => parse_json(path, &text)?,
         "csv" => parse_csv(path, &text)?,
         other => {
-            return Err(Error::parse(path, 0, "file name", format!("unknown extension `{other}` (expected .json or .csv)")))
+            return Err(Error::parse(
+                path,
+                0,
+                "file name",
+                format!("unknown extension `{other}` (expected .json or .csv)"),
+            ))
         }
     };
     check_frames(path, &frames)?;
@@ -74,33 +79,60 @@ pub fn read_frames(path: &Path) -> Result<Vec<DetectionFrame>> {
 }
 
 fn extension(path: &Path) -> String {
-    path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
+    path.extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase()
 }
 
 fn parse_json(path: &Path, text: &str) -> Result<Vec<DetectionFrame>> {
-    let file: DetectionFile =
-        serde_json::from_str(text).map_err(|e| Error::parse(path, e.line(), "json", e.to_string()))?;
+    let file: DetectionFile = serde_json::from_str(text)
+        .map_err(|e| Error::parse(path, e.line(), "json", e.to_string()))?;
     Ok(file.frames)
 }
 
 fn check_frames(path: &Path, frames: &[DetectionFrame]) -> Result<()> {
-    let dim = frames.iter().flat_map(|f| f.measurements.first()).map(|m| m.len()).next();
+    let dim = frames
+        .iter()
+        .flat_map(|f| f.measurements.first())
+        .map(|m| m.len())
+        .next();
     let mut last_time = f64::NEG_INFINITY;
     for (k, f) in frames.iter().enumerate() {
         let field = |s: &str| format!("frames[{k}].{s}");
         if !f.time.is_finite() {
-            return Err(Error::parse(path, 0, field("time"), format!("{} is not finite", f.time)));
+            return Err(Error::parse(
+                path,
+                0,
+                field("time"),
+                format!("{} is not finite", f.time),
+            ));
         }
         if f.time < last_time {
-            return Err(Error::parse(path, 0, field("time"), format!("{} is before the previous frame's {}", f.time, last_time)));
+            return Err(Error::parse(
+                path,
+                0,
+                field("time"),
+                format!("{} is before the previous frame's {}", f.time, last_time),
+            ));
         }
         last_time = f.time;
         for (j, m) in f.measurements.iter().enumerate() {
             if Some(m.len()) != dim || m.is_empty() {
-                return Err(Error::parse(path, 0, field(&format!("measurements[{j}]")), format!("has {} components, expected {}", m.len(), dim.unwrap_or(0))));
+                return Err(Error::parse(
+                    path,
+                    0,
+                    field(&format!("measurements[{j}]")),
+                    format!("has {} components, expected {}", m.len(), dim.unwrap_or(0)),
+                ));
             }
             if let Some(v) = m.iter().find(|v| !v.is_finite()) {
-                return Err(Error::parse(path, 0, field(&format!("measurements[{j}]")), format!("value {v} is not finite")));
+                return Err(Error::parse(
+                    path,
+                    0,
+                    field(&format!("measurements[{j}]")),
+                    format!("value {v} is not finite"),
+                ));
             }
         }
         if let Some(p) = f.sensor_pose {
@@ -110,7 +142,16 @@ fn check_frames(path: &Path, frames: &[DetectionFrame]) -> Result<()> {
         }
         if let Some(ids) = &f.ids {
             if ids.len() != f.measurements.len() {
-                return Err(Error::parse(path, 0, field("ids"), format!("{} ids for {} measurements", ids.len(), f.measurements.len())));
+                return Err(Error::parse(
+                    path,
+                    0,
+                    field("ids"),
+                    format!(
+                        "{} ids for {} measurements",
+                        ids.len(),
+                        f.measurements.len()
+                    ),
+                ));
             }
         }
     }
@@ -118,22 +159,39 @@ fn check_frames(path: &Path, frames: &[DetectionFrame]) -> Result<()> {
 }
 
 fn parse_csv(path: &Path, text: &str) -> Result<Vec<DetectionFrame>> {
-    let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty() && !l.starts_with('#'));
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty() && !l.starts_with('#'));
     let Some((_, header)) = lines.next() else {
         return Err(Error::parse(path, 1, "header", "the file is empty"));
     };
     let names: Vec<&str> = header.split(',').map(str::trim).collect();
     let col = |name: &str| names.iter().position(|n| *n == name);
-    let frame_col = col("frame").ok_or_else(|| Error::parse(path, 1, "header", "no `frame` column"))?;
-    let time_col = col("time").ok_or_else(|| Error::parse(path, 1, "header", "no `time` column"))?;
+    let frame_col =
+        col("frame").ok_or_else(|| Error::parse(path, 1, "header", "no `frame` column"))?;
+    let time_col =
+        col("time").ok_or_else(|| Error::parse(path, 1, "header", "no `time` column"))?;
     let z_cols: Vec<usize> = (0..).map_while(|i| col(&format!("z{i}"))).collect();
     if z_cols.is_empty() {
-        return Err(Error::parse(path, 1, "header", "no measurement columns `z0`, `z1`, ..."));
+        return Err(Error::parse(
+            path,
+            1,
+            "header",
+            "no measurement columns `z0`, `z1`, ...",
+        ));
     }
     let pose_cols = match (col("sensor_x"), col("sensor_y"), col("sensor_heading")) {
         (Some(a), Some(b), Some(c)) => Some([a, b, c]),
         (None, None, None) => None,
-        _ => return Err(Error::parse(path, 1, "header", "sensor pose needs all of sensor_x, sensor_y, sensor_heading")),
+        _ => {
+            return Err(Error::parse(
+                path,
+                1,
+                "header",
+                "sensor pose needs all of sensor_x, sensor_y, sensor_heading",
+            ))
+        }
     };
     let id_col = col("id");
     let mut frames: Vec<DetectionFrame> = Vec::new();
@@ -141,31 +199,66 @@ fn parse_csv(path: &Path, text: &str) -> Result<Vec<DetectionFrame>> {
         let line_no = i + 1;
         let cells: Vec<&str> = line.split(',').map(str::trim).collect();
         if cells.len() != names.len() {
-            return Err(Error::parse(path, line_no, "line", format!("{} fields, the header has {}", cells.len(), names.len())));
+            return Err(Error::parse(
+                path,
+                line_no,
+                "line",
+                format!("{} fields, the header has {}", cells.len(), names.len()),
+            ));
         }
         let num = |c: usize| -> Result<f64> {
-            let v: f64 = cells[c]
-                .parse()
-                .map_err(|_| Error::parse(path, line_no, names[c], format!("`{}` is not a number", cells[c])))?;
+            let v: f64 = cells[c].parse().map_err(|_| {
+                Error::parse(
+                    path,
+                    line_no,
+                    names[c],
+                    format!("`{}` is not a number", cells[c]),
+                )
+            })?;
             if v.is_finite() {
                 Ok(v)
             } else {
-                Err(Error::parse(path, line_no, names[c], format!("{v} is not finite")))
+                Err(Error::parse(
+                    path,
+                    line_no,
+                    names[c],
+                    format!("{v} is not finite"),
+                ))
             }
         };
-        let frame: usize = cells[frame_col]
-            .parse()
-            .map_err(|_| Error::parse(path, line_no, "frame", format!("`{}` is not a frame number", cells[frame_col])))?;
+        let frame: usize = cells[frame_col].parse().map_err(|_| {
+            Error::parse(
+                path,
+                line_no,
+                "frame",
+                format!("`{}` is not a frame number", cells[frame_col]),
+            )
+        })?;
         let time = num(time_col)?;
         if frame + 1 < frames.len() {
-            return Err(Error::parse(path, line_no, "frame", format!("frame {frame} after frame {}", frames.len() - 1)));
+            return Err(Error::parse(
+                path,
+                line_no,
+                "frame",
+                format!("frame {frame} after frame {}", frames.len() - 1),
+            ));
         }
         while frames.len() <= frame {
-            frames.push(DetectionFrame { time, measurements: Vec::new(), sensor_pose: None, ids: None });
+            frames.push(DetectionFrame {
+                time,
+                measurements: Vec::new(),
+                sensor_pose: None,
+                ids: None,
+            });
         }
         let f = frames.last_mut().expect("just pushed");
         if f.time != time {
-            return Err(Error::parse(path, line_no, "time", format!("{time} differs from {} earlier in frame {frame}", f.time)));
+            return Err(Error::parse(
+                path,
+                line_no,
+                "time",
+                format!("{time} differs from {} earlier in frame {frame}", f.time),
+            ));
         }
         if let Some(pc) = pose_cols {
             if pc.iter().all(|&c| !cells[c].is_empty()) {
@@ -175,10 +268,15 @@ fn parse_csv(path: &Path, text: &str) -> Result<Vec<DetectionFrame>> {
         if z_cols.iter().all(|&c| cells[c].is_empty()) {
             continue;
         }
-        let z = z_cols.iter().map(|&c| num(c)).collect::<Result<Vec<f64>>>()?;
+        let z = z_cols
+            .iter()
+            .map(|&c| num(c))
+            .collect::<Result<Vec<f64>>>()?;
         f.measurements.push(z);
         if let Some(c) = id_col {
-            let id: u64 = cells[c].parse().map_err(|_| Error::parse(path, line_no, "id", format!("`{}` is not an id", cells[c])))?;
+            let id: u64 = cells[c].parse().map_err(|_| {
+                Error::parse(path, line_no, "id", format!("`{}` is not an id", cells[c]))
+            })?;
             f.ids.get_or_insert_with(Vec::new).push(id);
         }
     }
@@ -188,9 +286,21 @@ fn parse_csv(path: &Path, text: &str) -> Result<Vec<DetectionFrame>> {
 /// Writes `bytes` to `path` atomically: a temporary file in the same folder, renamed into
 /// place once complete, so a reader never sees half a file.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let name = path.file_name().ok_or_else(|| Error::invalid("output path", format!("{} has no file name", path.display())))?;
-    let tmp = dir.join(format!(".{}.tmp{}", name.to_string_lossy(), std::process::id()));
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = path.file_name().ok_or_else(|| {
+        Error::invalid(
+            "output path",
+            format!("{} has no file name", path.display()),
+        )
+    })?;
+    let tmp = dir.join(format!(
+        ".{}.tmp{}",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
     let result = (|| {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;
@@ -212,10 +322,16 @@ pub fn write_estimates(path: &Path, frames: &[EstimateFrame]) -> Result<()> {
             struct Out<'a> {
                 frames: &'a [EstimateFrame],
             }
-            serde_json::to_vec_pretty(&Out { frames }).map_err(|e| Error::invalid("estimates", e.to_string()))?
+            serde_json::to_vec_pretty(&Out { frames })
+                .map_err(|e| Error::invalid("estimates", e.to_string()))?
         }
         "csv" => {
-            let dim = frames.iter().flat_map(|f| f.estimates.first()).map(|e| e.state.len()).next().unwrap_or(0);
+            let dim = frames
+                .iter()
+                .flat_map(|f| f.estimates.first())
+                .map(|e| e.state.len())
+                .next()
+                .unwrap_or(0);
             let mut s = String::from("frame,time,birth_step,index,existence,age");
             for c in 0..dim {
                 s.push_str(&format!(",x{c}"));
@@ -223,7 +339,10 @@ pub fn write_estimates(path: &Path, frames: &[EstimateFrame]) -> Result<()> {
             s.push('\n');
             for f in frames {
                 for e in &f.estimates {
-                    s.push_str(&format!("{},{},{},{},{},{}", f.frame, f.time, e.label.birth_step, e.label.index, e.existence, e.age));
+                    s.push_str(&format!(
+                        "{},{},{},{},{},{}",
+                        f.frame, f.time, e.label.birth_step, e.label.index, e.existence, e.age
+                    ));
                     for v in &e.state {
                         s.push_str(&format!(",{v}"));
                     }
@@ -232,7 +351,12 @@ pub fn write_estimates(path: &Path, frames: &[EstimateFrame]) -> Result<()> {
             }
             s.into_bytes()
         }
-        other => return Err(Error::invalid("output path", format!("unknown extension `{other}` (expected .json or .csv)"))),
+        other => {
+            return Err(Error::invalid(
+                "output path",
+                format!("unknown extension `{other}` (expected .json or .csv)"),
+            ))
+        }
     };
     write_atomic(path, &bytes)
 }
@@ -252,7 +376,10 @@ mod tests {
 
     #[test]
     fn csv_with_empty_and_skipped_frames() {
-        let p = tmp("a.csv", "frame,time,z0,z1,id\n0,0.0,1,2,7\n0,0.0,3,4,8\n1,1.0,,,\n3,3.0,5,6,7\n");
+        let p = tmp(
+            "a.csv",
+            "frame,time,z0,z1,id\n0,0.0,1,2,7\n0,0.0,3,4,8\n1,1.0,,,\n3,3.0,5,6,7\n",
+        );
         let f = read_frames(&p).unwrap();
         assert_eq!(f.len(), 4);
         assert_eq!(f[0].measurements, vec![vec![1.0, 2.0], vec![3.0, 4.0]]);
@@ -266,24 +393,39 @@ mod tests {
     fn csv_errors_name_line_and_field() {
         let p = tmp("b.csv", "frame,time,z0,z1\n0,0.0,1,2\n0,0.0,nan,2\n");
         let e = read_frames(&p).unwrap_err().to_string();
-        assert!(e.contains("b.csv:3") && e.contains("z0") && e.contains("not finite"), "{e}");
+        assert!(
+            e.contains("b.csv:3") && e.contains("z0") && e.contains("not finite"),
+            "{e}"
+        );
         let p = tmp("c.csv", "frame,time,z0,z1\n0,0.0,1\n");
         let e = read_frames(&p).unwrap_err().to_string();
         assert!(e.contains("c.csv:2") && e.contains("fields"), "{e}");
         let p = tmp("d.csv", "frame,time,z0,z1\n1,1.0,1,2\n0,0.0,1,2\n");
-        assert!(read_frames(&p).unwrap_err().to_string().contains("frame 0 after frame 1"));
+        assert!(read_frames(&p)
+            .unwrap_err()
+            .to_string()
+            .contains("frame 0 after frame 1"));
     }
 
     #[test]
     fn json_errors_name_the_frame() {
-        let p = tmp("a.json", r#"{"frames": [{"time": 0, "measurements": [[1, 2]]}, {"time": 1, "measurements": [[1, 2, 3]]}]}"#);
+        let p = tmp(
+            "a.json",
+            r#"{"frames": [{"time": 0, "measurements": [[1, 2]]}, {"time": 1, "measurements": [[1, 2, 3]]}]}"#,
+        );
         let e = read_frames(&p).unwrap_err().to_string();
         assert!(e.contains("frames[1].measurements[0]"), "{e}");
-        let p = tmp("b.json", "{\"frames\": [\n{\"time\": 0, \"measurements\": [[1, 2]]},\n{\"time\": x}]}");
+        let p = tmp(
+            "b.json",
+            "{\"frames\": [\n{\"time\": 0, \"measurements\": [[1, 2]]},\n{\"time\": x}]}",
+        );
         let e = read_frames(&p).unwrap_err().to_string();
         assert!(e.contains("b.json:3"), "{e}");
         let p = tmp("c.json", r#"{"frames": [{"time": 2}, {"time": 1}]}"#);
-        assert!(read_frames(&p).unwrap_err().to_string().contains("before the previous frame"));
+        assert!(read_frames(&p)
+            .unwrap_err()
+            .to_string()
+            .contains("before the previous frame"));
     }
 
     #[test]
@@ -291,16 +433,25 @@ mod tests {
         let frames = vec![EstimateFrame {
             frame: 0,
             time: 0.5,
-            estimates: vec![Estimate { label: Label::new(0, 1), existence: 0.9, state: vec![1.0, 2.0], age: 0 }],
+            estimates: vec![Estimate {
+                label: Label::new(0, 1),
+                existence: 0.9,
+                state: vec![1.0, 2.0],
+                age: 0,
+            }],
         }];
         let p = tmp("out.json", "");
         write_estimates(&p, &frames).unwrap();
-        let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
         assert_eq!(v["frames"][0]["estimates"][0]["label"]["index"], 1);
         let p = tmp("out.csv", "");
         write_estimates(&p, &frames).unwrap();
         let s = std::fs::read_to_string(&p).unwrap();
-        assert_eq!(s, "frame,time,birth_step,index,existence,age,x0,x1\n0,0.5,0,1,0.9,0,1,2\n");
+        assert_eq!(
+            s,
+            "frame,time,birth_step,index,existence,age,x0,x1\n0,0.5,0,1,0.9,0,1,2\n"
+        );
         assert!(write_estimates(&tmp("x.txt", ""), &frames).is_err());
     }
 }

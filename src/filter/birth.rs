@@ -71,10 +71,16 @@ impl StaticBirth {
         for (i, t) in terms.iter().enumerate() {
             let what = format!("birth term {i}");
             if !(t.existence > 0.0 && t.existence <= 1.0) {
-                return Err(Error::invalid(what, format!("existence {} outside (0, 1]", t.existence)));
+                return Err(Error::invalid(
+                    what,
+                    format!("existence {} outside (0, 1]", t.existence),
+                ));
             }
             if t.mean.is_empty() || t.mean.len() != t.std.len() {
-                return Err(Error::invalid(what, "mean and std must have the same, positive length"));
+                return Err(Error::invalid(
+                    what,
+                    "mean and std must have the same, positive length",
+                ));
             }
             ensure_finite(&format!("mean of {what}"), &t.mean)?;
             ensure_finite(&format!("std of {what}"), &t.std)?;
@@ -95,7 +101,12 @@ impl StaticBirth {
 }
 
 impl BirthModel for StaticBirth {
-    fn birth(&self, _: &StepContext, _: Option<&BirthEvidence<'_>>, rng: &mut FilterRng) -> Vec<BirthTrack> {
+    fn birth(
+        &self,
+        _: &StepContext,
+        _: Option<&BirthEvidence<'_>>,
+        rng: &mut FilterRng,
+    ) -> Vec<BirthTrack> {
         self.terms
             .iter()
             .map(|t| BirthTrack {
@@ -136,7 +147,10 @@ pub struct PositionBirthSampler {
 impl BirthSampler for PositionBirthSampler {
     fn sample(&self, z: &[f64], _: &StepContext, n: usize, rng: &mut FilterRng) -> ParticleSet {
         let mean: Vec<f64> = z.iter().flat_map(|&p| [p, 0.0]).collect();
-        let std: Vec<f64> = z.iter().flat_map(|_| [self.position_std, self.velocity_std]).collect();
+        let std: Vec<f64> = z
+            .iter()
+            .flat_map(|_| [self.position_std, self.velocity_std])
+            .collect();
         ParticleSet::gaussian(&mean, &std, n, rng)
     }
 }
@@ -160,17 +174,34 @@ pub struct AdaptiveBirth {
 
 impl AdaptiveBirth {
     /// Adaptive birth drawing each proposal's particles from `sampler`.
-    pub fn new(sampler: impl BirthSampler + 'static, expected_births: f64, max_existence: f64, particles: usize) -> Result<Self> {
+    pub fn new(
+        sampler: impl BirthSampler + 'static,
+        expected_births: f64,
+        max_existence: f64,
+        particles: usize,
+    ) -> Result<Self> {
         if !(expected_births > 0.0 && expected_births.is_finite()) {
-            return Err(Error::invalid("expected births per step", format!("{expected_births} must be positive")));
+            return Err(Error::invalid(
+                "expected births per step",
+                format!("{expected_births} must be positive"),
+            ));
         }
         if !(max_existence > 0.0 && max_existence <= 1.0) {
-            return Err(Error::invalid("maximum birth existence", format!("{max_existence} outside (0, 1]")));
+            return Err(Error::invalid(
+                "maximum birth existence",
+                format!("{max_existence} outside (0, 1]"),
+            ));
         }
         if particles == 0 {
             return Err(Error::invalid("birth particle count", "must be positive"));
         }
-        Ok(AdaptiveBirth { sampler: Box::new(sampler), expected_births, max_existence, min_existence: 1e-5, particles })
+        Ok(AdaptiveBirth {
+            sampler: Box::new(sampler),
+            expected_births,
+            max_existence,
+            min_existence: 1e-5,
+            particles,
+        })
     }
 
     /// The existence probabilities r_B(z) for association probabilities `assigned`.
@@ -182,7 +213,8 @@ impl AdaptiveBirth {
                 if total <= 0.0 {
                     0.0
                 } else {
-                    (self.expected_births * (1.0 - a.clamp(0.0, 1.0)) / total).min(self.max_existence)
+                    (self.expected_births * (1.0 - a.clamp(0.0, 1.0)) / total)
+                        .min(self.max_existence)
                 }
             })
             .collect()
@@ -190,8 +222,15 @@ impl AdaptiveBirth {
 }
 
 impl BirthModel for AdaptiveBirth {
-    fn birth(&self, _: &StepContext, evidence: Option<&BirthEvidence<'_>>, rng: &mut FilterRng) -> Vec<BirthTrack> {
-        let Some(ev) = evidence else { return Vec::new() };
+    fn birth(
+        &self,
+        _: &StepContext,
+        evidence: Option<&BirthEvidence<'_>>,
+        rng: &mut FilterRng,
+    ) -> Vec<BirthTrack> {
+        let Some(ev) = evidence else {
+            return Vec::new();
+        };
         self.birth_existence(ev.assigned)
             .into_iter()
             .zip(ev.measurements.iter())
@@ -212,21 +251,52 @@ mod tests {
 
     #[test]
     fn adaptive_existence_follows_reuter_rule() {
-        let b = AdaptiveBirth::new(PositionBirthSampler { position_std: 1.0, velocity_std: 1.0 }, 0.2, 0.05, 10).unwrap();
+        let b = AdaptiveBirth::new(
+            PositionBirthSampler {
+                position_std: 1.0,
+                velocity_std: 1.0,
+            },
+            0.2,
+            0.05,
+            10,
+        )
+        .unwrap();
         // unexplained masses 1, 0.5, 0 → total 1.5; λ_B = 0.2 → 0.1333 (capped 0.05), 0.0667 (capped), 0
         let r = b.birth_existence(&[0.0, 0.5, 1.0]);
         assert_eq!(r, vec![0.05, 0.05, 0.0]);
-        let b = AdaptiveBirth::new(PositionBirthSampler { position_std: 1.0, velocity_std: 1.0 }, 0.03, 0.05, 10).unwrap();
+        let b = AdaptiveBirth::new(
+            PositionBirthSampler {
+                position_std: 1.0,
+                velocity_std: 1.0,
+            },
+            0.03,
+            0.05,
+            10,
+        )
+        .unwrap();
         let r = b.birth_existence(&[0.0, 0.5, 1.0]);
         assert!((r[0] - 0.02).abs() < 1e-12 && (r[1] - 0.01).abs() < 1e-12 && r[2] == 0.0);
     }
 
     #[test]
     fn adaptive_birth_places_particles_at_unexplained_measurements() {
-        let b = AdaptiveBirth::new(PositionBirthSampler { position_std: 0.5, velocity_std: 1.0 }, 1.0, 0.5, 2000).unwrap();
+        let b = AdaptiveBirth::new(
+            PositionBirthSampler {
+                position_std: 0.5,
+                velocity_std: 1.0,
+            },
+            1.0,
+            0.5,
+            2000,
+        )
+        .unwrap();
         let m = Measurements::from_rows(2, &[[10.0, -4.0], [0.0, 0.0]]).unwrap();
         let ctx = StepContext::new(0, 0.0, 1.0);
-        let ev = BirthEvidence { measurements: &m, assigned: &[0.0, 1.0], context: &ctx };
+        let ev = BirthEvidence {
+            measurements: &m,
+            assigned: &[0.0, 1.0],
+            context: &ctx,
+        };
         let births = b.birth(&ctx, Some(&ev), &mut seeded(4));
         assert_eq!(births.len(), 1);
         let mean = births[0].particles.mean();
@@ -237,9 +307,20 @@ mod tests {
 
     #[test]
     fn static_birth_validates_terms() {
-        let bad = BirthTerm { existence: 1.5, mean: vec![0.0], std: vec![1.0] };
+        let bad = BirthTerm {
+            existence: 1.5,
+            mean: vec![0.0],
+            std: vec![1.0],
+        };
         assert!(StaticBirth::new(vec![bad], 10).is_err());
-        let nan = BirthTerm { existence: 0.1, mean: vec![f64::NAN], std: vec![1.0] };
-        assert!(StaticBirth::new(vec![nan], 10).unwrap_err().to_string().contains("birth term 0"));
+        let nan = BirthTerm {
+            existence: 0.1,
+            mean: vec![f64::NAN],
+            std: vec![1.0],
+        };
+        assert!(StaticBirth::new(vec![nan], 10)
+            .unwrap_err()
+            .to_string()
+            .contains("birth term 0"));
     }
 }

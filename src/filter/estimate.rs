@@ -48,7 +48,12 @@ pub fn map_estimates(tracks: &[Track]) -> Vec<Estimate> {
         .iter()
         .map(|&i| {
             let t = &tracks[i];
-            Estimate { label: t.label, existence: t.existence, state: t.particles.mean(), age: t.age }
+            Estimate {
+                label: t.label,
+                existence: t.existence,
+                state: t.particles.mean(),
+                age: t.age,
+            }
         })
         .collect();
     out.sort_by_key(|e| e.label);

@@ -45,7 +45,10 @@ pub fn partition(gated: &[Vec<usize>], n_meas: usize) -> Vec<Group> {
     for i in 0..n {
         let root = find(&mut parent, i);
         let g = *slot[root].get_or_insert_with(|| {
-            groups.push(Group { tracks: Vec::new(), measurements: Vec::new() });
+            groups.push(Group {
+                tracks: Vec::new(),
+                measurements: Vec::new(),
+            });
             groups.len() - 1
         });
         groups[g].tracks.push(i);
@@ -72,9 +75,18 @@ mod tests {
         assert_eq!(
             g,
             vec![
-                Group { tracks: vec![0, 1], measurements: vec![0, 1, 2] },
-                Group { tracks: vec![2], measurements: vec![] },
-                Group { tracks: vec![3], measurements: vec![3] },
+                Group {
+                    tracks: vec![0, 1],
+                    measurements: vec![0, 1, 2]
+                },
+                Group {
+                    tracks: vec![2],
+                    measurements: vec![]
+                },
+                Group {
+                    tracks: vec![3],
+                    measurements: vec![3]
+                },
             ]
         );
     }

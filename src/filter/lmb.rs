@@ -58,20 +58,37 @@ impl LmbConfig {
     /// Checks ranges; names the first bad field.
     pub fn validate(&self) -> Result<()> {
         if self.particles == 0 {
-            return Err(Error::invalid("config field `particles`", "must be positive"));
+            return Err(Error::invalid(
+                "config field `particles`",
+                "must be positive",
+            ));
         }
         if !(0.0..=1.0).contains(&self.resample_threshold) {
-            return Err(Error::invalid("config field `resample_threshold`", format!("{} outside [0, 1]", self.resample_threshold)));
+            return Err(Error::invalid(
+                "config field `resample_threshold`",
+                format!("{} outside [0, 1]", self.resample_threshold),
+            ));
         }
         if !(0.0..1.0).contains(&self.prune_threshold) {
-            return Err(Error::invalid("config field `prune_threshold`", format!("{} outside [0, 1)", self.prune_threshold)));
+            return Err(Error::invalid(
+                "config field `prune_threshold`",
+                format!("{} outside [0, 1)", self.prune_threshold),
+            ));
         }
         if self.max_tracks == 0 {
-            return Err(Error::invalid("config field `max_tracks`", "must be positive"));
+            return Err(Error::invalid(
+                "config field `max_tracks`",
+                "must be positive",
+            ));
         }
         match self.jitter {
-            Jitter::Roughening { k: s } | Jitter::Regularised { scale: s } if !(s >= 0.0 && s.is_finite()) => {
-                Err(Error::invalid("config field `jitter`", format!("scale {s} must be finite and ≥ 0")))
+            Jitter::Roughening { k: s } | Jitter::Regularised { scale: s }
+                if !(s >= 0.0 && s.is_finite()) =>
+            {
+                Err(Error::invalid(
+                    "config field `jitter`",
+                    format!("scale {s} must be finite and ≥ 0"),
+                ))
             }
             _ => Ok(()),
         }
@@ -92,7 +109,11 @@ pub struct Frame {
 impl Frame {
     /// A frame from a static sensor.
     pub fn new(time: f64, measurements: Measurements) -> Self {
-        Frame { time, measurements, platform: None }
+        Frame {
+            time,
+            measurements,
+            platform: None,
+        }
     }
 }
 
@@ -160,12 +181,16 @@ impl LmbFilterBuilder {
         Ok(LmbFilter {
             models: Models {
                 transition,
-                survival: self.survival.unwrap_or_else(|| Box::new(ConstantSurvival(0.99))),
+                survival: self
+                    .survival
+                    .unwrap_or_else(|| Box::new(ConstantSurvival(0.99))),
                 measurement,
                 detection: self.detection.ok_or_else(|| missing("detection"))?,
                 clutter: self.clutter.ok_or_else(|| missing("clutter"))?,
                 birth: self.birth.ok_or_else(|| missing("birth"))?,
-                associator: self.associator.unwrap_or_else(|| Box::new(AssociationMethod::default())),
+                associator: self
+                    .associator
+                    .unwrap_or_else(|| Box::new(AssociationMethod::default())),
             },
             config: self.config,
             tracks: Vec::new(),
@@ -267,7 +292,11 @@ impl LmbFilter {
         if !z.is_empty() && z.dim() != self.models.measurement.measurement_dim() {
             return Err(Error::invalid(
                 format!("measurements of step {}", self.step),
-                format!("have dimension {}, the measurement model expects {}", z.dim(), self.models.measurement.measurement_dim()),
+                format!(
+                    "have dimension {}, the measurement model expects {}",
+                    z.dim(),
+                    self.models.measurement.measurement_dim()
+                ),
             ));
         }
         let seed = rng.next_u64();
@@ -280,7 +309,11 @@ impl LmbFilter {
         self.prune();
         let estimates = map_estimates(&self.tracks);
 
-        self.previous = Some(Previous { context: ctx, measurements: z.clone(), assigned });
+        self.previous = Some(Previous {
+            context: ctx,
+            measurements: z.clone(),
+            assigned,
+        });
         self.step += 1;
         Ok(estimates)
     }
@@ -289,7 +322,10 @@ impl LmbFilter {
     fn context(&self, frame: &Frame) -> Result<StepContext> {
         let what = || format!("frame of step {}", self.step);
         if !frame.time.is_finite() {
-            return Err(Error::invalid(what(), format!("time stamp {} is not finite", frame.time)));
+            return Err(Error::invalid(
+                what(),
+                format!("time stamp {} is not finite", frame.time),
+            ));
         }
         if let Some(p) = &frame.platform {
             let v = p.to_homogeneous();
@@ -302,9 +338,18 @@ impl LmbFilter {
             Some(p) => (frame.time - p.context.time, p.context.platform),
         };
         if dt < 0.0 {
-            return Err(Error::invalid(what(), format!("time goes backwards by {} s", -dt)));
+            return Err(Error::invalid(
+                what(),
+                format!("time goes backwards by {} s", -dt),
+            ));
         }
-        Ok(StepContext { step: self.step, time: frame.time, dt, platform: frame.platform, previous_platform })
+        Ok(StepContext {
+            step: self.step,
+            time: frame.time,
+            dt,
+            platform: frame.platform,
+            previous_platform,
+        })
     }
 
     /// Prediction: survival reweighting r₊ = r·Σ wᵢ p_S(xᵢ), then the transition, per track.
@@ -332,7 +377,10 @@ impl LmbFilter {
             assigned: &p.assigned,
             context: &p.context,
         });
-        let births = self.models.birth.birth(ctx, evidence.as_ref(), &mut stream(seed, KEY_BIRTH));
+        let births = self
+            .models
+            .birth
+            .birth(ctx, evidence.as_ref(), &mut stream(seed, KEY_BIRTH));
         let step = self.step;
         let transition = &self.models.transition;
         let new: Vec<Track> = births
@@ -343,7 +391,11 @@ impl LmbFilter {
                 let label = Label::new(step, i as u32);
                 let mut particles = b.particles;
                 if b.at_previous_step && ctx.dt > 0.0 {
-                    transition.predict(&mut particles, ctx, &mut stream(seed, KEY_PREDICT ^ label.key()));
+                    transition.predict(
+                        &mut particles,
+                        ctx,
+                        &mut stream(seed, KEY_PREDICT ^ label.key()),
+                    );
                 }
                 Track::new(label, b.existence.min(1.0), particles)
             })
@@ -365,7 +417,10 @@ impl LmbFilter {
                 let log_qd: Vec<f64> = pd.iter().map(|d| (1.0 - d.clamp(0.0, 1.0)).ln()).collect();
                 let log_w: Vec<f64> = p.weights().iter().map(|w| w.ln()).collect();
                 let log_eta_miss = log_sum_exp2(&log_w, &log_qd);
-                let summary = TrackSummary { mean: p.mean(), std: p.std_dev() };
+                let summary = TrackSummary {
+                    mean: p.mean(),
+                    std: p.std_dev(),
+                };
                 let mut gated = Vec::new();
                 let mut log_eta = Vec::new();
                 let mut log_g = Vec::new();
@@ -387,7 +442,14 @@ impl LmbFilter {
                     log_eta.push(eta);
                     log_g.push(g);
                 }
-                TrackLikelihoods { log_pd, log_qd, log_eta_miss, gated, log_eta, log_g }
+                TrackLikelihoods {
+                    log_pd,
+                    log_qd,
+                    log_eta_miss,
+                    gated,
+                    log_eta,
+                    log_g,
+                }
             })
             .collect()
     }
@@ -400,7 +462,10 @@ impl LmbFilter {
         lik: &[TrackLikelihoods],
         seed: u64,
     ) -> Vec<TrackMarginals> {
-        let log_kappa: Vec<f64> = z.iter().map(|zj| self.models.clutter.log_intensity(zj, ctx)).collect();
+        let log_kappa: Vec<f64> = z
+            .iter()
+            .map(|zj| self.models.clutter.log_intensity(zj, ctx))
+            .collect();
         let gated: Vec<Vec<usize>> = lik.iter().map(|l| l.gated.clone()).collect();
         let groups = partition(&gated, z.len());
         let tracks = &self.tracks;
@@ -421,12 +486,20 @@ impl LmbFilter {
                     let l = &lik[ti];
                     problem.log_miss.push(log_miss_weight(r, l.log_eta_miss));
                     for (k, &j) in l.gated.iter().enumerate() {
-                        let col = g.measurements.binary_search(&j).expect("gated measurement in its group");
+                        let col = g
+                            .measurements
+                            .binary_search(&j)
+                            .expect("gated measurement in its group");
                         problem.log_detect[row * m + col] = r.ln() + l.log_eta[k] - log_kappa[j];
                     }
                 }
                 let marg: Marginals = if m == 0 {
-                    Marginals { n_tracks: n, n_meas: 0, miss: vec![1.0; n], detect: Vec::new() }
+                    Marginals {
+                        n_tracks: n,
+                        n_meas: 0,
+                        miss: vec![1.0; n],
+                        detect: Vec::new(),
+                    }
                 } else {
                     let key = tracks[g.tracks[0]].label.key();
                     associator.marginals(&problem, &mut stream(seed, KEY_ASSOCIATE ^ key))
@@ -440,11 +513,20 @@ impl LmbFilter {
                             .iter()
                             .enumerate()
                             .map(|(k, &j)| {
-                                let col = g.measurements.binary_search(&j).expect("gated measurement in its group");
+                                let col = g
+                                    .measurements
+                                    .binary_search(&j)
+                                    .expect("gated measurement in its group");
                                 (k, marg.detect[row * m + col])
                             })
                             .collect();
-                        (ti, TrackMarginals { miss: marg.miss[row], detect })
+                        (
+                            ti,
+                            TrackMarginals {
+                                miss: marg.miss[row],
+                                detect,
+                            },
+                        )
                     })
                     .collect()
             })
@@ -453,21 +535,36 @@ impl LmbFilter {
         for (ti, tm) in solved.into_iter().flatten() {
             out[ti] = Some(tm);
         }
-        out.into_iter().map(|o| o.expect("every track is in one group")).collect()
+        out.into_iter()
+            .map(|o| o.expect("every track is in one group"))
+            .collect()
     }
 
     /// The GLMB → LMB update of existence and particle weights, then resampling. Returns, for
     /// every measurement, the probability that some track generated it.
-    fn update(&mut self, lik: &[TrackLikelihoods], marg: &[TrackMarginals], n_meas: usize, seed: u64) -> Vec<f64> {
+    fn update(
+        &mut self,
+        lik: &[TrackLikelihoods],
+        marg: &[TrackMarginals],
+        n_meas: usize,
+        seed: u64,
+    ) -> Vec<f64> {
         let cfg = &self.config;
-        self.tracks.par_iter_mut().zip(lik.par_iter()).zip(marg.par_iter()).for_each(|((t, l), mg)| {
-            update_track(t, l, mg);
-            let n = t.particles.len();
-            if n != cfg.particles || t.particles.effective_sample_size() < cfg.resample_threshold * cfg.particles as f64 {
-                let mut rng = stream(seed, KEY_RESAMPLE ^ t.label.key());
-                t.particles.resample(cfg.particles, cfg.jitter, &mut rng);
-            }
-        });
+        self.tracks
+            .par_iter_mut()
+            .zip(lik.par_iter())
+            .zip(marg.par_iter())
+            .for_each(|((t, l), mg)| {
+                update_track(t, l, mg);
+                let n = t.particles.len();
+                if n != cfg.particles
+                    || t.particles.effective_sample_size()
+                        < cfg.resample_threshold * cfg.particles as f64
+                {
+                    let mut rng = stream(seed, KEY_RESAMPLE ^ t.label.key());
+                    t.particles.resample(cfg.particles, cfg.jitter, &mut rng);
+                }
+            });
         let mut assigned = vec![0.0; n_meas];
         for (l, mg) in lik.iter().zip(marg) {
             for &(k, p) in &mg.detect {
@@ -481,9 +578,14 @@ impl LmbFilter {
     /// Removes tracks below the existence threshold and keeps at most `max_tracks`.
     fn prune(&mut self) {
         let threshold = self.config.prune_threshold;
-        self.tracks.retain(|t| t.existence >= threshold && t.existence > 0.0);
+        self.tracks
+            .retain(|t| t.existence >= threshold && t.existence > 0.0);
         if self.tracks.len() > self.config.max_tracks {
-            self.tracks.sort_by(|a, b| b.existence.total_cmp(&a.existence).then(a.label.cmp(&b.label)));
+            self.tracks.sort_by(|a, b| {
+                b.existence
+                    .total_cmp(&a.existence)
+                    .then(a.label.cmp(&b.label))
+            });
             self.tracks.truncate(self.config.max_tracks);
             self.tracks.sort_by_key(|t| t.label);
         }
@@ -503,7 +605,11 @@ fn log_miss_weight(r: f64, log_eta_miss: f64) -> f64 {
 
 /// ln Σᵢ exp(aᵢ + bᵢ), safe against overflow and underflow; −∞ for an empty or all-−∞ sum.
 fn log_sum_exp2(a: &[f64], b: &[f64]) -> f64 {
-    let max = a.iter().zip(b).map(|(x, y)| x + y).fold(f64::NEG_INFINITY, f64::max);
+    let max = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| x + y)
+        .fold(f64::NEG_INFINITY, f64::max);
     if !max.is_finite() {
         return max;
     }
@@ -529,7 +635,11 @@ fn update_track(t: &mut Track, l: &TrackLikelihoods, mg: &TrackMarginals) {
     let eta_miss = l.log_eta_miss.exp();
     let denom = 1.0 - r + r * eta_miss;
     // Probability that the track exists and was missed.
-    let p_missed = if denom > 0.0 { mg.miss * (r * eta_miss / denom) } else { 0.0 };
+    let p_missed = if denom > 0.0 {
+        mg.miss * (r * eta_miss / denom)
+    } else {
+        0.0
+    };
     let p_detected: f64 = mg.detect.iter().map(|(_, p)| p).sum();
     let r_post = (p_missed + p_detected).clamp(0.0, 1.0);
     t.existence = r_post;
@@ -537,7 +647,12 @@ fn update_track(t: &mut Track, l: &TrackLikelihoods, mg: &TrackMarginals) {
     if r_post <= 0.0 {
         return;
     }
-    let detected: Vec<(usize, f64)> = mg.detect.iter().copied().filter(|(_, p)| *p > 0.0).collect();
+    let detected: Vec<(usize, f64)> = mg
+        .detect
+        .iter()
+        .copied()
+        .filter(|(_, p)| *p > 0.0)
+        .collect();
     if detected.is_empty() && l.log_qd.windows(2).all(|w| w[0] == w[1]) {
         return; // only the miss term, constant over particles: weights unchanged
     }

@@ -13,7 +13,10 @@ pub struct Measurements {
 impl Measurements {
     /// An empty set of `dim`-dimensional measurements.
     pub fn empty(dim: usize) -> Self {
-        Measurements { dim, data: Vec::new() }
+        Measurements {
+            dim,
+            data: Vec::new(),
+        }
     }
 
     /// Builds the set from rows; every row must have `dim` finite components.
@@ -21,7 +24,9 @@ impl Measurements {
         let mut m = Self::empty(dim);
         for (j, row) in rows.iter().enumerate() {
             m.push(row.as_ref()).map_err(|e| match e {
-                Error::InvalidInput { reason, .. } => Error::invalid(format!("measurement {j}"), reason),
+                Error::InvalidInput { reason, .. } => {
+                    Error::invalid(format!("measurement {j}"), reason)
+                }
                 other => other,
             })?;
         }

@@ -16,7 +16,10 @@ pub mod particles;
 pub mod track;
 
 pub use association::{AssociationMethod, Associator};
-pub use birth::{AdaptiveBirth, BirthModel, BirthSampler, BirthTerm, BirthTrack, PositionBirthSampler, StaticBirth};
+pub use birth::{
+    AdaptiveBirth, BirthModel, BirthSampler, BirthTerm, BirthTrack, PositionBirthSampler,
+    StaticBirth,
+};
 pub use label::Label;
 pub use lmb::{Frame, LmbConfig, LmbFilter, LmbFilterBuilder};
 pub use measurements::Measurements;

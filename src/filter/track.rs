@@ -22,7 +22,13 @@ pub struct Track {
 impl Track {
     /// A new track at age 0.
     pub fn new(label: Label, existence: f64, particles: ParticleSet) -> Self {
-        Track { label, existence, particles, age: 0, expected_detections: 0.0 }
+        Track {
+            label,
+            existence,
+            particles,
+            age: 0,
+            expected_detections: 0.0,
+        }
     }
 }
 
