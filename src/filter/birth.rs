@@ -47,6 +47,12 @@ pub trait BirthModel: Send + Sync {
     ) -> Vec<BirthTrack>;
 }
 
+impl<T: BirthModel + ?Sized> BirthModel for Box<T> {
+    fn birth(&self, ctx: &StepContext, evidence: Option<&BirthEvidence<'_>>, rng: &mut FilterRng) -> Vec<BirthTrack> {
+        (**self).birth(ctx, evidence, rng)
+    }
+}
+
 /// One Gaussian birth term: existence probability, mean and per-component standard deviation.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BirthTerm {

@@ -257,6 +257,16 @@ pub struct LmbFilter {
     previous: Option<Previous>,
 }
 
+impl std::fmt::Debug for LmbFilter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LmbFilter")
+            .field("config", &self.config)
+            .field("steps", &self.step)
+            .field("tracks", &self.tracks.len())
+            .finish_non_exhaustive()
+    }
+}
+
 impl LmbFilter {
     /// Starts building a filter.
     pub fn builder() -> LmbFilterBuilder {

@@ -143,3 +143,44 @@ pub use detection::{ConstantDetection, FieldOfViewDetection, GaussianRangeDetect
 pub use position::PositionMeasurement;
 pub use range_bearing::{wrap_angle, BearingConvention, RangeBearing};
 pub use survival::ConstantSurvival;
+
+// A boxed model is a model: lets trait objects (e.g. chosen at run time) go wherever a model
+// is expected.
+impl<T: TransitionModel + ?Sized> TransitionModel for Box<T> {
+    fn state_dim(&self) -> usize {
+        (**self).state_dim()
+    }
+    fn predict(&self, particles: &mut ParticleSet, ctx: &StepContext, rng: &mut FilterRng) {
+        (**self).predict(particles, ctx, rng)
+    }
+}
+
+impl<T: SurvivalModel + ?Sized> SurvivalModel for Box<T> {
+    fn survival_probability(&self, particles: &ParticleSet, ctx: &StepContext, out: &mut [f64]) {
+        (**self).survival_probability(particles, ctx, out)
+    }
+}
+
+impl<T: MeasurementModel + ?Sized> MeasurementModel for Box<T> {
+    fn measurement_dim(&self) -> usize {
+        (**self).measurement_dim()
+    }
+    fn log_likelihood(&self, z: &[f64], particles: &ParticleSet, ctx: &StepContext, out: &mut [f64]) {
+        (**self).log_likelihood(z, particles, ctx, out)
+    }
+    fn gate(&self, z: &[f64], track: &TrackSummary, ctx: &StepContext) -> bool {
+        (**self).gate(z, track, ctx)
+    }
+}
+
+impl<T: DetectionModel + ?Sized> DetectionModel for Box<T> {
+    fn detection_probability(&self, particles: &ParticleSet, ctx: &StepContext, out: &mut [f64]) {
+        (**self).detection_probability(particles, ctx, out)
+    }
+}
+
+impl<T: ClutterModel + ?Sized> ClutterModel for Box<T> {
+    fn log_intensity(&self, z: &[f64], ctx: &StepContext) -> f64 {
+        (**self).log_intensity(z, ctx)
+    }
+}

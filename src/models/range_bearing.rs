@@ -114,6 +114,11 @@ impl RangeBearing {
         }
     }
 
+    /// Noise standard deviations (range in m, bearing in rad).
+    pub fn noise(&self) -> (f64, f64) {
+        (self.sigma_range, self.sigma_bearing)
+    }
+
     /// The same model with the sensor mounted at (a, b) in the platform frame.
     pub fn with_offset(mut self, a: f64, b: f64) -> Result<Self> {
         crate::error::ensure_finite("range-bearing mounting offset", &[a, b])?;

@@ -10,6 +10,6 @@
 pub mod rfs_benchmark;
 
 pub use rfs_benchmark::{
-    BirthTerm, ClutterSpec, DetectionSpec, DynamicsSpec, Scenario, ScenarioModels, SensorSpec,
+    ClutterSpec, DetectionSpec, DynamicsSpec, Scenario, ScenarioModels, SensorSpec,
     SimRun, TargetSpec, Truth,
 };

@@ -19,6 +19,7 @@
 //! Not for: running a filter or scoring it (see [`crate::filter`] and [`crate::metrics`]).
 
 use crate::error::{ensure_finite, Error, Result};
+use crate::filter::BirthTerm;
 use crate::models::{
     wrap_angle, BearingConvention, ClutterModel, ConstantDetection, ConstantSurvival,
     ConstantVelocity, CoordinatedTurn, DetectionModel, GaussianRangeDetection, MeasurementModel,
@@ -133,17 +134,6 @@ impl ClutterSpec {
             ClutterSpec::RangeBearing { range, bearing, .. } => [*range, *bearing],
         }
     }
-}
-
-/// One Gaussian term of the birth LMB: existence probability `r` and N(mean, diag(std²)).
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct BirthTerm {
-    /// Existence probability.
-    pub r: f64,
-    /// Mean state.
-    pub mean: Vec<f64>,
-    /// Standard deviation of every state component.
-    pub std: Vec<f64>,
 }
 
 /// One true target.
@@ -297,7 +287,7 @@ impl Scenario {
             death,
         };
         let birth_at = |x: f64, y: f64| BirthTerm {
-            r: 0.03,
+            existence: 0.03,
             mean: vec![x, 0.0, y, 0.0],
             std: vec![10.0; 4],
         };
@@ -356,7 +346,7 @@ impl Scenario {
         };
         let birth_std = vec![50.0, 50.0, 50.0, 50.0, 6f64.to_radians()];
         let birth_at = |r: f64, x: f64, y: f64| BirthTerm {
-            r,
+            existence: r,
             mean: vec![x, 0.0, y, 0.0, 0.0],
             std: birth_std.clone(),
         };
@@ -485,7 +475,7 @@ impl Scenario {
         }
         let dim = self.dynamics.state_dim();
         for (i, b) in self.birth.iter().enumerate() {
-            probability(&format!("birth term {i} existence probability"), b.r)?;
+            probability(&format!("birth term {i} existence probability"), b.existence)?;
             if b.mean.len() != dim || b.std.len() != dim {
                 return Err(Error::invalid(
                     format!("birth term {i}"),

@@ -927,3 +927,9 @@ mod tests {
         }
     }
 }
+
+impl<T: Associator + ?Sized> Associator for Box<T> {
+    fn marginals(&self, problem: &AssociationProblem, rng: &mut FilterRng) -> Marginals {
+        (**self).marginals(problem, rng)
+    }
+}

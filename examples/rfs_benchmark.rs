@@ -1,0 +1,187 @@
+//! The standard RFS benchmark scenarios (linear: constant velocity with position measurements;
+//! nonlinear: coordinated turn with range-bearing measurements) run through the particle LMB
+//! filter over Monte-Carlo runs, reporting OSPA, GOSPA, cardinality error and time per step.
+//!
+//! ```text
+//! cargo run --release --example rfs_benchmark -- --scenario nonlinear --runs 20 --seed 1 \
+//!     --associator lbp --particles 1000 [--json]
+//! ```
+
+use anyhow::{Context, Result};
+use clap::Parser;
+use smc_lmb::filter::{AssociationMethod, Jitter, Frame, LmbConfig, LmbFilter, Measurements, StaticBirth};
+use smc_lmb::models::MeasurementModel;
+use smc_lmb::metrics::{cardinality_error, gospa, ospa};
+use smc_lmb::rng::seeded;
+use smc_lmb::sim::Scenario;
+use std::time::Instant;
+
+#[derive(Parser, Debug)]
+#[command(about = "Standard RFS benchmarks through the particle LMB filter")]
+struct Args {
+    /// `linear` or `nonlinear`.
+    #[arg(long, default_value = "nonlinear")]
+    scenario: String,
+    /// Monte-Carlo runs.
+    #[arg(long, default_value_t = 1)]
+    runs: usize,
+    /// Seed of the first run (run i uses seed + i).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// `murty`, `gibbs` or `lbp` (optionally with `:N`, e.g. `murty:500`).
+    #[arg(long, default_value = "lbp")]
+    associator: String,
+    /// Particles per track.
+    #[arg(long, default_value_t = 1000)]
+    particles: usize,
+    /// Diversity after resampling: `none`, `roughening:K` or `regularised:SCALE`.
+    #[arg(long, default_value = "regularised:0.2")]
+    jitter: String,
+    /// Resample when the effective sample size falls below this fraction of the particles.
+    #[arg(long, default_value_t = 0.5)]
+    resample_threshold: f64,
+    /// Print one JSON object instead of tables.
+    #[arg(long)]
+    json: bool,
+}
+
+struct RunResult {
+    ospa: Vec<f64>,
+    gospa: Vec<f64>,
+    card: Vec<f64>,
+    ms: Vec<f64>,
+}
+
+fn run_once(scenario: &Scenario, associator: &AssociationMethod, config: &LmbConfig, seed: u64) -> Result<RunResult> {
+    let particles = config.particles;
+    let sim = scenario.generate(seed)?;
+    let models = scenario.models()?;
+    let terms = scenario.birth.clone();
+    let dim = models.measurement.measurement_dim();
+    let mut filter = LmbFilter::builder()
+        .transition(models.transition)
+        .survival(models.survival)
+        .measurement(models.measurement)
+        .detection(models.detection)
+        .clutter(models.clutter)
+        .birth(StaticBirth::new(terms, particles)?)
+        .associator(associator.clone())
+        .config(config.clone())
+        .build()?;
+    let mut rng = seeded(seed ^ 0x5EED);
+    let (c, p) = (scenario.ospa_cutoff, scenario.ospa_order);
+    let mut out = RunResult { ospa: vec![], gospa: vec![], card: vec![], ms: vec![] };
+    for (k, z) in sim.measurements.iter().enumerate() {
+        let frame = Frame::new(k as f64 * scenario.period, Measurements::from_rows(dim, z)?);
+        let t0 = Instant::now();
+        let est = filter.step(&frame, &mut rng)?;
+        out.ms.push(t0.elapsed().as_secs_f64() * 1e3);
+        let x: Vec<Vec<f64>> = est.iter().map(|e| vec![e.state[0], e.state[2]]).collect();
+        let truth: Vec<Vec<f64>> = sim.truth[k].iter().map(|(_, s)| vec![s[0], s[2]]).collect();
+        out.ospa.push(ospa(&truth, &x, c, p)?.distance);
+        out.gospa.push(gospa(&truth, &x, c, p)?.distance);
+        out.card.push(cardinality_error([(truth.len(), x.len())]).mean);
+    }
+    Ok(out)
+}
+
+fn parse_jitter(s: &str) -> Result<Jitter> {
+    let (kind, value) = s.split_once(':').unwrap_or((s, ""));
+    let num = || value.parse::<f64>().with_context(|| format!("--jitter {s}: `{value}` is not a number"));
+    Ok(match kind {
+        "none" => Jitter::None,
+        "roughening" => Jitter::Roughening { k: num()? },
+        "regularised" => Jitter::Regularised { scale: num()? },
+        _ => anyhow::bail!("--jitter {s}: expected none, roughening:K or regularised:SCALE"),
+    })
+}
+
+fn mean(v: &[f64]) -> f64 {
+    v.iter().sum::<f64>() / v.len().max(1) as f64
+}
+
+fn median(v: &[f64]) -> f64 {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    if s.is_empty() {
+        return f64::NAN;
+    }
+    let n = s.len();
+    if n % 2 == 1 {
+        s[n / 2]
+    } else {
+        0.5 * (s[n / 2 - 1] + s[n / 2])
+    }
+}
+
+fn main() -> Result<()> {
+    let args = Args::parse();
+    let scenario = match args.scenario.as_str() {
+        "linear" => Scenario::linear(),
+        "nonlinear" => Scenario::nonlinear(),
+        other => anyhow::bail!("unknown scenario `{other}` (expected linear or nonlinear)"),
+    };
+    let associator: AssociationMethod =
+        args.associator.parse().map_err(|e| anyhow::anyhow!("{e}")).context("--associator")?;
+    anyhow::ensure!(args.runs > 0, "--runs must be at least 1");
+    let config = LmbConfig {
+        particles: args.particles,
+        resample_threshold: args.resample_threshold,
+        jitter: parse_jitter(&args.jitter)?,
+        prune_threshold: 1e-3,
+        max_tracks: 100,
+    };
+    let mut runs = Vec::with_capacity(args.runs);
+    for r in 0..args.runs {
+        let res = run_once(&scenario, &associator, &config, args.seed + r as u64)
+            .with_context(|| format!("run {r}"))?;
+        if !args.json {
+            eprintln!("run {r}: mean OSPA {:.2} m, {:.2} ms/step", mean(&res.ospa), mean(&res.ms));
+        }
+        runs.push(res);
+    }
+    let steps = scenario.steps;
+    let per_step = |f: fn(&RunResult) -> &Vec<f64>| -> Vec<f64> {
+        (0..steps).map(|k| mean(&runs.iter().map(|r| f(r)[k]).collect::<Vec<_>>())).collect()
+    };
+    let ospa_k = per_step(|r| &r.ospa);
+    let gospa_k = per_step(|r| &r.gospa);
+    let card_k = per_step(|r| &r.card);
+    let all_ms: Vec<f64> = runs.iter().flat_map(|r| r.ms.iter().copied()).collect();
+    let summary = serde_json::json!({
+        "scenario": args.scenario,
+        "runs": args.runs,
+        "seed": args.seed,
+        "associator": args.associator,
+        "particles": args.particles,
+        "threads": rayon::current_num_threads(),
+        "mean_ospa": mean(&ospa_k),
+        "mean_gospa": mean(&gospa_k),
+        "mean_card_error": mean(&card_k),
+        "ms_per_step_median": median(&all_ms),
+        "ms_per_step_mean": mean(&all_ms),
+        "ospa_per_run": runs.iter().map(|r| mean(&r.ospa)).collect::<Vec<_>>(),
+        "ospa_per_step": ospa_k,
+    });
+    if args.json {
+        println!("{summary}");
+        return Ok(());
+    }
+    println!("step  OSPA(m)  GOSPA(m)  |card err|");
+    for k in 0..steps {
+        println!("{:>4}  {:>7.2}  {:>8.2}  {:>10.2}", k + 1, ospa_k[k], gospa_k[k], card_k[k]);
+    }
+    println!(
+        "\n{} scenario, {} run(s), {} association, {} particles per track, {} thread(s)",
+        args.scenario,
+        args.runs,
+        args.associator,
+        args.particles,
+        rayon::current_num_threads()
+    );
+    println!("mean OSPA (c = {}, p = {}): {:.2} m", scenario.ospa_cutoff, scenario.ospa_order, mean(&ospa_k));
+    println!("mean GOSPA: {:.2} m", mean(&gospa_k));
+    println!("mean |cardinality error|: {:.3}", mean(&card_k));
+    println!("time per step: median {:.3} ms, mean {:.3} ms", median(&all_ms), mean(&all_ms));
+    Ok(())
+}

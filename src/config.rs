@@ -1,0 +1,355 @@
+//! A whole filter described as data: which built-in models, with which parameters, and the
+//! filter's tuning — what a user writes in a TOML or JSON file to run the filter on their own
+//! detections. [`RunConfig::build`] checks every value and builds the [`LmbFilter`].
+//!
+//! ```toml
+//! seed = 7
+//! survival = 0.99
+//! [filter]                 # LmbConfig; every field optional
+//! particles = 500
+//! [transition]
+//! model = "constant_velocity"   # or "coordinated_turn" (sigma_vel, sigma_turn)
+//! dims = 2
+//! sigma_accel = 1.0
+//! [measurement]
+//! model = "position"            # or "range_bearing" (sigma_range, sigma_bearing, offset, convention)
+//! sigma = 0.5
+//! [detection]
+//! model = "constant"            # or "gaussian_range" (peak, scale, center)
+//! probability = 0.9
+//! [clutter]
+//! rate = 5.0                    # expected false measurements per frame
+//! volume = 40000.0              # of the measurement space (m², or rad·m for range-bearing)
+//! [birth]
+//! model = "adaptive"            # or "static" with terms = [{ existence, mean, std }] and particles
+//! expected_births = 0.1
+//! max_existence = 0.05
+//! particles = 500
+//! position_std = 1.0
+//! velocity_std = 2.0
+//! [association]
+//! method = "lbp"                # or "murty" (k), "gibbs" (samples)
+//! ```
+//!
+//! Not for: parsing the file text (the command-line tool does that with `toml`/`serde_json`).
+
+use crate::error::{ensure_finite, Error, Result};
+use crate::filter::{AdaptiveBirth, AssociationMethod, BirthTerm, LmbConfig, LmbFilter, ParticleSet, StaticBirth};
+use crate::models::{
+    BearingConvention, ConstantDetection, ConstantSurvival, ConstantVelocity, CoordinatedTurn, GaussianRangeDetection,
+    PositionMeasurement, RangeBearing, StepContext, UniformClutter,
+};
+use crate::rng::FilterRng;
+use rand_distr::{Distribution, StandardNormal};
+use serde::{Deserialize, Serialize};
+
+/// A complete, serialisable filter description.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunConfig {
+    /// Seed of the filter's random stream. Default 0.
+    #[serde(default)]
+    pub seed: u64,
+    /// Constant survival probability p_S. Default 0.99.
+    #[serde(default = "default_survival")]
+    pub survival: f64,
+    /// Filter tuning.
+    #[serde(default)]
+    pub filter: LmbConfig,
+    /// Motion model.
+    pub transition: TransitionConfig,
+    /// Measurement model.
+    pub measurement: MeasurementConfig,
+    /// Detection probability.
+    pub detection: DetectionConfig,
+    /// Uniform clutter.
+    pub clutter: ClutterConfig,
+    /// Birth model.
+    pub birth: BirthConfig,
+    /// Association method. Default: loopy belief propagation.
+    #[serde(default)]
+    pub association: AssociationMethod,
+}
+
+fn default_survival() -> f64 {
+    0.99
+}
+
+/// Built-in motion models.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "model", rename_all = "snake_case", deny_unknown_fields)]
+pub enum TransitionConfig {
+    /// [`ConstantVelocity`]: state `[x, ẋ, y, ẏ(, z, ż)]`.
+    ConstantVelocity {
+        /// 2 or 3 axes.
+        dims: usize,
+        /// Acceleration noise standard deviation (m/s²).
+        sigma_accel: f64,
+    },
+    /// [`CoordinatedTurn`]: state `[x, ẋ, y, ẏ, ω]`.
+    CoordinatedTurn {
+        /// Acceleration noise standard deviation (m/s²).
+        sigma_vel: f64,
+        /// Turn-rate noise standard deviation (rad/s).
+        sigma_turn: f64,
+    },
+}
+
+/// Built-in measurement models.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "model", rename_all = "snake_case", deny_unknown_fields)]
+pub enum MeasurementConfig {
+    /// [`PositionMeasurement`]: z = position + noise; as many axes as the transition has.
+    Position {
+        /// Noise standard deviation per axis (m).
+        sigma: f64,
+    },
+    /// [`RangeBearing`]: z = [range, bearing] from the sensor pose given per frame.
+    RangeBearing {
+        /// Range noise standard deviation (m).
+        sigma_range: f64,
+        /// Bearing noise standard deviation (rad).
+        sigma_bearing: f64,
+        /// Sensor mounting offset (a, b) on the platform (m). Default (0, 0).
+        #[serde(default)]
+        offset: [f64; 2],
+        /// Bearing convention. Default `from_x_axis`.
+        #[serde(default)]
+        convention: BearingConvention,
+    },
+}
+
+/// Built-in detection models.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "model", rename_all = "snake_case", deny_unknown_fields)]
+pub enum DetectionConfig {
+    /// The same p_D everywhere.
+    Constant {
+        /// p_D.
+        probability: f64,
+    },
+    /// p_D = peak·exp(−‖p − center‖² / (2 scale²)).
+    GaussianRange {
+        /// Peak probability.
+        peak: f64,
+        /// Length scale (m).
+        scale: f64,
+        /// Centre (m). Default the origin.
+        #[serde(default)]
+        center: [f64; 2],
+    },
+}
+
+/// Uniform clutter: `rate` false measurements per frame spread over `volume`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClutterConfig {
+    /// Expected number of clutter measurements per frame.
+    pub rate: f64,
+    /// Volume of the measurement space they fall in.
+    pub volume: f64,
+}
+
+/// Built-in birth models.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "model", rename_all = "snake_case", deny_unknown_fields)]
+pub enum BirthConfig {
+    /// [`StaticBirth`]: Gaussian terms proposed at every step.
+    Static {
+        /// The terms (existence, mean, std in the state layout of the transition).
+        terms: Vec<BirthTerm>,
+        /// Particles per birth track.
+        particles: usize,
+    },
+    /// [`AdaptiveBirth`] from unexplained measurements.
+    Adaptive {
+        /// Expected births per step λ_B.
+        expected_births: f64,
+        /// Cap r_B,max on a birth's existence.
+        max_existence: f64,
+        /// Particles per birth track.
+        particles: usize,
+        /// Position spread around the measured point (m).
+        position_std: f64,
+        /// Velocity spread around zero (m/s).
+        velocity_std: f64,
+        /// Turn-rate spread around zero (rad/s), for the coordinated-turn state. Default 0.1.
+        #[serde(default = "default_turn_std")]
+        turn_rate_std: f64,
+    },
+}
+
+fn default_turn_std() -> f64 {
+    0.1
+}
+
+impl RunConfig {
+    /// Checks every value and builds the filter. Errors name the offending field.
+    pub fn build(&self) -> Result<LmbFilter> {
+        if !(0.0..=1.0).contains(&self.survival) {
+            return Err(Error::invalid("config field `survival`", format!("{} outside [0, 1]", self.survival)));
+        }
+        let (state_dim, axes) = match self.transition {
+            TransitionConfig::ConstantVelocity { dims, .. } => (2 * dims, dims),
+            TransitionConfig::CoordinatedTurn { .. } => (5, 2),
+        };
+        let builder = LmbFilter::builder()
+            .survival(ConstantSurvival::new(self.survival)?)
+            .config(self.filter.clone())
+            .associator(self.association.clone())
+            .clutter(UniformClutter::new(self.clutter.rate, self.clutter.volume)?);
+        let builder = match self.transition {
+            TransitionConfig::ConstantVelocity { dims, sigma_accel } => {
+                builder.transition(ConstantVelocity::new(dims, sigma_accel)?)
+            }
+            TransitionConfig::CoordinatedTurn { sigma_vel, sigma_turn } => {
+                builder.transition(CoordinatedTurn::new(sigma_vel, sigma_turn)?)
+            }
+        };
+        let builder = match &self.detection {
+            DetectionConfig::Constant { probability } => builder.detection(ConstantDetection::new(*probability)?),
+            DetectionConfig::GaussianRange { peak, scale, center } => {
+                builder.detection(GaussianRangeDetection::new(*peak, *scale, *center)?)
+            }
+        };
+        let range_bearing = match &self.measurement {
+            MeasurementConfig::Position { .. } => None,
+            MeasurementConfig::RangeBearing { sigma_range, sigma_bearing, offset, convention } => {
+                if axes != 2 {
+                    return Err(Error::invalid("config field `measurement`", "range-bearing needs a planar transition"));
+                }
+                Some(RangeBearing::new(*sigma_range, *sigma_bearing)?.with_offset(offset[0], offset[1])?.with_convention(*convention))
+            }
+        };
+        let builder = match (&self.measurement, range_bearing) {
+            (MeasurementConfig::Position { sigma }, _) => builder.measurement(PositionMeasurement::new(axes, *sigma)?),
+            (_, Some(rb)) => builder.measurement(rb),
+            (_, None) => unreachable!("range-bearing model built above"),
+        };
+        let builder = match &self.birth {
+            BirthConfig::Static { terms, particles } => {
+                if let Some((i, t)) = terms.iter().enumerate().find(|(_, t)| t.mean.len() != state_dim) {
+                    return Err(Error::invalid(
+                        format!("config field `birth.terms[{i}]`"),
+                        format!("has {} state components, the transition has {state_dim}", t.mean.len()),
+                    ));
+                }
+                builder.birth(StaticBirth::new(terms.clone(), *particles)?)
+            }
+            BirthConfig::Adaptive { expected_births, max_existence, particles, position_std, velocity_std, turn_rate_std } => {
+                ensure_finite("config field `birth` spreads", &[*position_std, *velocity_std, *turn_rate_std])?;
+                if *position_std < 0.0 || *velocity_std < 0.0 || *turn_rate_std < 0.0 {
+                    return Err(Error::invalid("config field `birth`", "standard deviations must be ≥ 0"));
+                }
+                let sampler = MeasurementBirth {
+                    range_bearing,
+                    axes,
+                    turn_rate: state_dim == 5,
+                    position_std: *position_std,
+                    velocity_std: *velocity_std,
+                    turn_rate_std: *turn_rate_std,
+                };
+                builder.birth(AdaptiveBirth::new(sampler, *expected_births, *max_existence, *particles)?)
+            }
+        };
+        builder.build()
+    }
+}
+
+/// Birth particles around a measured point: position from the measurement (converted from
+/// range-bearing with the frame's sensor pose) plus Gaussian spread, velocity and turn rate
+/// around zero.
+struct MeasurementBirth {
+    range_bearing: Option<RangeBearing>,
+    axes: usize,
+    turn_rate: bool,
+    position_std: f64,
+    velocity_std: f64,
+    turn_rate_std: f64,
+}
+
+impl crate::filter::BirthSampler for MeasurementBirth {
+    fn sample(&self, z: &[f64], ctx: &StepContext, n: usize, rng: &mut FilterRng) -> ParticleSet {
+        let position: Vec<f64> = match &self.range_bearing {
+            Some(rb) => rb.to_cartesian([z[0], z[1]], ctx).to_vec(),
+            None => z[..self.axes].to_vec(),
+        };
+        let mut mean: Vec<f64> = position.iter().flat_map(|&p| [p, 0.0]).collect();
+        let mut std: Vec<f64> = position.iter().flat_map(|_| [self.position_std, self.velocity_std]).collect();
+        if self.turn_rate {
+            mean.push(0.0);
+            std.push(self.turn_rate_std);
+        }
+        let mut set = ParticleSet::gaussian(&mean, &std, n, rng);
+        if let Some(rb) = &self.range_bearing {
+            // Spread along the measurement's own uncertainty as well: perturb each particle's
+            // range and bearing and convert again.
+            let (sr, sb) = rb.noise();
+            let comps = set.components_mut();
+            let mut it = comps.into_iter();
+            let (x, _, y) = (it.next().unwrap(), it.next().unwrap(), it.next().unwrap());
+            for (xi, yi) in x.iter_mut().zip(y.iter_mut()) {
+                let er: f64 = StandardNormal.sample(rng);
+                let eb: f64 = StandardNormal.sample(rng);
+                let p = rb.to_cartesian([z[0] + sr * er, z[1] + sb * eb], ctx);
+                *xi += p[0] - position[0];
+                *yi += p[1] - position[1];
+            }
+        }
+        set
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> RunConfig {
+        serde_json::from_value(serde_json::json!({
+            "transition": {"model": "constant_velocity", "dims": 2, "sigma_accel": 1.0},
+            "measurement": {"model": "position", "sigma": 0.5},
+            "detection": {"model": "constant", "probability": 0.9},
+            "clutter": {"rate": 5.0, "volume": 40000.0},
+            "birth": {"model": "adaptive", "expected_births": 0.1, "max_existence": 0.05, "particles": 100,
+                      "position_std": 1.0, "velocity_std": 2.0}
+        }))
+        .unwrap()
+    }
+
+    #[test]
+    fn defaults_fill_in_and_the_filter_builds() {
+        let c = sample();
+        assert_eq!(c.survival, 0.99);
+        assert_eq!(c.filter, LmbConfig::default());
+        assert!(c.build().is_ok());
+    }
+
+    #[test]
+    fn bad_values_are_named() {
+        let mut c = sample();
+        c.clutter.volume = f64::NAN;
+        assert!(c.build().unwrap_err().to_string().contains("clutter volume"));
+        let mut c = sample();
+        c.survival = 1.5;
+        assert!(c.build().unwrap_err().to_string().contains("survival"));
+        let mut c = sample();
+        c.birth = BirthConfig::Static { terms: vec![BirthTerm { existence: 0.1, mean: vec![0.0; 3], std: vec![1.0; 3] }], particles: 10 };
+        assert!(c.build().unwrap_err().to_string().contains("birth.terms[0]"));
+        let err = serde_json::from_str::<RunConfig>(r#"{"transition": {"model": "warp_drive"}}"#).unwrap_err();
+        assert!(err.to_string().contains("warp_drive"));
+    }
+
+    #[test]
+    fn range_bearing_birth_lands_on_the_measured_point() {
+        let rb = RangeBearing::new(1.0, 0.01).unwrap();
+        let s = MeasurementBirth { range_bearing: Some(rb), axes: 2, turn_rate: true, position_std: 0.1, velocity_std: 1.0, turn_rate_std: 0.1 };
+        let mut ctx = StepContext::new(0, 0.0, 1.0);
+        ctx.platform = Some(nalgebra::Isometry3::translation(10.0, 0.0, 0.0));
+        use crate::filter::BirthSampler;
+        let p = s.sample(&[5.0, std::f64::consts::FRAC_PI_2], &ctx, 4000, &mut crate::rng::seeded(2));
+        let m = p.mean();
+        assert_eq!(p.dim(), 5);
+        // sensor at (10, 0) facing +x, bearing 90° → point (10, 5)
+        assert!((m[0] - 10.0).abs() < 0.1 && (m[2] - 5.0).abs() < 0.1, "{m:?}");
+    }
+}
