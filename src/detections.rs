@@ -58,13 +58,30 @@ pub struct EstimateFrame {
     pub estimates: Vec<Estimate>,
 }
 
+/// What to do with a measurement row that holds NaN or an infinity.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+pub enum NonFinite {
+    /// Refuse the file, naming frame/line and field (the default).
+    #[default]
+    Error,
+    /// Leave the row out and count it.
+    Skip,
+}
+
 /// Reads a detections or truth file (`.json` or `.csv`), checking that every number is finite
 /// and every frame's measurements have the same dimension as the first one.
 pub fn read_frames(path: &Path) -> Result<Vec<DetectionFrame>> {
+    read_frames_with(path, NonFinite::Error).map(|(frames, _)| frames)
+}
+
+/// Like [`read_frames`], with a policy for non-finite measurement values (JSON cannot hold them;
+/// CSV cells such as `nan` or `inf` can). Returns the frames and the number of rows skipped.
+pub fn read_frames_with(path: &Path, policy: NonFinite) -> Result<(Vec<DetectionFrame>, usize)> {
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let mut skipped = 0;
     let frames = match extension(path).as_str() {
         "json" => parse_json(path, &text)?,
-        "csv" => parse_csv(path, &text)?,
+        "csv" => parse_csv(path, &text, policy, &mut skipped)?,
         other => {
             return Err(Error::parse(
                 path,
@@ -75,7 +92,7 @@ pub fn read_frames(path: &Path) -> Result<Vec<DetectionFrame>> {
         }
     };
     check_frames(path, &frames)?;
-    Ok(frames)
+    Ok((frames, skipped))
 }
 
 fn extension(path: &Path) -> String {
@@ -158,7 +175,7 @@ fn check_frames(path: &Path, frames: &[DetectionFrame]) -> Result<()> {
     Ok(())
 }
 
-fn parse_csv(path: &Path, text: &str) -> Result<Vec<DetectionFrame>> {
+fn parse_csv(path: &Path, text: &str, policy: NonFinite, skipped: &mut usize) -> Result<Vec<DetectionFrame>> {
     let mut lines = text
         .lines()
         .enumerate()
@@ -206,15 +223,13 @@ fn parse_csv(path: &Path, text: &str) -> Result<Vec<DetectionFrame>> {
                 format!("{} fields, the header has {}", cells.len(), names.len()),
             ));
         }
+        let raw = |c: usize| -> Result<f64> {
+            cells[c].parse().map_err(|_| {
+                Error::parse(path, line_no, names[c], format!("`{}` is not a number", cells[c]))
+            })
+        };
         let num = |c: usize| -> Result<f64> {
-            let v: f64 = cells[c].parse().map_err(|_| {
-                Error::parse(
-                    path,
-                    line_no,
-                    names[c],
-                    format!("`{}` is not a number", cells[c]),
-                )
-            })?;
+            let v = raw(c)?;
             if v.is_finite() {
                 Ok(v)
             } else {
@@ -268,10 +283,17 @@ fn parse_csv(path: &Path, text: &str) -> Result<Vec<DetectionFrame>> {
         if z_cols.iter().all(|&c| cells[c].is_empty()) {
             continue;
         }
-        let z = z_cols
-            .iter()
-            .map(|&c| num(c))
-            .collect::<Result<Vec<f64>>>()?;
+        let z = match policy {
+            NonFinite::Error => z_cols.iter().map(|&c| num(c)).collect::<Result<Vec<f64>>>()?,
+            NonFinite::Skip => {
+                let z = z_cols.iter().map(|&c| raw(c)).collect::<Result<Vec<f64>>>()?;
+                if z.iter().any(|v| !v.is_finite()) {
+                    *skipped += 1;
+                    continue;
+                }
+                z
+            }
+        };
         f.measurements.push(z);
         if let Some(c) = id_col {
             let id: u64 = cells[c].parse().map_err(|_| {
@@ -397,6 +419,8 @@ mod tests {
             e.contains("b.csv:3") && e.contains("z0") && e.contains("not finite"),
             "{e}"
         );
+        let (f, skipped) = read_frames_with(&p, NonFinite::Skip).unwrap();
+        assert_eq!((f[0].measurements.len(), skipped), (1, 1));
         let p = tmp("c.csv", "frame,time,z0,z1\n0,0.0,1\n");
         let e = read_frames(&p).unwrap_err().to_string();
         assert!(e.contains("c.csv:2") && e.contains("fields"), "{e}");
