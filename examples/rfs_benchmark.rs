@@ -9,9 +9,11 @@
 
 use anyhow::{Context, Result};
 use clap::Parser;
-use smc_lmb::filter::{AssociationMethod, Jitter, Frame, LmbConfig, LmbFilter, Measurements, StaticBirth};
-use smc_lmb::models::MeasurementModel;
+use smc_lmb::filter::{
+    AssociationMethod, Frame, Jitter, LmbConfig, LmbFilter, Measurements, StaticBirth,
+};
 use smc_lmb::metrics::{cardinality_error, gospa, ospa};
+use smc_lmb::models::MeasurementModel;
 use smc_lmb::rng::seeded;
 use smc_lmb::sim::Scenario;
 use std::time::Instant;
@@ -52,7 +54,12 @@ struct RunResult {
     ms: Vec<f64>,
 }
 
-fn run_once(scenario: &Scenario, associator: &AssociationMethod, config: &LmbConfig, seed: u64) -> Result<RunResult> {
+fn run_once(
+    scenario: &Scenario,
+    associator: &AssociationMethod,
+    config: &LmbConfig,
+    seed: u64,
+) -> Result<RunResult> {
     let particles = config.particles;
     let sim = scenario.generate(seed)?;
     let models = scenario.models()?;
@@ -70,7 +77,12 @@ fn run_once(scenario: &Scenario, associator: &AssociationMethod, config: &LmbCon
         .build()?;
     let mut rng = seeded(seed ^ 0x5EED);
     let (c, p) = (scenario.ospa_cutoff, scenario.ospa_order);
-    let mut out = RunResult { ospa: vec![], gospa: vec![], card: vec![], ms: vec![] };
+    let mut out = RunResult {
+        ospa: vec![],
+        gospa: vec![],
+        card: vec![],
+        ms: vec![],
+    };
     for (k, z) in sim.measurements.iter().enumerate() {
         let frame = Frame::new(k as f64 * scenario.period, Measurements::from_rows(dim, z)?);
         let t0 = Instant::now();
@@ -80,14 +92,19 @@ fn run_once(scenario: &Scenario, associator: &AssociationMethod, config: &LmbCon
         let truth: Vec<Vec<f64>> = sim.truth[k].iter().map(|(_, s)| vec![s[0], s[2]]).collect();
         out.ospa.push(ospa(&truth, &x, c, p)?.distance);
         out.gospa.push(gospa(&truth, &x, c, p)?.distance);
-        out.card.push(cardinality_error([(truth.len(), x.len())]).mean);
+        out.card
+            .push(cardinality_error([(truth.len(), x.len())]).mean);
     }
     Ok(out)
 }
 
 fn parse_jitter(s: &str) -> Result<Jitter> {
     let (kind, value) = s.split_once(':').unwrap_or((s, ""));
-    let num = || value.parse::<f64>().with_context(|| format!("--jitter {s}: `{value}` is not a number"));
+    let num = || {
+        value
+            .parse::<f64>()
+            .with_context(|| format!("--jitter {s}: `{value}` is not a number"))
+    };
     Ok(match kind {
         "none" => Jitter::None,
         "roughening" => Jitter::Roughening { k: num()? },
@@ -121,8 +138,11 @@ fn main() -> Result<()> {
         "nonlinear" => Scenario::nonlinear(),
         other => anyhow::bail!("unknown scenario `{other}` (expected linear or nonlinear)"),
     };
-    let associator: AssociationMethod =
-        args.associator.parse().map_err(|e| anyhow::anyhow!("{e}")).context("--associator")?;
+    let associator: AssociationMethod = args
+        .associator
+        .parse()
+        .map_err(|e| anyhow::anyhow!("{e}"))
+        .context("--associator")?;
     anyhow::ensure!(args.runs > 0, "--runs must be at least 1");
     let config = LmbConfig {
         particles: args.particles,
@@ -136,13 +156,19 @@ fn main() -> Result<()> {
         let res = run_once(&scenario, &associator, &config, args.seed + r as u64)
             .with_context(|| format!("run {r}"))?;
         if !args.json {
-            eprintln!("run {r}: mean OSPA {:.2} m, {:.2} ms/step", mean(&res.ospa), mean(&res.ms));
+            eprintln!(
+                "run {r}: mean OSPA {:.2} m, {:.2} ms/step",
+                mean(&res.ospa),
+                mean(&res.ms)
+            );
         }
         runs.push(res);
     }
     let steps = scenario.steps;
     let per_step = |f: fn(&RunResult) -> &Vec<f64>| -> Vec<f64> {
-        (0..steps).map(|k| mean(&runs.iter().map(|r| f(r)[k]).collect::<Vec<_>>())).collect()
+        (0..steps)
+            .map(|k| mean(&runs.iter().map(|r| f(r)[k]).collect::<Vec<_>>()))
+            .collect()
     };
     let ospa_k = per_step(|r| &r.ospa);
     let gospa_k = per_step(|r| &r.gospa);
@@ -169,7 +195,13 @@ fn main() -> Result<()> {
     }
     println!("step  OSPA(m)  GOSPA(m)  |card err|");
     for k in 0..steps {
-        println!("{:>4}  {:>7.2}  {:>8.2}  {:>10.2}", k + 1, ospa_k[k], gospa_k[k], card_k[k]);
+        println!(
+            "{:>4}  {:>7.2}  {:>8.2}  {:>10.2}",
+            k + 1,
+            ospa_k[k],
+            gospa_k[k],
+            card_k[k]
+        );
     }
     println!(
         "\n{} scenario, {} run(s), {} association, {} particles per track, {} thread(s)",
@@ -179,9 +211,18 @@ fn main() -> Result<()> {
         args.particles,
         rayon::current_num_threads()
     );
-    println!("mean OSPA (c = {}, p = {}): {:.2} m", scenario.ospa_cutoff, scenario.ospa_order, mean(&ospa_k));
+    println!(
+        "mean OSPA (c = {}, p = {}): {:.2} m",
+        scenario.ospa_cutoff,
+        scenario.ospa_order,
+        mean(&ospa_k)
+    );
     println!("mean GOSPA: {:.2} m", mean(&gospa_k));
     println!("mean |cardinality error|: {:.3}", mean(&card_k));
-    println!("time per step: median {:.3} ms, mean {:.3} ms", median(&all_ms), mean(&all_ms));
+    println!(
+        "time per step: median {:.3} ms, mean {:.3} ms",
+        median(&all_ms),
+        mean(&all_ms)
+    );
     Ok(())
 }

@@ -34,10 +34,12 @@
 //! Not for: parsing the file text (the command-line tool does that with `toml`/`serde_json`).
 
 use crate::error::{ensure_finite, Error, Result};
-use crate::filter::{AdaptiveBirth, AssociationMethod, BirthTerm, LmbConfig, LmbFilter, ParticleSet, StaticBirth};
+use crate::filter::{
+    AdaptiveBirth, AssociationMethod, BirthTerm, LmbConfig, LmbFilter, ParticleSet, StaticBirth,
+};
 use crate::models::{
-    BearingConvention, ConstantDetection, ConstantSurvival, ConstantVelocity, CoordinatedTurn, GaussianRangeDetection,
-    PositionMeasurement, RangeBearing, StepContext, UniformClutter,
+    BearingConvention, ConstantDetection, ConstantSurvival, ConstantVelocity, CoordinatedTurn,
+    GaussianRangeDetection, PositionMeasurement, RangeBearing, StepContext, UniformClutter,
 };
 use crate::rng::FilterRng;
 use rand_distr::{Distribution, StandardNormal};
@@ -187,7 +189,10 @@ impl RunConfig {
     /// Checks every value and builds the filter. Errors name the offending field.
     pub fn build(&self) -> Result<LmbFilter> {
         if !(0.0..=1.0).contains(&self.survival) {
-            return Err(Error::invalid("config field `survival`", format!("{} outside [0, 1]", self.survival)));
+            return Err(Error::invalid(
+                "config field `survival`",
+                format!("{} outside [0, 1]", self.survival),
+            ));
         }
         let (state_dim, axes) = match self.transition {
             TransitionConfig::ConstantVelocity { dims, .. } => (2 * dims, dims),
@@ -202,44 +207,83 @@ impl RunConfig {
             TransitionConfig::ConstantVelocity { dims, sigma_accel } => {
                 builder.transition(ConstantVelocity::new(dims, sigma_accel)?)
             }
-            TransitionConfig::CoordinatedTurn { sigma_vel, sigma_turn } => {
-                builder.transition(CoordinatedTurn::new(sigma_vel, sigma_turn)?)
-            }
+            TransitionConfig::CoordinatedTurn {
+                sigma_vel,
+                sigma_turn,
+            } => builder.transition(CoordinatedTurn::new(sigma_vel, sigma_turn)?),
         };
         let builder = match &self.detection {
-            DetectionConfig::Constant { probability } => builder.detection(ConstantDetection::new(*probability)?),
-            DetectionConfig::GaussianRange { peak, scale, center } => {
-                builder.detection(GaussianRangeDetection::new(*peak, *scale, *center)?)
+            DetectionConfig::Constant { probability } => {
+                builder.detection(ConstantDetection::new(*probability)?)
             }
+            DetectionConfig::GaussianRange {
+                peak,
+                scale,
+                center,
+            } => builder.detection(GaussianRangeDetection::new(*peak, *scale, *center)?),
         };
         let range_bearing = match &self.measurement {
             MeasurementConfig::Position { .. } => None,
-            MeasurementConfig::RangeBearing { sigma_range, sigma_bearing, offset, convention } => {
+            MeasurementConfig::RangeBearing {
+                sigma_range,
+                sigma_bearing,
+                offset,
+                convention,
+            } => {
                 if axes != 2 {
-                    return Err(Error::invalid("config field `measurement`", "range-bearing needs a planar transition"));
+                    return Err(Error::invalid(
+                        "config field `measurement`",
+                        "range-bearing needs a planar transition",
+                    ));
                 }
-                Some(RangeBearing::new(*sigma_range, *sigma_bearing)?.with_offset(offset[0], offset[1])?.with_convention(*convention))
+                Some(
+                    RangeBearing::new(*sigma_range, *sigma_bearing)?
+                        .with_offset(offset[0], offset[1])?
+                        .with_convention(*convention),
+                )
             }
         };
         let builder = match (&self.measurement, range_bearing) {
-            (MeasurementConfig::Position { sigma }, _) => builder.measurement(PositionMeasurement::new(axes, *sigma)?),
+            (MeasurementConfig::Position { sigma }, _) => {
+                builder.measurement(PositionMeasurement::new(axes, *sigma)?)
+            }
             (_, Some(rb)) => builder.measurement(rb),
             (_, None) => unreachable!("range-bearing model built above"),
         };
         let builder = match &self.birth {
             BirthConfig::Static { terms, particles } => {
-                if let Some((i, t)) = terms.iter().enumerate().find(|(_, t)| t.mean.len() != state_dim) {
+                if let Some((i, t)) = terms
+                    .iter()
+                    .enumerate()
+                    .find(|(_, t)| t.mean.len() != state_dim)
+                {
                     return Err(Error::invalid(
                         format!("config field `birth.terms[{i}]`"),
-                        format!("has {} state components, the transition has {state_dim}", t.mean.len()),
+                        format!(
+                            "has {} state components, the transition has {state_dim}",
+                            t.mean.len()
+                        ),
                     ));
                 }
                 builder.birth(StaticBirth::new(terms.clone(), *particles)?)
             }
-            BirthConfig::Adaptive { expected_births, max_existence, particles, position_std, velocity_std, turn_rate_std } => {
-                ensure_finite("config field `birth` spreads", &[*position_std, *velocity_std, *turn_rate_std])?;
+            BirthConfig::Adaptive {
+                expected_births,
+                max_existence,
+                particles,
+                position_std,
+                velocity_std,
+                turn_rate_std,
+            } => {
+                ensure_finite(
+                    "config field `birth` spreads",
+                    &[*position_std, *velocity_std, *turn_rate_std],
+                )?;
                 if *position_std < 0.0 || *velocity_std < 0.0 || *turn_rate_std < 0.0 {
-                    return Err(Error::invalid("config field `birth`", "standard deviations must be ≥ 0"));
+                    return Err(Error::invalid(
+                        "config field `birth`",
+                        "standard deviations must be ≥ 0",
+                    ));
                 }
                 let sampler = MeasurementBirth {
                     range_bearing,
@@ -249,7 +293,12 @@ impl RunConfig {
                     velocity_std: *velocity_std,
                     turn_rate_std: *turn_rate_std,
                 };
-                builder.birth(AdaptiveBirth::new(sampler, *expected_births, *max_existence, *particles)?)
+                builder.birth(AdaptiveBirth::new(
+                    sampler,
+                    *expected_births,
+                    *max_existence,
+                    *particles,
+                )?)
             }
         };
         builder.build()
@@ -275,7 +324,10 @@ impl crate::filter::BirthSampler for MeasurementBirth {
             None => z[..self.axes].to_vec(),
         };
         let mut mean: Vec<f64> = position.iter().flat_map(|&p| [p, 0.0]).collect();
-        let mut std: Vec<f64> = position.iter().flat_map(|_| [self.position_std, self.velocity_std]).collect();
+        let mut std: Vec<f64> = position
+            .iter()
+            .flat_map(|_| [self.position_std, self.velocity_std])
+            .collect();
         if self.turn_rate {
             mean.push(0.0);
             std.push(self.turn_rate_std);
@@ -328,28 +380,59 @@ mod tests {
     fn bad_values_are_named() {
         let mut c = sample();
         c.clutter.volume = f64::NAN;
-        assert!(c.build().unwrap_err().to_string().contains("clutter volume"));
+        assert!(c
+            .build()
+            .unwrap_err()
+            .to_string()
+            .contains("clutter volume"));
         let mut c = sample();
         c.survival = 1.5;
         assert!(c.build().unwrap_err().to_string().contains("survival"));
         let mut c = sample();
-        c.birth = BirthConfig::Static { terms: vec![BirthTerm { existence: 0.1, mean: vec![0.0; 3], std: vec![1.0; 3] }], particles: 10 };
-        assert!(c.build().unwrap_err().to_string().contains("birth.terms[0]"));
-        let err = serde_json::from_str::<RunConfig>(r#"{"transition": {"model": "warp_drive"}}"#).unwrap_err();
+        c.birth = BirthConfig::Static {
+            terms: vec![BirthTerm {
+                existence: 0.1,
+                mean: vec![0.0; 3],
+                std: vec![1.0; 3],
+            }],
+            particles: 10,
+        };
+        assert!(c
+            .build()
+            .unwrap_err()
+            .to_string()
+            .contains("birth.terms[0]"));
+        let err = serde_json::from_str::<RunConfig>(r#"{"transition": {"model": "warp_drive"}}"#)
+            .unwrap_err();
         assert!(err.to_string().contains("warp_drive"));
     }
 
     #[test]
     fn range_bearing_birth_lands_on_the_measured_point() {
         let rb = RangeBearing::new(1.0, 0.01).unwrap();
-        let s = MeasurementBirth { range_bearing: Some(rb), axes: 2, turn_rate: true, position_std: 0.1, velocity_std: 1.0, turn_rate_std: 0.1 };
+        let s = MeasurementBirth {
+            range_bearing: Some(rb),
+            axes: 2,
+            turn_rate: true,
+            position_std: 0.1,
+            velocity_std: 1.0,
+            turn_rate_std: 0.1,
+        };
         let mut ctx = StepContext::new(0, 0.0, 1.0);
         ctx.platform = Some(nalgebra::Isometry3::translation(10.0, 0.0, 0.0));
         use crate::filter::BirthSampler;
-        let p = s.sample(&[5.0, std::f64::consts::FRAC_PI_2], &ctx, 4000, &mut crate::rng::seeded(2));
+        let p = s.sample(
+            &[5.0, std::f64::consts::FRAC_PI_2],
+            &ctx,
+            4000,
+            &mut crate::rng::seeded(2),
+        );
         let m = p.mean();
         assert_eq!(p.dim(), 5);
         // sensor at (10, 0) facing +x, bearing 90° → point (10, 5)
-        assert!((m[0] - 10.0).abs() < 0.1 && (m[2] - 5.0).abs() < 0.1, "{m:?}");
+        assert!(
+            (m[0] - 10.0).abs() < 0.1 && (m[2] - 5.0).abs() < 0.1,
+            "{m:?}"
+        );
     }
 }

@@ -175,7 +175,12 @@ fn check_frames(path: &Path, frames: &[DetectionFrame]) -> Result<()> {
     Ok(())
 }
 
-fn parse_csv(path: &Path, text: &str, policy: NonFinite, skipped: &mut usize) -> Result<Vec<DetectionFrame>> {
+fn parse_csv(
+    path: &Path,
+    text: &str,
+    policy: NonFinite,
+    skipped: &mut usize,
+) -> Result<Vec<DetectionFrame>> {
     let mut lines = text
         .lines()
         .enumerate()
@@ -225,7 +230,12 @@ fn parse_csv(path: &Path, text: &str, policy: NonFinite, skipped: &mut usize) ->
         }
         let raw = |c: usize| -> Result<f64> {
             cells[c].parse().map_err(|_| {
-                Error::parse(path, line_no, names[c], format!("`{}` is not a number", cells[c]))
+                Error::parse(
+                    path,
+                    line_no,
+                    names[c],
+                    format!("`{}` is not a number", cells[c]),
+                )
             })
         };
         let num = |c: usize| -> Result<f64> {
@@ -284,9 +294,15 @@ fn parse_csv(path: &Path, text: &str, policy: NonFinite, skipped: &mut usize) ->
             continue;
         }
         let z = match policy {
-            NonFinite::Error => z_cols.iter().map(|&c| num(c)).collect::<Result<Vec<f64>>>()?,
+            NonFinite::Error => z_cols
+                .iter()
+                .map(|&c| num(c))
+                .collect::<Result<Vec<f64>>>()?,
             NonFinite::Skip => {
-                let z = z_cols.iter().map(|&c| raw(c)).collect::<Result<Vec<f64>>>()?;
+                let z = z_cols
+                    .iter()
+                    .map(|&c| raw(c))
+                    .collect::<Result<Vec<f64>>>()?;
                 if z.iter().any(|v| !v.is_finite()) {
                     *skipped += 1;
                     continue;

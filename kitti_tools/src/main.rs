@@ -1,1 +1,31 @@
-fn main() {}
+//! `kitti-tools`: the command-line face of smc-lmb. Each subcommand parses its flags, builds a
+//! configuration and calls the library; no pipeline lives here.
+
+mod detections_cmd;
+
+use anyhow::Result;
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(
+    name = "kitti-tools",
+    version,
+    about = "Labelled multi-Bernoulli tracking tools"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run the filter on your own per-frame detections (JSON or CSV) with a model config
+    /// (TOML or JSON); write per-frame estimates and, given truth, print OSPA/GOSPA.
+    Detections(detections_cmd::Args),
+}
+
+fn main() -> Result<()> {
+    match Cli::parse().command {
+        Command::Detections(args) => detections_cmd::run(args),
+    }
+}

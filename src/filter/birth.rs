@@ -48,7 +48,12 @@ pub trait BirthModel: Send + Sync {
 }
 
 impl<T: BirthModel + ?Sized> BirthModel for Box<T> {
-    fn birth(&self, ctx: &StepContext, evidence: Option<&BirthEvidence<'_>>, rng: &mut FilterRng) -> Vec<BirthTrack> {
+    fn birth(
+        &self,
+        ctx: &StepContext,
+        evidence: Option<&BirthEvidence<'_>>,
+        rng: &mut FilterRng,
+    ) -> Vec<BirthTrack> {
         (**self).birth(ctx, evidence, rng)
     }
 }

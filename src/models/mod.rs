@@ -165,7 +165,13 @@ impl<T: MeasurementModel + ?Sized> MeasurementModel for Box<T> {
     fn measurement_dim(&self) -> usize {
         (**self).measurement_dim()
     }
-    fn log_likelihood(&self, z: &[f64], particles: &ParticleSet, ctx: &StepContext, out: &mut [f64]) {
+    fn log_likelihood(
+        &self,
+        z: &[f64],
+        particles: &ParticleSet,
+        ctx: &StepContext,
+        out: &mut [f64],
+    ) {
         (**self).log_likelihood(z, particles, ctx, out)
     }
     fn gate(&self, z: &[f64], track: &TrackSummary, ctx: &StepContext) -> bool {

@@ -10,6 +10,6 @@
 pub mod rfs_benchmark;
 
 pub use rfs_benchmark::{
-    ClutterSpec, DetectionSpec, DynamicsSpec, Scenario, ScenarioModels, SensorSpec,
-    SimRun, TargetSpec, Truth,
+    ClutterSpec, DetectionSpec, DynamicsSpec, Scenario, ScenarioModels, SensorSpec, SimRun,
+    TargetSpec, Truth,
 };

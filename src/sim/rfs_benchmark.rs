@@ -475,7 +475,10 @@ impl Scenario {
         }
         let dim = self.dynamics.state_dim();
         for (i, b) in self.birth.iter().enumerate() {
-            probability(&format!("birth term {i} existence probability"), b.existence)?;
+            probability(
+                &format!("birth term {i} existence probability"),
+                b.existence,
+            )?;
             if b.mean.len() != dim || b.std.len() != dim {
                 return Err(Error::invalid(
                     format!("birth term {i}"),

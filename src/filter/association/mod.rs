@@ -222,23 +222,40 @@ pub trait Associator: Send + Sync {
 pub enum AssociationMethod {
     /// Murty's k-best ranked assignment ([`MurtyAssociator`]).
     Murty {
-        /// Number of best hypotheses kept.
+        /// Number of best hypotheses kept (default 200).
+        #[serde(default = "default_murty_k")]
         k: usize,
     },
     /// Gibbs sampling of hypotheses ([`GibbsAssociator`]).
     Gibbs {
-        /// Number of Gibbs sweeps.
+        /// Number of Gibbs sweeps (default 1000).
+        #[serde(default = "default_gibbs_samples")]
         samples: usize,
     },
     /// Loopy belief propagation ([`LbpAssociator`]).
     Lbp {
-        /// Iteration cap.
+        /// Iteration cap (default 100).
+        #[serde(default = "default_lbp_iterations")]
         max_iterations: usize,
-        /// Stop when no message changes by more than this.
+        /// Stop when no message changes by more than this (default 1e-9).
+        #[serde(default = "default_lbp_tolerance")]
         tolerance: f64,
     },
     /// Exhaustive enumeration ([`ExhaustiveAssociator`] with its default cap).
     Exhaustive,
+}
+
+fn default_murty_k() -> usize {
+    MurtyAssociator::default().k
+}
+fn default_gibbs_samples() -> usize {
+    GibbsAssociator::default().samples
+}
+fn default_lbp_iterations() -> usize {
+    LbpAssociator::default().max_iterations
+}
+fn default_lbp_tolerance() -> f64 {
+    LbpAssociator::default().tolerance
 }
 
 impl Default for AssociationMethod {
