@@ -221,18 +221,19 @@ struct Previous {
 /// Per-track quantities of one update: detection probabilities and the likelihood of every
 /// gated measurement, all in the log domain.
 struct TrackLikelihoods {
-    /// ln p_D(xᵢ).
-    log_pd: Vec<f64>,
-    /// ln (1 − p_D(xᵢ)).
-    log_qd: Vec<f64>,
-    /// ln η_miss = ln Σ wᵢ (1 − p_D(xᵢ)).
-    log_eta_miss: f64,
+    /// p_D(xᵢ), clamped to [0, 1].
+    pd: Vec<f64>,
+    /// η_miss = Σ wᵢ (1 − p_D(xᵢ)) (no underflow risk: a plain sum of probabilities).
+    eta_miss: f64,
     /// Gated measurement indices.
     gated: Vec<usize>,
-    /// For each gated measurement: ln Σ wᵢ p_D(xᵢ) g(z | xᵢ) (without κ).
+    /// For each gated measurement: ln η = ln Σ wᵢ p_D(xᵢ) g(z | xᵢ) (without κ).
     log_eta: Vec<f64>,
-    /// For each gated measurement: ln g(z | xᵢ) per particle.
-    log_g: Vec<Vec<f64>>,
+    /// For each gated measurement: the likelihoods scaled by their largest value,
+    /// exp(ln g(z | xᵢ) − maxₖ ln g(z | xₖ)), so the best particle has 1 whatever the scale.
+    scaled_g: Vec<Vec<f64>>,
+    /// For each gated measurement: Σ wᵢ p_D(xᵢ) · scaled_g[i].
+    scaled_eta: Vec<f64>,
 }
 
 /// A track's row of association marginals, in its own terms.
@@ -372,9 +373,14 @@ impl LmbFilter {
             let mut rng = stream(seed, KEY_PREDICT ^ t.label.key());
             let mut ps = vec![0.0; t.particles.len()];
             m.survival.survival_probability(&t.particles, ctx, &mut ps);
-            ps.iter_mut().for_each(|p| *p = p.clamp(0.0, 1.0).ln());
-            let log_eta_s = t.particles.reweight_log(&ps);
-            t.existence *= log_eta_s.exp().min(1.0);
+            ps.iter_mut()
+                .for_each(|p| *p = if p.is_nan() { 0.0 } else { p.clamp(0.0, 1.0) });
+            // η_S = Σ wᵢ p_S(xᵢ); a constant p_S leaves the weights as they are.
+            let eta_s = match ps.first() {
+                Some(&p0) if ps.iter().all(|&p| p == p0) => p0,
+                _ => t.particles.reweight(&ps),
+            };
+            t.existence *= eta_s.clamp(0.0, 1.0);
             m.transition.predict(&mut t.particles, ctx, &mut rng);
             t.age += 1;
         });
@@ -423,42 +429,56 @@ impl LmbFilter {
                 let n = p.len();
                 let mut pd = vec![0.0; n];
                 m.detection.detection_probability(p, ctx, &mut pd);
-                let log_pd: Vec<f64> = pd.iter().map(|d| d.clamp(0.0, 1.0).ln()).collect();
-                let log_qd: Vec<f64> = pd.iter().map(|d| (1.0 - d.clamp(0.0, 1.0)).ln()).collect();
-                let log_w: Vec<f64> = p.weights().iter().map(|w| w.ln()).collect();
-                let log_eta_miss = log_sum_exp2(&log_w, &log_qd);
-                let summary = TrackSummary {
-                    mean: p.mean(),
-                    std: p.std_dev(),
-                };
-                let mut gated = Vec::new();
-                let mut log_eta = Vec::new();
-                let mut log_g = Vec::new();
-                let mut wd: Vec<f64> = log_w.iter().zip(&log_pd).map(|(a, b)| a + b).collect();
-                if wd.iter().all(|v| *v == f64::NEG_INFINITY) {
-                    wd.clear();
+                pd.iter_mut()
+                    .for_each(|d| *d = if d.is_nan() { 0.0 } else { d.clamp(0.0, 1.0) });
+                let w = p.weights();
+                let eta_miss: f64 = w.iter().zip(&pd).map(|(w, d)| w * (1.0 - d)).sum();
+                let detectable = w.iter().zip(&pd).any(|(w, d)| w * d > 0.0);
+                let mut gated: Vec<usize> = Vec::new();
+                if detectable && !z.is_empty() {
+                    let summary = TrackSummary {
+                        mean: p.mean(),
+                        std: p.std_dev(),
+                    };
+                    gated = (0..z.len())
+                        .filter(|&j| m.measurement.gate(z.get(j), &summary, ctx))
+                        .collect();
                 }
-                for (j, zj) in z.iter().enumerate() {
-                    if wd.is_empty() || !m.measurement.gate(zj, &summary, ctx) {
+                let zs: Vec<&[f64]> = gated.iter().map(|&j| z.get(j)).collect();
+                let mut scaled_g = vec![vec![0.0; n]; zs.len()];
+                m.measurement
+                    .log_likelihood_batch(&zs, p, ctx, &mut scaled_g);
+                let (mut log_eta, mut scaled_eta) =
+                    (Vec::with_capacity(zs.len()), Vec::with_capacity(zs.len()));
+                for g in &mut scaled_g {
+                    // log-sum-exp: shift by the largest log-likelihood before leaving the log
+                    // domain, so likelihoods that would underflow keep their ratios.
+                    let top = g.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                    if !top.is_finite() {
+                        log_eta.push(f64::NEG_INFINITY);
+                        scaled_eta.push(0.0);
                         continue;
                     }
-                    let mut g = vec![0.0; n];
-                    m.measurement.log_likelihood(zj, p, ctx, &mut g);
-                    let eta = log_sum_exp2(&wd, &g);
-                    if eta == f64::NEG_INFINITY || eta.is_nan() {
-                        continue;
-                    }
-                    gated.push(j);
-                    log_eta.push(eta);
-                    log_g.push(g);
+                    g.iter_mut().for_each(|v| *v = (*v - top).exp());
+                    let sum: f64 = g.iter().zip(w).zip(&pd).map(|((g, w), d)| g * w * d).sum();
+                    log_eta.push(top + sum.ln());
+                    scaled_eta.push(sum);
                 }
+                // Drop pairs no particle can explain.
+                let keep: Vec<bool> = scaled_eta.iter().map(|s| *s > 0.0).collect();
+                let mut k = keep.iter();
+                gated.retain(|_| *k.next().expect("one flag per pair"));
+                let mut k = keep.iter();
+                scaled_g.retain(|_| *k.next().expect("one flag per pair"));
+                log_eta.retain(|e| *e > f64::NEG_INFINITY);
+                scaled_eta.retain(|s| *s > 0.0);
                 TrackLikelihoods {
-                    log_pd,
-                    log_qd,
-                    log_eta_miss,
+                    pd,
+                    eta_miss,
                     gated,
                     log_eta,
-                    log_g,
+                    scaled_g,
+                    scaled_eta,
                 }
             })
             .collect()
@@ -494,7 +514,7 @@ impl LmbFilter {
                 for (row, &ti) in g.tracks.iter().enumerate() {
                     let r = tracks[ti].existence;
                     let l = &lik[ti];
-                    problem.log_miss.push(log_miss_weight(r, l.log_eta_miss));
+                    problem.log_miss.push(log_miss_weight(r, l.eta_miss));
                     for (k, &j) in l.gated.iter().enumerate() {
                         let col = g
                             .measurements
@@ -602,39 +622,9 @@ impl LmbFilter {
     }
 }
 
-/// ln(1 − r + r·η_miss), stable for r → 1 and η_miss → 0.
-fn log_miss_weight(r: f64, log_eta_miss: f64) -> f64 {
-    let absent = 1.0 - r;
-    let missed = r * log_eta_miss.exp();
-    if absent + missed > 0.0 {
-        (absent + missed).ln()
-    } else {
-        r.ln() + log_eta_miss
-    }
-}
-
-/// ln Σᵢ exp(aᵢ + bᵢ), safe against overflow and underflow; −∞ for an empty or all-−∞ sum.
-fn log_sum_exp2(a: &[f64], b: &[f64]) -> f64 {
-    let max = a
-        .iter()
-        .zip(b)
-        .map(|(x, y)| x + y)
-        .fold(f64::NEG_INFINITY, f64::max);
-    if !max.is_finite() {
-        return max;
-    }
-    let s: f64 = a.iter().zip(b).map(|(x, y)| (x + y - max).exp()).sum();
-    max + s.ln()
-}
-
-/// ln(eᵃ + eᵇ).
-fn log_add_exp(a: f64, b: f64) -> f64 {
-    let (hi, lo) = if a > b { (a, b) } else { (b, a) };
-    if lo == f64::NEG_INFINITY {
-        hi
-    } else {
-        hi + (lo - hi).exp().ln_1p()
-    }
+/// ln(1 − r + r·η_miss); −∞ when the track surely exists and is surely detected.
+fn log_miss_weight(r: f64, eta_miss: f64) -> f64 {
+    (1.0 - r + r * eta_miss).max(0.0).ln()
 }
 
 /// Posterior existence and particle weights of one track from its association marginals
@@ -642,11 +632,10 @@ fn log_add_exp(a: f64, b: f64) -> f64 {
 /// miss/absence hypotheses split as in the marginal form of the fast LMB update).
 fn update_track(t: &mut Track, l: &TrackLikelihoods, mg: &TrackMarginals) {
     let r = t.existence;
-    let eta_miss = l.log_eta_miss.exp();
-    let denom = 1.0 - r + r * eta_miss;
+    let denom = 1.0 - r + r * l.eta_miss;
     // Probability that the track exists and was missed.
     let p_missed = if denom > 0.0 {
-        mg.miss * (r * eta_miss / denom)
+        mg.miss * (r * l.eta_miss / denom)
     } else {
         0.0
     };
@@ -663,22 +652,30 @@ fn update_track(t: &mut Track, l: &TrackLikelihoods, mg: &TrackMarginals) {
         .copied()
         .filter(|(_, p)| *p > 0.0)
         .collect();
-    if detected.is_empty() && l.log_qd.windows(2).all(|w| w[0] == w[1]) {
+    if detected.is_empty() && l.pd.windows(2).all(|w| w[0] == w[1]) {
         return; // only the miss term, constant over particles: weights unchanged
     }
-    let n = t.particles.len();
-    let mut factor = vec![f64::NEG_INFINITY; n];
-    if p_missed > 0.0 && l.log_eta_miss.is_finite() {
-        let c = p_missed.ln() - l.log_eta_miss;
-        for (f, q) in factor.iter_mut().zip(&l.log_qd) {
-            *f = c + q;
-        }
-    }
+    // Particle i's factor: P_missed·(1 − p_D,i)/η_miss + p_D,i · Σ_j P_j·ĝ_j,i / η̂_j, where ĝ and
+    // η̂ are the likelihoods and sums scaled by the same constant (which cancels). The
+    // particle with ĝ = 1 of any detection term keeps a positive factor, so the set never empties.
+    let miss = if p_missed > 0.0 && l.eta_miss > 0.0 {
+        p_missed / l.eta_miss
+    } else {
+        0.0
+    };
+    let mut factor: Vec<f64> = l.pd.iter().map(|d| miss * (1.0 - d)).collect();
+    let mut detect_sum = vec![0.0; factor.len()];
     for (k, p) in detected {
-        let c = p.ln() - l.log_eta[k];
-        for ((f, d), g) in factor.iter_mut().zip(&l.log_pd).zip(&l.log_g[k]) {
-            *f = log_add_exp(*f, c + d + g);
-        }
+        let c = p / l.scaled_eta[k];
+        detect_sum
+            .iter_mut()
+            .zip(&l.scaled_g[k])
+            .for_each(|(s, g)| *s += c * g);
     }
-    t.particles.reweight_log(&factor);
+    factor
+        .iter_mut()
+        .zip(&l.pd)
+        .zip(&detect_sum)
+        .for_each(|((f, d), s)| *f += d * s);
+    t.particles.reweight(&factor);
 }

@@ -198,6 +198,21 @@ impl ParticleSet {
         max + total.ln()
     }
 
+    /// Multiplies weight `i` by `factor[i]` (finite, ≥ 0) and renormalises; returns
+    /// Σᵢ wᵢ·factor[i]. When that sum is zero or not finite the weights are left unchanged.
+    pub fn reweight(&mut self, factor: &[f64]) -> f64 {
+        debug_assert_eq!(factor.len(), self.len);
+        let total: f64 = self.weights.iter().zip(factor).map(|(w, f)| w * f).sum();
+        if !(total > 0.0 && total.is_finite()) {
+            return total;
+        }
+        let inv = 1.0 / total;
+        for (w, f) in self.weights.iter_mut().zip(factor) {
+            *w *= f * inv;
+        }
+        total
+    }
+
     /// Weighted mean of every component into `out`.
     pub fn mean_into(&self, out: &mut [f64]) {
         for (c, o) in out.iter_mut().enumerate().take(self.dim) {

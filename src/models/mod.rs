@@ -107,6 +107,20 @@ pub trait MeasurementModel: Send + Sync {
         ctx: &StepContext,
         out: &mut [f64],
     );
+    /// log g(z | xᵢ) for several measurements at once: `out[j]` (one slot per particle) gets
+    /// the row of `zs[j]`. The default calls [`MeasurementModel::log_likelihood`] for each;
+    /// models whose predicted measurement h(xᵢ) is costly override it to compute h once.
+    fn log_likelihood_batch(
+        &self,
+        zs: &[&[f64]],
+        particles: &ParticleSet,
+        ctx: &StepContext,
+        out: &mut [Vec<f64>],
+    ) {
+        for (z, o) in zs.iter().zip(out.iter_mut()) {
+            self.log_likelihood(z, particles, ctx, o);
+        }
+    }
     /// A cheap test whether `z` could come from a track summarised by `track`; pairs that fail
     /// are never evaluated by [`MeasurementModel::log_likelihood`]. The default admits all.
     fn gate(&self, z: &[f64], track: &TrackSummary, ctx: &StepContext) -> bool {
@@ -173,6 +187,15 @@ impl<T: MeasurementModel + ?Sized> MeasurementModel for Box<T> {
         out: &mut [f64],
     ) {
         (**self).log_likelihood(z, particles, ctx, out)
+    }
+    fn log_likelihood_batch(
+        &self,
+        zs: &[&[f64]],
+        particles: &ParticleSet,
+        ctx: &StepContext,
+        out: &mut [Vec<f64>],
+    ) {
+        (**self).log_likelihood_batch(zs, particles, ctx, out)
     }
     fn gate(&self, z: &[f64], track: &TrackSummary, ctx: &StepContext) -> bool {
         (**self).gate(z, track, ctx)

@@ -271,11 +271,12 @@ impl MeasurementModel for RangeBearing {
         }
     }
 
-    /// Admits `z` when its Cartesian point lies within
-    /// k · (σ_ρ + σ_θ · ρ_max + √(s_x² + s_y²)) of the track's mean position, where k is the
-    /// gate width, ρ_max the larger of the measured range and the sensor's distance to the
-    /// mean, and s the track's position standard deviations. Since a bearing error Δθ at range
-    /// ρ displaces the point by at most ρ·|Δθ|, this is a conservative region.
+    /// Admits `z` when it falls in a window around the predicted measurement of the track's
+    /// mean position, in measurement space: |z_ρ − ρ̂| ≤ k·(σ_ρ + s) and
+    /// |z_θ − θ̂| ≤ k·σ_θ + asin(min(1, k·s / ρ̂)), where k is the gate width and
+    /// s = √(s_x² + s_y²) the track's position spread. A particle cloud of radius k·s at range ρ̂
+    /// subtends at most that bearing interval, so the window is conservative; a track whose
+    /// cloud reaches the sensor admits every bearing.
     fn gate(&self, z: &[f64], track: &TrackSummary, ctx: &StepContext) -> bool {
         let [zr, zb] = match z {
             [r, b] if r.is_finite() && b.is_finite() => [*r, *b],
@@ -284,15 +285,60 @@ impl MeasurementModel for RangeBearing {
         if track.mean.len() < 3 || track.std.len() < 3 {
             return true;
         }
-        let [cx, cy] = self.to_cartesian([zr, zb], ctx);
-        let (mx, my) = (track.mean[0], track.mean[2]);
         let s = self.sensor(ctx);
-        let rho = zr.abs().max((mx - s.x).hypot(my - s.y));
+        let (rho, theta) = self.measure(&s, track.mean[0], track.mean[2]);
         let spread = track.std[0].hypot(track.std[2]);
-        let allowed = self.gate_sigmas * (self.sigma_range + self.sigma_bearing * rho + spread);
-        let d = (cx - mx).hypot(cy - my);
+        let k = self.gate_sigmas;
+        let range_ok = (zr - rho).abs() <= k * (self.sigma_range + spread);
+        let reach = if rho > 0.0 {
+            (k * spread / rho).min(1.0)
+        } else {
+            1.0
+        };
+        let bearing_ok =
+            reach >= 1.0 || wrap_angle(zb - theta).abs() <= k * self.sigma_bearing + reach.asin();
         // NaN in the summary: admit rather than silently drop.
-        d.is_nan() || allowed.is_nan() || d <= allowed
+        !(rho.is_finite() && spread.is_finite()) || (range_ok && bearing_ok)
+    }
+
+    fn log_likelihood_batch(
+        &self,
+        zs: &[&[f64]],
+        particles: &ParticleSet,
+        ctx: &StepContext,
+        out: &mut [Vec<f64>],
+    ) {
+        if particles.dim() < 3 {
+            out.iter_mut().for_each(|o| o.fill(f64::NEG_INFINITY));
+            return;
+        }
+        // The predicted measurement of every particle, once for all measurements.
+        let s = self.sensor(ctx);
+        let n = particles.len();
+        let (mut ranges, mut bearings) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        for (&x, &y) in particles.component(0).iter().zip(particles.component(2)) {
+            let (r, b) = self.measure(&s, x, y);
+            ranges.push(r);
+            bearings.push(b);
+        }
+        let norm = self.log_normaliser();
+        let inv_r = 1.0 / self.sigma_range;
+        let inv_b = 1.0 / self.sigma_bearing;
+        for (z, o) in zs.iter().zip(out.iter_mut()) {
+            let (zr, zb) = match z {
+                [r, b] if r.is_finite() && b.is_finite() => (*r, *b),
+                _ => {
+                    o.fill(f64::NEG_INFINITY);
+                    continue;
+                }
+            };
+            for ((o, &r), &b) in o.iter_mut().zip(&ranges).zip(&bearings) {
+                let er = (zr - r) * inv_r;
+                let eb = wrap_angle(zb - b) * inv_b;
+                let l = norm - 0.5 * (er * er + eb * eb);
+                *o = if l.is_nan() { f64::NEG_INFINITY } else { l };
+            }
+        }
     }
 }
 
@@ -418,6 +464,45 @@ mod tests {
             .unwrap()
             .with_gate_sigmas(0.0)
             .is_err());
+    }
+
+    #[test]
+    fn gate_window_is_tight_in_range_and_wide_in_bearing() {
+        let m = RangeBearing::benchmark();
+        // mean at range 1000 straight along +y (bearing 0), spread s = √(20² + 20²) = 28.3 m:
+        // range half-width 5·(10 + 28.3) = 191 m; bearing half-width 5·2° + asin(141/1000) = 18.1°
+        let track = TrackSummary {
+            mean: vec![0.0, 0.0, 1000.0, 0.0, 0.0],
+            std: vec![20.0, 5.0, 20.0, 5.0, 0.01],
+        };
+        assert!(m.gate(&[1180.0, 0.0], &track, &ctx()));
+        assert!(!m.gate(&[1200.0, 0.0], &track, &ctx()));
+        assert!(m.gate(&[1000.0, 18f64.to_radians()], &track, &ctx()));
+        assert!(!m.gate(&[1000.0, 18.5f64.to_radians()], &track, &ctx()));
+        // a cloud that reaches the sensor admits every bearing
+        let near = TrackSummary {
+            mean: vec![0.0, 0.0, 10.0, 0.0, 0.0],
+            std: vec![5.0, 1.0, 5.0, 1.0, 0.0],
+        };
+        assert!(m.gate(&[10.0, PI], &near, &ctx()));
+    }
+
+    #[test]
+    fn batch_likelihood_equals_one_at_a_time() {
+        let m = RangeBearing::new(2.0, 0.05)
+            .unwrap()
+            .with_offset(0.3, -0.1)
+            .unwrap();
+        let mut rng = crate::rng::seeded(5);
+        let p = ParticleSet::gaussian(&[3.0, 0.0, 4.0, 0.0], &[1.0, 1.0, 1.0, 1.0], 50, &mut rng);
+        let zs: [&[f64]; 3] = [&[5.0, 0.9], &[4.0, -3.1], &[f64::NAN, 0.0]];
+        let mut batch = vec![vec![0.0; 50]; 3];
+        m.log_likelihood_batch(&zs, &p, &ctx(), &mut batch);
+        for (z, row) in zs.iter().zip(&batch) {
+            let mut one = vec![0.0; 50];
+            m.log_likelihood(z, &p, &ctx(), &mut one);
+            assert_eq!(&one, row);
+        }
     }
 
     #[test]
