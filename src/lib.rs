@@ -8,6 +8,7 @@ pub mod assignment;
 pub mod detections;
 pub mod error;
 pub mod filter;
+pub mod laser2d;
 pub mod metrics;
 pub mod models;
 pub mod rng;
