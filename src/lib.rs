@@ -9,6 +9,7 @@ pub mod config;
 pub mod detections;
 pub mod error;
 pub mod filter;
+pub mod laser2d;
 pub mod metrics;
 pub mod models;
 pub mod rng;

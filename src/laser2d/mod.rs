@@ -1,0 +1,36 @@
+//! Planar (2D) laser scanners: scans, the readers that load them from real recordings, and
+//! the adaptive breakpoint segmentation that turns a scan into candidate objects.
+//!
+//! * [`scan`]: [`Scan`] (polar beams, "no return" policy, Cartesian points), [`Pose2`],
+//!   [`OdometryRecord`].
+//! * [`carmen`]: CARMEN logs (`FLASER`, `ROBOTLASER1`, `ODOM`; plain, `.gz`, `.bz2`),
+//!   streamed line by line.
+//! * [`rosbag`]: `sensor_msgs/LaserScan` and `nav_msgs/Odometry` from ROS 1 bags.
+//! * [`csv`]: the project's own one-scan-per-line text format, read and written.
+//! * [`segment`]: the adaptive breakpoint detector (seed 000, eq. 15) and [`Segment`]s.
+//!
+//! Not for: background subtraction, shape features, tracking or mapping — segments are the
+//! hand-over point to the detectors and the filter.
+//!
+//! ```
+//! use smc_lmb::laser2d::{segment_scan, BreakpointConfig, Scan};
+//! let ranges = vec![3.0_f32; 30];
+//! let scan = Scan::new(0.0, -0.3, 0.02, ranges, 0.0, 30.0).unwrap();
+//! let segments = segment_scan(&scan, &BreakpointConfig::default()).unwrap();
+//! assert_eq!(segments.len(), 1);
+//! ```
+
+pub mod carmen;
+pub mod csv;
+pub mod rosbag;
+pub mod scan;
+pub mod segment;
+
+pub use self::carmen::{
+    read_carmen, CarmenLog, CarmenOptions, CarmenReader, CarmenRecord, CarmenStats, OnMalformed,
+    TimeOrder,
+};
+pub use self::csv::{read_scan_csv, write_scan_csv};
+pub use self::rosbag::{bag_topics, read_bag, BagOptions, BagScans, BagTopic, OdometryTopic};
+pub use self::scan::{attach_odometry, OdometryRecord, Pose2, Scan};
+pub use self::segment::{breakpoint_threshold, segment_scan, BreakpointConfig, Segment};
