@@ -5,6 +5,7 @@
 #![warn(missing_docs)]
 
 pub mod assignment;
+pub mod cloud;
 pub mod detections;
 pub mod error;
 pub mod filter;
