@@ -9,6 +9,7 @@ pub mod cloud;
 pub mod detections;
 pub mod error;
 pub mod filter;
+pub mod kitti;
 pub mod metrics;
 pub mod models;
 pub mod rng;
