@@ -1,4 +1,4 @@
-//! Small helpers shared by the KITTI text readers: reading a whole file with an error that
+//! Small functions shared by the KITTI text readers: reading a whole file with an error that
 //! names it, and turning one whitespace-separated token into a number with an error that names
 //! file, line and field.
 //!
