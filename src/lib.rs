@@ -5,10 +5,12 @@
 #![warn(missing_docs)]
 
 pub mod assignment;
+pub mod cloud;
 pub mod config;
 pub mod detections;
 pub mod error;
 pub mod filter;
+pub mod kitti;
 pub mod laser2d;
 pub mod metrics;
 pub mod models;

@@ -1,0 +1,389 @@
+//! [`RawDrive`]: one synchronised KITTI raw drive on disk, laid out as
+//!
+//! ```text
+//! DATE/                                  e.g. 2011_09_26/
+//!   calib_imu_to_velo.txt  calib_velo_to_cam.txt  calib_cam_to_cam.txt
+//!   DATE_drive_NNNN_sync/                the drive folder handed to RawDrive::open
+//!     velodyne_points/data/0000000000.bin ...   velodyne_points/timestamps.txt
+//!     oxts/data/0000000000.txt ...              oxts/timestamps.txt
+//! ```
+//!
+//! Opening lists the frame files only; clouds, packets, stamps and calibration are read when
+//! asked for. Either sensor folder may be absent: a drive without OXTS still gives point clouds,
+//! and asking it for poses is an error naming the missing folder. [`RawDrive::check`] reports
+//! every inconsistency at once.
+//!
+//! Not for: camera images, or the odometry benchmark layout (see [`super::odometry`]).
+
+use super::calib::{read_cam_to_cam, read_rigid_calib, CamToCamCalib, RigidCalib};
+use super::frames::{frame_file_name, list_frame_files, numbering_gaps, require_contiguous};
+use super::issue::Issue;
+use super::oxts::{read_oxts_file, OxtsPacket};
+use super::poses::{self, VehicleState};
+use super::timestamps::{read_timestamps, Timestamps};
+use crate::cloud::{read_kitti_bin_with, BinScan, NonFinite, PointCloud};
+use crate::error::{Error, Result};
+use nalgebra::Isometry3;
+use std::path::{Path, PathBuf};
+
+/// File name of the IMU→Velodyne calibration in the date folder.
+pub const CALIB_IMU_TO_VELO: &str = "calib_imu_to_velo.txt";
+/// File name of the Velodyne→camera calibration in the date folder.
+pub const CALIB_VELO_TO_CAM: &str = "calib_velo_to_cam.txt";
+/// File name of the camera-to-camera calibration in the date folder.
+pub const CALIB_CAM_TO_CAM: &str = "calib_cam_to_cam.txt";
+
+/// Frame files of one data folder: (frame number, path), sorted by number.
+type FrameFiles = Vec<(u64, PathBuf)>;
+
+/// One synchronised raw drive (`DATE/DATE_drive_NNNN_sync`).
+#[derive(Clone, Debug)]
+pub struct RawDrive {
+    dir: PathBuf,
+    date_dir: PathBuf,
+    /// `None` when `velodyne_points/data` does not exist.
+    velodyne: Option<FrameFiles>,
+    /// `None` when `oxts/data` does not exist.
+    oxts: Option<FrameFiles>,
+}
+
+fn list_if_present(dir: &Path, ext: &str) -> Result<Option<FrameFiles>> {
+    if dir.is_dir() {
+        list_frame_files(dir, ext).map(Some)
+    } else {
+        Ok(None)
+    }
+}
+
+fn missing_folder(path: &Path, consequence: &str) -> Error {
+    Error::io(
+        path,
+        std::io::Error::new(
+            std::io::ErrorKind::NotFound,
+            format!("folder missing; {consequence}"),
+        ),
+    )
+}
+
+impl RawDrive {
+    /// Opens a drive folder and lists its Velodyne and OXTS frame files.
+    ///
+    /// Errors: `dir` does not exist or is not a folder, or a data folder cannot be listed.
+    /// Missing sensor folders are not errors here (see [`check`](Self::check)).
+    pub fn open(dir: impl AsRef<Path>) -> Result<RawDrive> {
+        let dir = dir.as_ref().to_path_buf();
+        let meta = std::fs::metadata(&dir).map_err(|e| Error::io(&dir, e))?;
+        if !meta.is_dir() {
+            return Err(Error::invalid(
+                format!("drive folder {}", dir.display()),
+                "is not a folder",
+            ));
+        }
+        let date_dir = match dir.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            Some(_) => PathBuf::from("."),
+            None => dir.clone(),
+        };
+        let velodyne = list_if_present(&dir.join("velodyne_points").join("data"), "bin")?;
+        let oxts = list_if_present(&dir.join("oxts").join("data"), "txt")?;
+        Ok(RawDrive {
+            dir,
+            date_dir,
+            velodyne,
+            oxts,
+        })
+    }
+
+    /// The drive folder.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// The folder holding the calibration files (the drive folder's parent).
+    pub fn date_dir(&self) -> &Path {
+        &self.date_dir
+    }
+
+    /// The drive folder's name, e.g. `2011_09_26_drive_0001_sync`.
+    pub fn name(&self) -> String {
+        self.dir
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default()
+    }
+
+    /// `velodyne_points/data`.
+    pub fn velodyne_dir(&self) -> PathBuf {
+        self.dir.join("velodyne_points").join("data")
+    }
+
+    /// `oxts/data`.
+    pub fn oxts_dir(&self) -> PathBuf {
+        self.dir.join("oxts").join("data")
+    }
+
+    /// `velodyne_points/timestamps.txt`.
+    pub fn velodyne_timestamps_path(&self) -> PathBuf {
+        self.dir.join("velodyne_points").join("timestamps.txt")
+    }
+
+    /// `oxts/timestamps.txt`.
+    pub fn oxts_timestamps_path(&self) -> PathBuf {
+        self.dir.join("oxts").join("timestamps.txt")
+    }
+
+    /// Whether `velodyne_points/data` exists.
+    pub fn has_velodyne(&self) -> bool {
+        self.velodyne.is_some()
+    }
+
+    /// Whether `oxts/data` exists.
+    pub fn has_oxts(&self) -> bool {
+        self.oxts.is_some()
+    }
+
+    /// Number of `.bin` files in `velodyne_points/data` (0 when the folder is missing).
+    pub fn velodyne_count(&self) -> usize {
+        self.velodyne.as_ref().map_or(0, Vec::len)
+    }
+
+    /// Number of `.txt` files in `oxts/data` (0 when the folder is missing).
+    pub fn oxts_count(&self) -> usize {
+        self.oxts.as_ref().map_or(0, Vec::len)
+    }
+
+    /// Number of frames: the Velodyne frames when `velodyne_points/data` exists, otherwise the
+    /// OXTS packets.
+    pub fn frame_count(&self) -> usize {
+        if self.has_velodyne() {
+            self.velodyne_count()
+        } else {
+            self.oxts_count()
+        }
+    }
+
+    /// Path of Velodyne frame `k` (whether or not it exists).
+    pub fn velodyne_path(&self, k: usize) -> PathBuf {
+        self.velodyne_dir().join(frame_file_name(k as u64, "bin"))
+    }
+
+    /// Reads Velodyne frame `k`; a non-finite value is an error naming the file and point.
+    pub fn velodyne(&self, k: usize) -> Result<PointCloud> {
+        self.velodyne_with(k, NonFinite::Error).map(|s| s.cloud)
+    }
+
+    /// Reads Velodyne frame `k` with a choice for non-finite points.
+    pub fn velodyne_with(&self, k: usize, policy: NonFinite) -> Result<BinScan> {
+        if !self.has_velodyne() {
+            return Err(missing_folder(
+                &self.velodyne_dir(),
+                "this drive has no Velodyne point clouds",
+            ));
+        }
+        read_kitti_bin_with(self.velodyne_path(k), policy)
+    }
+
+    /// Reads every OXTS packet, in frame order.
+    ///
+    /// Errors: `oxts/data` is missing (naming it), a file in the numbering is missing (naming
+    /// it), or a file is malformed (naming file, line and field).
+    pub fn oxts(&self) -> Result<Vec<OxtsPacket>> {
+        let files = self.oxts.as_ref().ok_or_else(|| {
+            missing_folder(
+                &self.oxts_dir(),
+                "this drive has no OXTS packets, so no poses (point clouds only)",
+            )
+        })?;
+        require_contiguous(&self.oxts_dir(), files, "txt")?;
+        files.iter().map(|(_, p)| read_oxts_file(p)).collect()
+    }
+
+    /// Velodyne time stamps (`velodyne_points/timestamps.txt`).
+    pub fn timestamps(&self) -> Result<Timestamps> {
+        read_timestamps(self.velodyne_timestamps_path())
+    }
+
+    /// OXTS time stamps (`oxts/timestamps.txt`).
+    pub fn oxts_timestamps(&self) -> Result<Timestamps> {
+        read_timestamps(self.oxts_timestamps_path())
+    }
+
+    /// The IMU→Velodyne calibration T_velo_imu (p_velo = T_velo_imu·p_imu).
+    pub fn calib_imu_to_velo(&self) -> Result<RigidCalib> {
+        read_rigid_calib(self.date_dir.join(CALIB_IMU_TO_VELO))
+    }
+
+    /// The Velodyne→camera-0 calibration T_cam0_velo (p_cam0 = T_cam0_velo·p_velo).
+    pub fn calib_velo_to_cam(&self) -> Result<RigidCalib> {
+        read_rigid_calib(self.date_dir.join(CALIB_VELO_TO_CAM))
+    }
+
+    /// `R_rect_00` and `P_rect_02` of the camera-to-camera calibration.
+    pub fn calib_cam_to_cam(&self) -> Result<CamToCamCalib> {
+        read_cam_to_cam(self.date_dir.join(CALIB_CAM_TO_CAM))
+    }
+
+    /// Fails when the drive has Velodyne frames and their number differs from the OXTS count.
+    fn ensure_counts_agree(&self, n_oxts: usize) -> Result<()> {
+        if self.has_velodyne() && self.velodyne_count() != n_oxts {
+            return Err(Issue::CountMismatch {
+                a: self.oxts_dir(),
+                a_count: n_oxts,
+                b: self.velodyne_dir(),
+                b_count: self.velodyne_count(),
+            }
+            .to_error());
+        }
+        Ok(())
+    }
+
+    /// IMU poses relative to the first packet (first = identity), one per frame; see
+    /// [`poses::imu_poses`].
+    pub fn imu_poses(&self) -> Result<Vec<Isometry3<f64>>> {
+        let packets = self.oxts()?;
+        self.ensure_counts_agree(packets.len())?;
+        poses::imu_poses(&packets)
+    }
+
+    /// Velodyne poses relative to the first Velodyne frame (first = identity), one per frame:
+    /// pose k maps Velodyne coordinates of frame k to those of frame 0.
+    ///
+    /// Errors: no OXTS folder (naming it), Velodyne and OXTS counts that disagree, a missing or
+    /// malformed `calib_imu_to_velo.txt`, or any OXTS reading error.
+    pub fn poses(&self) -> Result<Vec<Isometry3<f64>>> {
+        let imu = self.imu_poses()?;
+        let calib = self.calib_imu_to_velo()?;
+        Ok(poses::velodyne_poses(&imu, &calib.isometry))
+    }
+
+    /// Planar vehicle states [X, Ẋ, Y, Ẏ, φ, φ̇], one per frame; see [`VehicleState`].
+    pub fn vehicle_states(&self) -> Result<Vec<VehicleState>> {
+        let packets = self.oxts()?;
+        self.ensure_counts_agree(packets.len())?;
+        poses::vehicle_states(&packets)
+    }
+
+    /// Every inconsistency of the drive on disk: missing sensor folders, timestamp files or
+    /// calibration files; gaps in frame numbering; frame counts that disagree between the data
+    /// folders and their timestamp files; OXTS files or timestamp files that do not parse; stamps
+    /// that do not increase; `.bin` files whose size is not a multiple of 16 bytes.
+    /// An empty list means the drive is consistent.
+    pub fn check(&self) -> Vec<Issue> {
+        let mut issues = Vec::new();
+        let sensors: [(&str, &Option<FrameFiles>, PathBuf, PathBuf, &str); 2] = [
+            (
+                "no point clouds",
+                &self.velodyne,
+                self.velodyne_dir(),
+                self.velodyne_timestamps_path(),
+                "Velodyne frames have no time stamps",
+            ),
+            (
+                "no OXTS packets, so no poses (point clouds only)",
+                &self.oxts,
+                self.oxts_dir(),
+                self.oxts_timestamps_path(),
+                "OXTS packets have no time stamps",
+            ),
+        ];
+        for (missing_consequence, files, dir, stamps_path, stamps_consequence) in sensors {
+            let Some(files) = files else {
+                issues.push(Issue::MissingFolder {
+                    path: dir,
+                    consequence: missing_consequence.to_string(),
+                });
+                continue;
+            };
+            for (first, last) in numbering_gaps(files.iter().map(|f| f.0)) {
+                issues.push(Issue::NumberingGap {
+                    folder: dir.clone(),
+                    first_missing: first,
+                    last_missing: last,
+                });
+            }
+            if !stamps_path.exists() {
+                issues.push(Issue::MissingFile {
+                    path: stamps_path,
+                    consequence: stamps_consequence.to_string(),
+                });
+                continue;
+            }
+            match read_timestamps(&stamps_path) {
+                Err(e) => issues.push(Issue::Unreadable {
+                    path: stamps_path,
+                    error: e.to_string(),
+                }),
+                Ok(stamps) => {
+                    if stamps.len() != files.len() {
+                        issues.push(Issue::CountMismatch {
+                            a: dir.clone(),
+                            a_count: files.len(),
+                            b: stamps_path.clone(),
+                            b_count: stamps.len(),
+                        });
+                    }
+                    if let Some(i) = stamps.first_non_increasing() {
+                        issues.push(Issue::NonIncreasingTime {
+                            path: stamps_path,
+                            line: i + 1,
+                        });
+                    }
+                }
+            }
+        }
+        if let (Some(v), Some(o)) = (&self.velodyne, &self.oxts) {
+            if v.len() != o.len() {
+                issues.push(Issue::CountMismatch {
+                    a: self.velodyne_dir(),
+                    a_count: v.len(),
+                    b: self.oxts_dir(),
+                    b_count: o.len(),
+                });
+            }
+        }
+        for (_, path) in self.oxts.iter().flatten() {
+            if let Err(e) = read_oxts_file(path) {
+                issues.push(Issue::Unreadable {
+                    path: path.clone(),
+                    error: e.to_string(),
+                });
+            }
+        }
+        for (_, path) in self.velodyne.iter().flatten() {
+            match std::fs::metadata(path) {
+                Err(e) => issues.push(Issue::Unreadable {
+                    path: path.clone(),
+                    error: e.to_string(),
+                }),
+                Ok(m) if m.len() % 16 != 0 => issues.push(Issue::Unreadable {
+                    path: path.clone(),
+                    error: format!("{} bytes is not a multiple of 16", m.len()),
+                }),
+                Ok(_) => {}
+            }
+        }
+        let calib = [
+            (CALIB_IMU_TO_VELO, "no Velodyne poses"),
+            (CALIB_VELO_TO_CAM, "no Velodyne→camera transform"),
+            (CALIB_CAM_TO_CAM, "no camera rectification"),
+        ];
+        for (name, consequence) in calib {
+            let path = self.date_dir.join(name);
+            if !path.exists() {
+                issues.push(Issue::MissingFile {
+                    path,
+                    consequence: consequence.to_string(),
+                });
+            }
+        }
+        issues
+    }
+
+    /// [`check`](Self::check), stopping with the first issue as an error.
+    pub fn ensure_consistent(&self) -> Result<()> {
+        match self.check().first() {
+            None => Ok(()),
+            Some(issue) => Err(issue.to_error()),
+        }
+    }
+}

@@ -1,0 +1,120 @@
+//! Numbered frame files: KITTI stores one file per frame, named by the frame index padded to
+//! ten digits (`0000000042.bin`, `0000000042.txt`). This module lists such files in a folder,
+//! finds gaps in the numbering, and builds the names.
+//!
+//! Not for: reading the files' contents.
+
+use crate::error::{Error, Result};
+use std::path::{Path, PathBuf};
+
+/// The KITTI file name of frame `k` with extension `ext` (without the dot), e.g.
+/// `frame_file_name(42, "bin") == "0000000042.bin"`.
+pub fn frame_file_name(k: u64, ext: &str) -> String {
+    format!("{k:010}.{ext}")
+}
+
+/// The files `<digits>.<ext>` of `dir`, as (frame number, path) sorted by number.
+///
+/// Other files are ignored. Errors: the folder cannot be read ([`Error::Io`] naming it), or two
+/// files carry the same number (e.g. `5.bin` and `0000000005.bin`).
+pub fn list_frame_files(dir: &Path, ext: &str) -> Result<Vec<(u64, PathBuf)>> {
+    let entries = std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))?;
+    let mut files = Vec::new();
+    for entry in entries {
+        let entry = entry.map_err(|e| Error::io(dir, e))?;
+        let path = entry.path();
+        if path.extension().and_then(|e| e.to_str()) != Some(ext) {
+            continue;
+        }
+        let Some(stem) = path.file_stem().and_then(|s| s.to_str()) else {
+            continue;
+        };
+        if stem.is_empty() || !stem.bytes().all(|b| b.is_ascii_digit()) {
+            continue;
+        }
+        let Ok(k) = stem.parse::<u64>() else {
+            continue;
+        };
+        files.push((k, path));
+    }
+    files.sort();
+    for pair in files.windows(2) {
+        if pair[0].0 == pair[1].0 {
+            return Err(Error::parse(
+                &pair[1].1,
+                0,
+                "file name",
+                format!("frame {} also stored as {}", pair[0].0, pair[0].1.display()),
+            ));
+        }
+    }
+    Ok(files)
+}
+
+/// Frame numbers missing from `0..=max` in a sorted list of frame numbers, as inclusive ranges.
+pub fn numbering_gaps(numbers: impl IntoIterator<Item = u64>) -> Vec<(u64, u64)> {
+    let mut gaps = Vec::new();
+    let mut next = 0u64;
+    for k in numbers {
+        if k > next {
+            gaps.push((next, k - 1));
+        }
+        next = next.max(k + 1);
+    }
+    gaps
+}
+
+/// Fails naming the first missing file when the numbering of `files` is not `0, 1, 2, ...`.
+pub(crate) fn require_contiguous(dir: &Path, files: &[(u64, PathBuf)], ext: &str) -> Result<()> {
+    if let Some(&(first, last)) = numbering_gaps(files.iter().map(|f| f.0)).first() {
+        let missing = dir.join(frame_file_name(first, ext));
+        let reason = if first == last {
+            "missing (frame numbering has a gap)".to_string()
+        } else {
+            format!("missing, up to frame {last} (frame numbering has a gap)")
+        };
+        return Err(Error::parse(missing, 0, "file", reason));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_ten_digits() {
+        assert_eq!(frame_file_name(42, "bin"), "0000000042.bin");
+    }
+
+    #[test]
+    fn gaps_are_ranges() {
+        assert!(numbering_gaps([0, 1, 2]).is_empty());
+        assert_eq!(numbering_gaps([0, 3, 4, 6]), vec![(1, 2), (5, 5)]);
+        assert_eq!(numbering_gaps([2]), vec![(0, 1)]);
+    }
+
+    #[test]
+    fn listing_sorts_ignores_and_detects_duplicates() {
+        let dir = tempfile::tempdir().unwrap();
+        for n in [
+            "0000000002.txt",
+            "0000000000.txt",
+            "notes.txt",
+            "0000000001.bin",
+        ] {
+            std::fs::write(dir.path().join(n), "").unwrap();
+        }
+        let files = list_frame_files(dir.path(), "txt").unwrap();
+        assert_eq!(files.iter().map(|f| f.0).collect::<Vec<_>>(), vec![0, 2]);
+        let msg = require_contiguous(dir.path(), &files, "txt")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            msg.contains("0000000001.txt") && msg.contains("missing"),
+            "{msg}"
+        );
+        std::fs::write(dir.path().join("2.txt"), "").unwrap();
+        assert!(list_frame_files(dir.path(), "txt").is_err());
+    }
+}
