@@ -21,7 +21,6 @@
 use crate::error::{Error, Result};
 use crate::filter::Estimate;
 use serde::{Deserialize, Serialize};
-use std::io::Write;
 use std::path::Path;
 
 /// One frame of a detections (or truth) file.
@@ -321,37 +320,6 @@ fn parse_csv(
     Ok(frames)
 }
 
-/// Writes `bytes` to `path` atomically: a temporary file in the same folder, renamed into
-/// place once complete, so a reader never sees half a file.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path.file_name().ok_or_else(|| {
-        Error::invalid(
-            "output path",
-            format!("{} has no file name", path.display()),
-        )
-    })?;
-    let tmp = dir.join(format!(
-        ".{}.tmp{}",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(Error::io(path, e));
-    }
-    Ok(())
-}
-
 /// Writes estimates as JSON or CSV (by extension), atomically.
 pub fn write_estimates(path: &Path, frames: &[EstimateFrame]) -> Result<()> {
     let bytes = match extension(path).as_str() {
@@ -396,7 +364,7 @@ pub fn write_estimates(path: &Path, frames: &[EstimateFrame]) -> Result<()> {
             ))
         }
     };
-    write_atomic(path, &bytes)
+    crate::atomic::write_bytes(path, &bytes)
 }
 
 #[cfg(test)]

@@ -5,6 +5,7 @@
 #![warn(missing_docs)]
 
 pub mod assignment;
+pub mod atomic;
 pub mod cloud;
 pub mod config;
 pub mod detections;

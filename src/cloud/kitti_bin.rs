@@ -7,8 +7,8 @@
 //!
 //! Not for: other point-cloud formats, or finding the files of a drive (see [`crate::kitti`]).
 
-use super::atomic::write_atomically;
 use super::points::PointCloud;
+use crate::atomic::write_atomically;
 use crate::error::{Error, Result};
 use memmap2::Mmap;
 use std::borrow::Cow;

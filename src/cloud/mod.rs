@@ -4,10 +4,8 @@
 //! Not for: finding the frames of a recording (see [`crate::kitti`]) or detecting objects in
 //! the points.
 
-mod atomic;
 pub mod kitti_bin;
 pub mod points;
 
-pub(crate) use atomic::write_atomically;
 pub use kitti_bin::{read_kitti_bin, read_kitti_bin_with, write_kitti_bin, BinScan, NonFinite};
 pub use points::{Bounds, Point, PointCloud};

@@ -7,7 +7,7 @@
 
 use super::frames::{frame_file_name, list_frame_files, require_contiguous};
 use super::text::{numbered_lines, parse_f64, read_text};
-use crate::cloud::write_atomically;
+use crate::atomic::write_atomically;
 use crate::error::{Error, Result};
 use std::io::Write;
 use std::path::Path;

@@ -7,7 +7,7 @@
 //! stamps). Not for: time zones or time-of-week GPS time.
 
 use super::text::{numbered_lines, read_text};
-use crate::cloud::write_atomically;
+use crate::atomic::write_atomically;
 use crate::error::{Error, Result};
 use std::fmt;
 use std::io::Write;

@@ -23,7 +23,7 @@
 //!
 //! Not for: the tracking benchmark's `label_02` text files, or image-space boxes.
 
-use crate::cloud::write_atomically;
+use crate::atomic::write_atomically;
 use crate::error::{Error, Result};
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use quick_xml::events::Event;

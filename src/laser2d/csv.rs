@@ -72,7 +72,7 @@ pub fn write_scan_csv(path: impl AsRef<Path>, scans: &[Scan]) -> Result<()> {
         }
         text.push('\n');
     }
-    crate::detections::write_atomic(path.as_ref(), text.as_bytes())
+    crate::atomic::write_bytes(path.as_ref(), text.as_bytes())
 }
 
 /// Reads a laser2d csv v1 file. Every problem is an [`Error::Parse`] naming the line and

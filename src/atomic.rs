@@ -35,7 +35,7 @@ fn temp_path(path: &Path) -> Result<PathBuf> {
 
 /// Writes a file atomically: `fill` writes the content into a buffered temporary file which then
 /// replaces `path`. On any failure the temporary file is removed and `path` is left untouched.
-pub(crate) fn write_atomically(
+pub fn write_atomically(
     path: &Path,
     fill: impl FnOnce(&mut BufWriter<fs::File>) -> std::io::Result<()>,
 ) -> Result<()> {
@@ -56,6 +56,11 @@ pub(crate) fn write_atomically(
         return Err(Error::io(path, e));
     }
     Ok(())
+}
+
+/// Writes `bytes` to `path` atomically (see [`write_atomically`]).
+pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_atomically(path, |w| std::io::Write::write_all(w, bytes))
 }
 
 #[cfg(test)]
