@@ -15,7 +15,7 @@ use smc_lmb::filter::{
 use smc_lmb::metrics::{cardinality_error, gospa, ospa};
 use smc_lmb::models::MeasurementModel;
 use smc_lmb::rng::seeded;
-use smc_lmb::sim::Scenario;
+use smc_lmb::sim::{DynamicsSpec, Scenario};
 use std::time::Instant;
 
 #[derive(Parser, Debug)]
@@ -42,6 +42,10 @@ struct Args {
     /// Resample when the effective sample size falls below this fraction of the particles.
     #[arg(long, default_value_t = 0.5)]
     resample_threshold: f64,
+    /// Acceleration noise of the filter's motion model (m/s²); default: the scenario's
+    /// reference value (5). The truth is generated without noise either way.
+    #[arg(long)]
+    sigma_accel: Option<f64>,
     /// Print one JSON object instead of tables.
     #[arg(long)]
     json: bool,
@@ -133,11 +137,17 @@ fn median(v: &[f64]) -> f64 {
 
 fn main() -> Result<()> {
     let args = Args::parse();
-    let scenario = match args.scenario.as_str() {
+    let mut scenario = match args.scenario.as_str() {
         "linear" => Scenario::linear(),
         "nonlinear" => Scenario::nonlinear(),
         other => anyhow::bail!("unknown scenario `{other}` (expected linear or nonlinear)"),
     };
+    if let Some(s) = args.sigma_accel {
+        match &mut scenario.dynamics {
+            DynamicsSpec::ConstantVelocity { sigma_accel } => *sigma_accel = s,
+            DynamicsSpec::CoordinatedTurn { sigma_vel, .. } => *sigma_vel = s,
+        }
+    }
     let associator: AssociationMethod = args
         .associator
         .parse()
@@ -180,6 +190,10 @@ fn main() -> Result<()> {
         "seed": args.seed,
         "associator": args.associator,
         "particles": args.particles,
+        "sigma_accel": match scenario.dynamics {
+            DynamicsSpec::ConstantVelocity { sigma_accel } => sigma_accel,
+            DynamicsSpec::CoordinatedTurn { sigma_vel, .. } => sigma_vel,
+        },
         "threads": rayon::current_num_threads(),
         "mean_ospa": mean(&ospa_k),
         "mean_gospa": mean(&gospa_k),
