@@ -1,7 +1,4 @@
-//! # smc-lmb
-//!
-//! Multi-object tracking with a labelled multi-Bernoulli (LMB) filter whose single-object
-//! densities are particle sets.
+#![doc = include_str!("../README.md")]
 #![warn(missing_docs)]
 
 pub mod assignment;
