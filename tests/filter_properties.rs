@@ -1,0 +1,74 @@
+//! Invariants of the recursion under arbitrary frames: existence probabilities stay in [0, 1],
+//! labels stay unique, weights stay normalised, particle sets never empty, and estimates are
+//! drawn from the tracks.
+
+use proptest::prelude::*;
+use smc_lmb::filter::{
+    AdaptiveBirth, AssociationMethod, Frame, LmbConfig, LmbFilter, Measurements,
+    PositionBirthSampler,
+};
+use smc_lmb::models::{ConstantDetection, ConstantVelocity, PositionMeasurement, UniformClutter};
+use smc_lmb::rng::seeded;
+use std::collections::HashSet;
+
+fn filter(assoc: AssociationMethod, pd: f64) -> LmbFilter {
+    LmbFilter::builder()
+        .transition(ConstantVelocity::new(2, 1.0).unwrap())
+        .measurement(PositionMeasurement::new(2, 1.0).unwrap())
+        .detection(ConstantDetection(pd))
+        .clutter(UniformClutter::rectangle(2.0, [-50.0, 50.0], [-50.0, 50.0]).unwrap())
+        .birth(
+            AdaptiveBirth::new(
+                PositionBirthSampler {
+                    position_std: 1.0,
+                    velocity_std: 2.0,
+                },
+                0.5,
+                0.3,
+                64,
+            )
+            .unwrap(),
+        )
+        .associator(assoc)
+        .config(LmbConfig {
+            particles: 64,
+            max_tracks: 12,
+            ..LmbConfig::default()
+        })
+        .build()
+        .unwrap()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 32, ..ProptestConfig::default() })]
+    #[test]
+    fn recursion_keeps_its_invariants(
+        frames in proptest::collection::vec(proptest::collection::vec((-60.0f64..60.0, -60.0f64..60.0), 0..12), 1..10),
+        method in 0usize..3,
+        pd in prop_oneof![Just(1.0), 0.05f64..0.99],
+        seed in 0u64..1000,
+    ) {
+        let assoc = ["lbp", "murty:20", "gibbs:50"][method].parse().unwrap();
+        let mut f = filter(assoc, pd);
+        let mut rng = seeded(seed);
+        for (k, zs) in frames.iter().enumerate() {
+            let rows: Vec<[f64; 2]> = zs.iter().map(|&(x, y)| [x, y]).collect();
+            let est = f.step(&Frame::new(k as f64 * 0.5, Measurements::from_rows(2, &rows).unwrap()), &mut rng).unwrap();
+            let tracks = f.tracks();
+            prop_assert!(tracks.len() <= 12);
+            let labels: HashSet<_> = tracks.iter().map(|t| t.label).collect();
+            prop_assert_eq!(labels.len(), tracks.len(), "labels unique");
+            for t in tracks {
+                prop_assert!((0.0..=1.0).contains(&t.existence), "r = {}", t.existence);
+                prop_assert_eq!(t.particles.len(), 64);
+                let s: f64 = t.particles.weights().iter().sum();
+                prop_assert!((s - 1.0).abs() < 1e-9);
+                prop_assert!(t.particles.component(0).iter().all(|x| x.is_finite()));
+            }
+            for e in &est {
+                prop_assert!(labels.contains(&e.label));
+                prop_assert!(e.state.iter().all(|x| x.is_finite()));
+            }
+        }
+    }
+}
