@@ -76,7 +76,7 @@ fn run_once(
         .detection(models.detection)
         .clutter(models.clutter)
         .birth(StaticBirth::new(terms, particles)?)
-        .associator(associator.clone())
+        .associator(*associator)
         .config(config.clone())
         .build()?;
     let mut rng = seeded(seed ^ 0x5EED);

@@ -201,7 +201,7 @@ impl RunConfig {
         let builder = LmbFilter::builder()
             .survival(ConstantSurvival::new(self.survival)?)
             .config(self.filter.clone())
-            .associator(self.association.clone())
+            .associator(self.association)
             .clutter(UniformClutter::new(self.clutter.rate, self.clutter.volume)?);
         let builder = match self.transition {
             TransitionConfig::ConstantVelocity { dims, sigma_accel } => {

@@ -79,11 +79,7 @@ impl Measurements {
 
     /// Number of measurements.
     pub fn len(&self) -> usize {
-        if self.dim == 0 {
-            0
-        } else {
-            self.data.len() / self.dim
-        }
+        self.data.len().checked_div(self.dim).unwrap_or(0)
     }
 
     /// True when the frame has no measurement.

@@ -309,6 +309,7 @@ impl ParticleSet {
     }
 
     /// Resamples to `n` particles and applies `jitter`.
+    #[allow(clippy::needless_range_loop)] // `c` selects a component and its spread alike
     pub fn resample(&mut self, n: usize, jitter: Jitter, rng: &mut FilterRng) {
         let sigma_before = match jitter {
             Jitter::Regularised { .. } => self.std_dev(),
