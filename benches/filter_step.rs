@@ -12,9 +12,7 @@ use smc_lmb::filter::{
     BirthModel, BirthTrack, Frame, LmbConfig, LmbFilter, Measurements, StaticBirth,
 };
 use smc_lmb::models::StepContext;
-use smc_lmb::models::{
-    ConstantDetection, ConstantVelocity, MeasurementModel, PositionMeasurement, UniformClutter,
-};
+use smc_lmb::models::{ConstantDetection, ConstantVelocity, PositionMeasurement, UniformClutter};
 use smc_lmb::rng::seeded;
 use smc_lmb::sim::Scenario;
 use smc_lmb::FilterRng;
@@ -114,25 +112,15 @@ fn rfs(c: &mut Criterion) {
         g.throughput(Throughput::Elements(scenario.steps as u64));
         g.bench_function(format!("{name}/whole_run_{particles}_particles"), |b| {
             b.iter(|| {
-                let m = scenario.models().unwrap();
-                let dim = m.measurement.measurement_dim();
-                let mut f = LmbFilter::builder()
-                    .transition(m.transition)
-                    .survival(m.survival)
-                    .measurement(m.measurement)
-                    .detection(m.detection)
-                    .clutter(m.clutter)
-                    .birth(StaticBirth::new(scenario.birth.clone(), particles).unwrap())
-                    .config(LmbConfig {
-                        particles,
-                        ..LmbConfig::default()
-                    })
-                    .build()
-                    .unwrap();
+                let config = LmbConfig {
+                    particles,
+                    ..LmbConfig::default()
+                };
+                let mut f = scenario.filter(config, Default::default()).unwrap();
                 let mut rng = seeded(3);
                 for (k, z) in sim.measurements.iter().enumerate() {
                     f.step(
-                        &Frame::new(k as f64, Measurements::from_rows(dim, z).unwrap()),
+                        &Frame::new(k as f64, Measurements::from_rows(2, z).unwrap()),
                         &mut rng,
                     )
                     .unwrap();

@@ -9,11 +9,8 @@
 
 use anyhow::{Context, Result};
 use clap::Parser;
-use smc_lmb::filter::{
-    AssociationMethod, Frame, Jitter, LmbConfig, LmbFilter, Measurements, StaticBirth,
-};
+use smc_lmb::filter::{AssociationMethod, Frame, Jitter, LmbConfig, Measurements};
 use smc_lmb::metrics::{cardinality_error, gospa, ospa};
-use smc_lmb::models::MeasurementModel;
 use smc_lmb::rng::seeded;
 use smc_lmb::sim::{DynamicsSpec, Scenario};
 use std::time::Instant;
@@ -64,21 +61,8 @@ fn run_once(
     config: &LmbConfig,
     seed: u64,
 ) -> Result<RunResult> {
-    let particles = config.particles;
     let sim = scenario.generate(seed)?;
-    let models = scenario.models()?;
-    let terms = scenario.birth.clone();
-    let dim = models.measurement.measurement_dim();
-    let mut filter = LmbFilter::builder()
-        .transition(models.transition)
-        .survival(models.survival)
-        .measurement(models.measurement)
-        .detection(models.detection)
-        .clutter(models.clutter)
-        .birth(StaticBirth::new(terms, particles)?)
-        .associator(*associator)
-        .config(config.clone())
-        .build()?;
+    let mut filter = scenario.filter(config.clone(), *associator)?;
     let mut rng = seeded(seed ^ 0x5EED);
     let (c, p) = (scenario.ospa_cutoff, scenario.ospa_order);
     let mut out = RunResult {
@@ -88,7 +72,7 @@ fn run_once(
         ms: vec![],
     };
     for (k, z) in sim.measurements.iter().enumerate() {
-        let frame = Frame::new(k as f64 * scenario.period, Measurements::from_rows(dim, z)?);
+        let frame = Frame::new(k as f64 * scenario.period, Measurements::from_rows(2, z)?);
         let t0 = Instant::now();
         let est = filter.step(&frame, &mut rng)?;
         out.ms.push(t0.elapsed().as_secs_f64() * 1e3);

@@ -4,9 +4,8 @@
 //! Bounds leave room for a single run's spread; the example `rfs_benchmark` measures the means
 //! over many runs.
 
-use smc_lmb::filter::{AssociationMethod, Frame, LmbConfig, LmbFilter, Measurements, StaticBirth};
+use smc_lmb::filter::{AssociationMethod, Frame, LmbConfig, Measurements};
 use smc_lmb::metrics::ospa;
-use smc_lmb::models::MeasurementModel;
 use smc_lmb::rng::seeded;
 use smc_lmb::sim::Scenario;
 
@@ -17,28 +16,21 @@ fn mean_ospa(
     associator: AssociationMethod,
 ) -> f64 {
     let sim = scenario.generate(seed).unwrap();
-    let m = scenario.models().unwrap();
-    let dim = m.measurement.measurement_dim();
-    let mut filter = LmbFilter::builder()
-        .transition(m.transition)
-        .survival(m.survival)
-        .measurement(m.measurement)
-        .detection(m.detection)
-        .clutter(m.clutter)
-        .birth(StaticBirth::new(scenario.birth.clone(), particles).unwrap())
-        .associator(associator)
-        .config(LmbConfig {
-            particles,
-            ..LmbConfig::default()
-        })
-        .build()
+    let mut filter = scenario
+        .filter(
+            LmbConfig {
+                particles,
+                ..LmbConfig::default()
+            },
+            associator,
+        )
         .unwrap();
     let mut rng = seeded(seed + 100);
     let mut total = 0.0;
     for (k, z) in sim.measurements.iter().enumerate() {
         let est = filter
             .step(
-                &Frame::new(k as f64, Measurements::from_rows(dim, z).unwrap()),
+                &Frame::new(k as f64, Measurements::from_rows(2, z).unwrap()),
                 &mut rng,
             )
             .unwrap();

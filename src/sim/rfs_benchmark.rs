@@ -19,7 +19,7 @@
 //! Not for: running a filter or scoring it (see [`crate::filter`] and [`crate::metrics`]).
 
 use crate::error::{ensure_finite, Error, Result};
-use crate::filter::BirthTerm;
+use crate::filter::{AssociationMethod, BirthTerm, LmbConfig, LmbFilter, StaticBirth};
 use crate::models::{
     wrap_angle, BearingConvention, ClutterModel, ConstantDetection, ConstantSurvival,
     ConstantVelocity, CoordinatedTurn, DetectionModel, GaussianRangeDetection, MeasurementModel,
@@ -626,6 +626,23 @@ impl Scenario {
             measurements,
             origins,
         })
+    }
+
+    /// The particle LMB filter the scenario prescribes: its [`models`](Self::models), the birth
+    /// terms as a static birth sampled with `config.particles` particles each, the given tuning
+    /// and association method.
+    pub fn filter(&self, config: LmbConfig, associator: AssociationMethod) -> Result<LmbFilter> {
+        let m = self.models()?;
+        LmbFilter::builder()
+            .transition(m.transition)
+            .survival(m.survival)
+            .measurement(m.measurement)
+            .detection(m.detection)
+            .clutter(m.clutter)
+            .birth(StaticBirth::new(self.birth.clone(), config.particles)?)
+            .associator(associator)
+            .config(config)
+            .build()
     }
 
     /// The library's models configured as the scenario describes (the filter side).
