@@ -129,10 +129,11 @@ impl RobotSpec {
             ));
         }
         for (i, l) in self.legs.iter().enumerate() {
-            if !(l.duration.is_finite() && l.duration >= 0.0)
-                || !l.speed.is_finite()
-                || !l.turn_rate.is_finite()
-            {
+            let ok = l.duration.is_finite()
+                && l.duration >= 0.0
+                && l.speed.is_finite()
+                && l.turn_rate.is_finite();
+            if !ok {
                 return Err(Error::invalid(
                     format!("robot leg {i}"),
                     format!("{l:?} (duration must be finite and ≥ 0, speed and turn rate finite)"),
@@ -216,9 +217,10 @@ impl PersonSpec {
             }
         }
         for (i, l) in self.legs.iter().enumerate() {
-            if !(l.duration.is_finite() && l.duration >= 0.0)
-                || !l.velocity.iter().all(|v| v.is_finite())
-            {
+            let ok = l.duration.is_finite()
+                && l.duration >= 0.0
+                && l.velocity.iter().all(|v| v.is_finite());
+            if !ok {
                 return Err(Error::invalid(
                     format!("person {} leg {i}", self.id),
                     format!("{l:?} (duration must be finite and ≥ 0, velocity finite)"),
