@@ -5,10 +5,19 @@
 //! targets and range-bearing measurements) as plain data, a seeded generator of noiseless
 //! truth and noisy, cluttered measurements, and the matching filter-side models.
 //!
+//! [`people2d`] simulates walking people (discs) seen by a planar laser scanner on a moving
+//! robot, in the two scenarios of the ML-RANSAC paper, with exact ray casting, noisy
+//! odometry and per-scan ground truth and visibility.
+//!
 //! Not for: reading recorded data sets or scoring estimates (see [`crate::metrics`]).
 
+pub mod people2d;
 pub mod rfs_benchmark;
 
+pub use people2d::{
+    OdometryNoise, People2dRun, PeopleScenario, PersonLeg, PersonSpec, RobotLeg, RobotSpec,
+    ScannerSpec,
+};
 pub use rfs_benchmark::{
     ClutterSpec, DetectionSpec, DynamicsSpec, Scenario, ScenarioModels, SensorSpec, SimRun,
     TargetSpec, Truth,
