@@ -213,3 +213,6 @@ impl<T: ClutterModel + ?Sized> ClutterModel for Box<T> {
         (**self).log_intensity(z, ctx)
     }
 }
+
+pub mod ect;
+pub use ect::ExtendedConstantTurn;
