@@ -216,3 +216,5 @@ impl<T: ClutterModel + ?Sized> ClutterModel for Box<T> {
 
 pub mod ect;
 pub use ect::ExtendedConstantTurn;
+pub mod plane;
+pub use plane::{EgoSource, PlaneMeasurement, PlaneTransition};
