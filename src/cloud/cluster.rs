@@ -230,9 +230,9 @@ mod tests {
             }
         }
         let mut groups: std::collections::BTreeMap<usize, Vec<u32>> = Default::default();
-        for a in 0..n {
+        for (a, &idx) in subset.iter().enumerate() {
             let r = find(&mut parent, a);
-            groups.entry(r).or_default().push(subset[a]);
+            groups.entry(r).or_default().push(idx);
         }
         let mut out: Vec<Vec<u32>> = groups.into_values().collect();
         for g in &mut out {

@@ -413,7 +413,7 @@ impl MeasurementModel for PlaneMeasurement {
         }
         let m = &track.mean;
         let mean_norm = (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt();
-        if !(mean_norm > 1e-9) {
+        if mean_norm.is_nan() || mean_norm <= 1e-9 {
             return true;
         }
         let (angle, dd) = plane_residual(&[z[0], z[1], z[2], z[3]], &[m[0], m[1], m[2], m[3]]);
