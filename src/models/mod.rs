@@ -213,3 +213,8 @@ impl<T: ClutterModel + ?Sized> ClutterModel for Box<T> {
         (**self).log_intensity(z, ctx)
     }
 }
+
+pub mod ect;
+pub use ect::ExtendedConstantTurn;
+pub mod plane;
+pub use plane::{EgoSource, PlaneMeasurement, PlaneTransition};
