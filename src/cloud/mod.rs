@@ -5,6 +5,7 @@
 //! the points.
 
 pub mod kitti_bin;
+pub mod planes;
 pub mod points;
 
 pub use kitti_bin::{read_kitti_bin, read_kitti_bin_with, write_kitti_bin, BinScan, NonFinite};
