@@ -19,6 +19,12 @@
 //! 5. the inliers leave the pool. Rounds stop when fewer than `min_points` inliers are found
 //!    or `max_planes` rounds have run.
 //!
+//! Once a near-horizontal plane below the sensor has been extracted, later rounds look for
+//! walls only: hypotheses are drawn from points more than `ground_clearance` above that plane
+//! and only those within `max_wall_tilt` of vertical are kept (a real road is not one flat
+//! plane, and its residual slabs would otherwise win every round). Points near the ground stay
+//! available as inliers of later planes.
+//!
 //! Each extracted plane is then classified. Near-horizontal planes below the sensor are
 //! ground candidates (the one with most inliers becomes the ground and is not split). Other
 //! planes are split into spatially connected pieces (flood fill on a 2-D grid of
@@ -77,6 +83,9 @@ pub struct PlaneConfig {
     pub max_ground_tilt: f64,
     /// Ground: the plane must lie at least this far below the sensor origin (m).
     pub min_ground_depth: f64,
+    /// After the ground is found, hypotheses are drawn only from points more than this far
+    /// above it (m); the points themselves stay available as inliers.
+    pub ground_clearance: f64,
     /// Walls: maximum angle between the normal and the horizontal plane (rad).
     pub max_wall_tilt: f64,
     /// Walls: minimum patch area (m²).
@@ -106,6 +115,7 @@ impl Default for PlaneConfig {
             max_threshold: 0.20,
             max_ground_tilt: 10f64.to_radians(),
             min_ground_depth: 0.5,
+            ground_clearance: 0.3,
             max_wall_tilt: 15f64.to_radians(),
             min_wall_area: 15.0,
             min_wall_length: 4.0,
@@ -137,6 +147,7 @@ impl PlaneConfig {
         let non_negative = [
             ("max_ground_tilt", self.max_ground_tilt),
             ("min_ground_depth", self.min_ground_depth),
+            ("ground_clearance", self.ground_clearance),
             ("max_wall_tilt", self.max_wall_tilt),
             ("min_wall_area", self.min_wall_area),
             ("min_wall_length", self.min_wall_length),
@@ -248,6 +259,10 @@ impl PlaneF32 {
         }
     }
     #[inline]
+    fn residual_signed(&self, p: &[f32; 3]) -> f32 {
+        self.n[0] * p[0] + self.n[1] * p[1] + self.n[2] * p[2] + self.d
+    }
+    #[inline]
     fn residual(&self, p: &[f32; 3]) -> f32 {
         (self.n[0] * p[0] + self.n[1] * p[1] + self.n[2] * p[2] + self.d).abs()
     }
@@ -284,13 +299,40 @@ pub fn extract_planes(
     let mut active: Vec<u32> = (0..pts.len() as u32).collect();
     // Extracted planes: (final plane, local inlier indices).
     let mut extracted: Vec<(Plane, Vec<u32>)> = Vec::new();
+    let ground_like = |p: &Plane| {
+        p.tilt() <= config.max_ground_tilt
+            && p.normal.z > 0.0
+            && p.offset >= config.min_ground_depth
+    };
+    let mut first_ground: Option<PlaneF32> = None;
     for _ in 0..config.max_planes {
         if active.len() < config.min_points {
             break;
         }
-        let Some((plane, inliers)) = one_round(&pts, &active, config, rng) else {
+        // Once a ground plane is out, the search is for walls: hypotheses are drawn only from
+        // points clearly above that plane and only near-vertical ones are kept.
+        let pool: Vec<u32> = match &first_ground {
+            Some(g) => active
+                .iter()
+                .copied()
+                .filter(|&i| g.residual_signed(&pts[i as usize]) > config.ground_clearance as f32)
+                .collect(),
+            None => active.clone(),
+        };
+        let min_tilt = if first_ground.is_some() {
+            std::f64::consts::FRAC_PI_2 - config.max_wall_tilt
+        } else {
+            0.0
+        };
+        if pool.len() < config.min_points {
+            break;
+        }
+        let Some((plane, inliers)) = one_round(&pts, &active, &pool, min_tilt, config, rng) else {
             break;
         };
+        if first_ground.is_none() && ground_like(&plane) {
+            first_ground = Some(PlaneF32::new(&plane));
+        }
         let mut is_inlier = vec![false; pts.len()];
         for &i in &inliers {
             is_inlier[i as usize] = true;
@@ -300,11 +342,6 @@ pub fn extract_planes(
     }
 
     // Ground: most inliers among near-horizontal planes below the sensor.
-    let ground_like = |p: &Plane| {
-        p.tilt() <= config.max_ground_tilt
-            && p.normal.z > 0.0
-            && p.offset >= config.min_ground_depth
-    };
     let ground_idx = extracted
         .iter()
         .enumerate()
@@ -444,16 +481,18 @@ fn rms(plane: &Plane, points: &[Point3<f64>]) -> f64 {
 fn one_round(
     pts: &[[f32; 3]],
     active: &[u32],
+    pool: &[u32],
+    min_tilt: f64,
     config: &PlaneConfig,
     rng: &mut FilterRng,
 ) -> Option<(Plane, Vec<u32>)> {
     // 1. Subsample (with replacement when the pool is small) and voxel grid.
-    let m = config.score_sample.min(active.len());
-    let sample: Vec<[f32; 3]> = if m == active.len() {
-        active.iter().map(|&i| pts[i as usize]).collect()
+    let m = config.score_sample.min(pool.len());
+    let sample: Vec<[f32; 3]> = if m == pool.len() {
+        pool.iter().map(|&i| pts[i as usize]).collect()
     } else {
         (0..m)
-            .map(|_| pts[active[rng.random_range(0..active.len())] as usize])
+            .map(|_| pts[pool[rng.random_range(0..pool.len())] as usize])
             .collect()
     };
     let inv = 1.0 / config.sample_cell as f32;
@@ -491,7 +530,9 @@ fn one_round(
             continue;
         }
         if let Ok(p) = Plane::from_point_normal(&Point3::from(pa), n) {
-            hyps.push(PlaneF32::new(&p));
+            if p.tilt() >= min_tilt {
+                hyps.push(PlaneF32::new(&p));
+            }
         }
     }
     if hyps.is_empty() {
@@ -510,7 +551,7 @@ fn one_round(
         .max_by(|a, b| a.1.cmp(b.1).then(b.0.cmp(&a.0)))
         .map(|(i, s)| (i, *s))?;
     // Expected support in the whole pool far below min_points: stop early.
-    let expected = best_score as f64 * active.len() as f64 / m as f64;
+    let expected = best_score as f64 * pool.len() as f64 / m as f64;
     if expected < 0.5 * config.min_points as f64 {
         return None;
     }
