@@ -31,7 +31,7 @@ fn segment(path: &Path) -> (usize, PlaneSegmentation) {
     );
     for w in &seg.walls {
         println!(
-            "  wall: n = [{:.3}, {:.3}, {:.3}], d = {:.2} m, area = {:.1} m², extent = ({:.1}, {:.1}) m, {} points, rms {:.3} m",
+            "  wall: n = [{:.3}, {:.3}, {:.3}], d = {:.2} m, area = {:.1} m², extent = ({:.1}, {:.1}) m, {} points, rms {:.3} m, centre {:.1?}",
             w.patch.plane.normal.x,
             w.patch.plane.normal.y,
             w.patch.plane.normal.z,
@@ -40,7 +40,8 @@ fn segment(path: &Path) -> (usize, PlaneSegmentation) {
             w.patch.extent.0,
             w.patch.extent.1,
             w.inliers.len(),
-            w.rms
+            w.rms,
+            w.patch.centre().coords.as_slice()
         );
     }
     for r in &seg.rejected {
