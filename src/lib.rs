@@ -8,6 +8,7 @@ pub mod config;
 pub mod detections;
 pub mod error;
 pub mod filter;
+pub mod geometry;
 pub mod kitti;
 pub mod laser2d;
 pub mod metrics;

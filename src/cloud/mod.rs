@@ -7,6 +7,7 @@
 
 pub mod cluster;
 pub mod kitti_bin;
+pub mod planes;
 pub mod points;
 
 pub use cluster::{euclidean_clusters, euclidean_clusters_of, Cluster, ClusterParams};
