@@ -88,7 +88,7 @@ pub fn decode_kitti_bin(
 }
 
 fn check_size(path: &Path, size: u64) -> Result<()> {
-    if size % BYTES_PER_POINT as u64 != 0 {
+    if !size.is_multiple_of(BYTES_PER_POINT as u64) {
         return Err(Error::parse(
             path,
             0,
