@@ -84,3 +84,36 @@ pub fn ensure_finite(what: &str, values: &[f64]) -> Result<()> {
         )),
     }
 }
+
+/// Checks a parameter that must be finite and > 0.
+pub fn ensure_positive(what: &str, v: f64) -> Result<()> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            what,
+            format!("{v} (must be finite and positive)"),
+        ))
+    }
+}
+
+/// Checks a parameter that must be finite and ≥ 0.
+pub fn ensure_non_negative(what: &str, v: f64) -> Result<()> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            what,
+            format!("{v} (must be finite and non-negative)"),
+        ))
+    }
+}
+
+/// Checks a probability (in [0, 1]; NaN fails).
+pub fn ensure_probability(what: &str, p: f64) -> Result<()> {
+    if (0.0..=1.0).contains(&p) {
+        Ok(())
+    } else {
+        Err(Error::invalid(what, format!("{p} (must lie in [0, 1])")))
+    }
+}

@@ -7,27 +7,8 @@
 
 use super::survival::clamp_probability;
 use super::{DetectionModel, StepContext};
-use crate::error::{Error, Result};
+use crate::error::{ensure_positive, ensure_probability, Result};
 use crate::filter::ParticleSet;
-
-fn check_probability(what: &str, p: f64) -> Result<()> {
-    if (0.0..=1.0).contains(&p) {
-        Ok(())
-    } else {
-        Err(Error::invalid(what, format!("{p} (must lie in [0, 1])")))
-    }
-}
-
-fn check_positive(what: &str, v: f64) -> Result<()> {
-    if v.is_finite() && v > 0.0 {
-        Ok(())
-    } else {
-        Err(Error::invalid(
-            what,
-            format!("{v} (must be finite and positive)"),
-        ))
-    }
-}
 
 /// p_D(x) = `self.0` everywhere.
 ///
@@ -39,7 +20,7 @@ pub struct ConstantDetection(pub f64);
 impl ConstantDetection {
     /// A detection probability `p` in [0, 1].
     pub fn new(p: f64) -> Result<Self> {
-        check_probability("detection probability", p)?;
+        ensure_probability("detection probability", p)?;
         Ok(ConstantDetection(p))
     }
 
@@ -70,8 +51,8 @@ pub struct GaussianRangeDetection {
 impl GaussianRangeDetection {
     /// Peak probability `peak` ∈ [0, 1] at `center`, length scale `scale` > 0.
     pub fn new(peak: f64, scale: f64, center: [f64; 2]) -> Result<Self> {
-        check_probability("detection peak", peak)?;
-        check_positive("detection scale", scale)?;
+        ensure_probability("detection peak", peak)?;
+        ensure_positive("detection scale", scale)?;
         crate::error::ensure_finite("detection centre", &center)?;
         Ok(GaussianRangeDetection {
             peak,
@@ -147,10 +128,10 @@ impl FieldOfViewDetection {
     /// A sector of radius `max_range` > 0 and half opening `half_angle` > 0 (radians), with
     /// probabilities `p_inside` and `p_outside` in [0, 1]; no mounting offset.
     pub fn new(p_inside: f64, p_outside: f64, max_range: f64, half_angle: f64) -> Result<Self> {
-        check_probability("detection probability inside the field of view", p_inside)?;
-        check_probability("detection probability outside the field of view", p_outside)?;
-        check_positive("field-of-view range", max_range)?;
-        check_positive("field-of-view half angle", half_angle)?;
+        ensure_probability("detection probability inside the field of view", p_inside)?;
+        ensure_probability("detection probability outside the field of view", p_outside)?;
+        ensure_positive("field-of-view range", max_range)?;
+        ensure_positive("field-of-view half angle", half_angle)?;
         Ok(FieldOfViewDetection {
             p_inside,
             p_outside,

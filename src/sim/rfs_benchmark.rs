@@ -18,7 +18,9 @@
 //!
 //! Not for: running a filter or scoring it (see [`crate::filter`] and [`crate::metrics`]).
 
-use crate::error::{ensure_finite, Error, Result};
+use crate::error::{
+    ensure_finite, ensure_non_negative, ensure_positive, ensure_probability, Error, Result,
+};
 use crate::filter::{AssociationMethod, BirthTerm, LmbConfig, LmbFilter, StaticBirth};
 use crate::models::{
     wrap_angle, BearingConvention, ClutterModel, ConstantDetection, ConstantSurvival,
@@ -245,36 +247,6 @@ fn uniform(rng: &mut FilterRng, [lo, hi]: [f64; 2]) -> f64 {
     lo + (hi - lo) * rng.random::<f64>()
 }
 
-fn positive(what: &str, v: f64) -> Result<()> {
-    if v.is_finite() && v > 0.0 {
-        Ok(())
-    } else {
-        Err(Error::invalid(
-            what,
-            format!("{v} (must be finite and positive)"),
-        ))
-    }
-}
-
-fn non_negative(what: &str, v: f64) -> Result<()> {
-    if v.is_finite() && v >= 0.0 {
-        Ok(())
-    } else {
-        Err(Error::invalid(
-            what,
-            format!("{v} (must be finite and non-negative)"),
-        ))
-    }
-}
-
-fn probability(what: &str, p: f64) -> Result<()> {
-    if (0.0..=1.0).contains(&p) {
-        Ok(())
-    } else {
-        Err(Error::invalid(what, format!("{p} (must lie in [0, 1])")))
-    }
-}
-
 impl Scenario {
     /// The linear benchmark: constant velocity (σ_v = 5 m/s²), position measurements
     /// (σ = 10 m), p_D = 0.98, clutter 30 per scan on [−1000, 1000]², four birth terms
@@ -426,38 +398,40 @@ impl Scenario {
         if self.steps == 0 {
             return Err(Error::invalid("scenario steps", "0 (must be at least 1)"));
         }
-        positive("scenario period", self.period)?;
-        probability("scenario survival probability", self.survival)?;
+        ensure_positive("scenario period", self.period)?;
+        ensure_probability("scenario survival probability", self.survival)?;
         match self.dynamics {
             DynamicsSpec::ConstantVelocity { sigma_accel } => {
-                non_negative("scenario sigma_accel", sigma_accel)?
+                ensure_non_negative("scenario sigma_accel", sigma_accel)?
             }
             DynamicsSpec::CoordinatedTurn {
                 sigma_vel,
                 sigma_turn,
             } => {
-                non_negative("scenario sigma_vel", sigma_vel)?;
-                non_negative("scenario sigma_turn", sigma_turn)?;
+                ensure_non_negative("scenario sigma_vel", sigma_vel)?;
+                ensure_non_negative("scenario sigma_turn", sigma_turn)?;
             }
         }
         match self.sensor {
-            SensorSpec::Position { sigma } => positive("scenario sensor sigma", sigma)?,
+            SensorSpec::Position { sigma } => ensure_positive("scenario sensor sigma", sigma)?,
             SensorSpec::RangeBearing {
                 sigma_range,
                 sigma_bearing,
             } => {
-                positive("scenario sigma_range", sigma_range)?;
-                positive("scenario sigma_bearing", sigma_bearing)?;
+                ensure_positive("scenario sigma_range", sigma_range)?;
+                ensure_positive("scenario sigma_bearing", sigma_bearing)?;
             }
         }
         match self.detection {
-            DetectionSpec::Constant { p } => probability("scenario detection probability", p)?,
+            DetectionSpec::Constant { p } => {
+                ensure_probability("scenario detection probability", p)?
+            }
             DetectionSpec::GaussianRange { peak, scale } => {
-                probability("scenario detection peak", peak)?;
-                positive("scenario detection scale", scale)?;
+                ensure_probability("scenario detection peak", peak)?;
+                ensure_positive("scenario detection scale", scale)?;
             }
         }
-        non_negative("scenario clutter rate", self.clutter.rate())?;
+        ensure_non_negative("scenario clutter rate", self.clutter.rate())?;
         if self.clutter.rate() > 0.0 && Poisson::<f64>::new(self.clutter.rate()).is_err() {
             return Err(Error::invalid(
                 "scenario clutter rate",
@@ -475,7 +449,7 @@ impl Scenario {
         }
         let dim = self.dynamics.state_dim();
         for (i, b) in self.birth.iter().enumerate() {
-            probability(
+            ensure_probability(
                 &format!("birth term {i} existence probability"),
                 b.existence,
             )?;
@@ -491,7 +465,7 @@ impl Scenario {
             }
             ensure_finite(&format!("birth term {i} mean"), &b.mean)?;
             for &s in &b.std {
-                non_negative(&format!("birth term {i} std"), s)?;
+                ensure_non_negative(&format!("birth term {i} std"), s)?;
             }
         }
         for t in &self.targets {
