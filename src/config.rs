@@ -39,7 +39,8 @@ use crate::filter::{
 };
 use crate::models::{
     BearingConvention, ConstantDetection, ConstantSurvival, ConstantVelocity, CoordinatedTurn,
-    GaussianRangeDetection, PositionMeasurement, RangeBearing, StepContext, UniformClutter,
+    FieldOfViewDetection, GaussianRangeDetection, PositionMeasurement, RangeBearing, StepContext,
+    UniformClutter,
 };
 use crate::rng::FilterRng;
 use rand_distr::{Distribution, StandardNormal};
@@ -140,6 +141,22 @@ pub enum DetectionConfig {
         #[serde(default)]
         center: [f64; 2],
     },
+    /// p_D inside a range/bearing sector around the sensor (platform pose + mounting offset),
+    /// another value outside it.
+    FieldOfView {
+        /// p_D inside the sector.
+        p_inside: f64,
+        /// p_D outside it.
+        #[serde(default)]
+        p_outside: f64,
+        /// Sector radius (m).
+        max_range: f64,
+        /// Half the opening angle around the sensor's x axis (rad).
+        half_angle: f64,
+        /// Sensor mounting offset (a, b) on the platform (m). Default (0, 0).
+        #[serde(default)]
+        offset: [f64; 2],
+    },
 }
 
 /// Uniform clutter: `rate` false measurements per frame spread over `volume`.
@@ -221,6 +238,16 @@ impl RunConfig {
                 scale,
                 center,
             } => builder.detection(GaussianRangeDetection::new(*peak, *scale, *center)?),
+            DetectionConfig::FieldOfView {
+                p_inside,
+                p_outside,
+                max_range,
+                half_angle,
+                offset,
+            } => builder.detection(
+                FieldOfViewDetection::new(*p_inside, *p_outside, *max_range, *half_angle)?
+                    .with_offset(offset[0], offset[1])?,
+            ),
         };
         let range_bearing = match &self.measurement {
             MeasurementConfig::Position { .. } => None,

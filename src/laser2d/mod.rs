@@ -25,6 +25,7 @@ pub mod csv;
 pub mod rosbag;
 pub mod scan;
 pub mod segment;
+pub mod tracking;
 
 pub use self::carmen::{
     read_carmen, CarmenLog, CarmenOptions, CarmenReader, CarmenRecord, CarmenStats, OnMalformed,
@@ -34,3 +35,4 @@ pub use self::csv::{read_scan_csv, write_scan_csv};
 pub use self::rosbag::{bag_topics, read_bag, BagOptions, BagScans, BagTopic, OdometryTopic};
 pub use self::scan::{attach_odometry, OdometryRecord, Pose2, Scan};
 pub use self::segment::{breakpoint_threshold, segment_scan, BreakpointConfig, Segment};
+pub use self::tracking::{PeopleTracker, PeopleTrackerConfig};
