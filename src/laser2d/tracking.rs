@@ -24,8 +24,10 @@ pub struct PeopleTrackerConfig {
     pub breakpoint: BreakpointConfig,
     /// Segments wider than this (m) are not people. Default 0.8 m.
     pub max_width: f64,
-    /// Segments with fewer points are ignored. Default 2.
+    /// Groups with fewer points are ignored. Default 2.
     pub min_points: usize,
+    /// Neighbouring segments closer than this (m) are one group. Default 0.6 m.
+    pub merge_gap: f64,
     /// A segment's middle point lies on the body surface; the centre is this much (m) farther
     /// along the beam. Default 0.2 m.
     pub body_radius: f64,
@@ -45,9 +47,14 @@ impl PeopleTrackerConfig {
         mount: [f64; 2],
     ) -> Self {
         PeopleTrackerConfig {
-            breakpoint: BreakpointConfig::default(),
+            // Breakpoints at the scanner's own range noise, or a person's noisy outline splits.
+            breakpoint: BreakpointConfig {
+                sigma_r: sigma_range.max(BreakpointConfig::default().sigma_r),
+                ..BreakpointConfig::default()
+            },
             max_width: 0.8,
             min_points: 2,
+            merge_gap: 0.6,
             body_radius: 0.2,
             filter: RunConfig {
                 seed: 0,
@@ -91,6 +98,10 @@ impl PeopleTrackerConfig {
     }
 }
 
+fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
 /// Turns scans into labelled people estimates.
 #[derive(Debug)]
 pub struct PeopleTracker {
@@ -111,24 +122,53 @@ impl PeopleTracker {
         })
     }
 
-    /// The segments of `scan` that look like people.
-    pub fn person_segments(&self, scan: &Scan) -> Result<Vec<Segment>> {
-        Ok(segment_scan(scan, &self.config.breakpoint)?
+    /// The point groups of `scan` that look like people: breakpoint segments, with
+    /// neighbouring segments merged while their gap is below `merge_gap` and the merged group
+    /// stays within `max_width` (range noise splits a person's outline into pieces), then
+    /// filtered by size.
+    pub fn person_segments(&self, scan: &Scan) -> Result<Vec<Vec<[f64; 2]>>> {
+        let mut groups: Vec<Vec<[f64; 2]>> = Vec::new();
+        let mut previous: Option<Segment> = None;
+        for s in segment_scan(scan, &self.config.breakpoint)? {
+            let merge = match (&previous, groups.last()) {
+                (Some(p), Some(g)) => {
+                    p.beams.end + 1 >= s.beams.start
+                        && dist(p.last, s.first) <= self.config.merge_gap
+                        && dist(g[0], s.last) <= self.config.max_width
+                }
+                _ => false,
+            };
+            if merge {
+                groups
+                    .last_mut()
+                    .expect("merging into a group")
+                    .extend_from_slice(&s.points);
+            } else {
+                groups.push(s.points.clone());
+            }
+            previous = Some(s);
+        }
+        Ok(groups
             .into_iter()
-            .filter(|s| {
-                s.num_points() >= self.config.min_points && s.width <= self.config.max_width
+            .filter(|g| {
+                g.len() >= self.config.min_points
+                    && dist(g[0], g[g.len() - 1]) <= self.config.max_width
             })
             .collect())
     }
 
     /// Range-bearing measurements (sensor frame, bearing from the sensor's x axis) of the
-    /// centres of the person-sized segments.
+    /// people's centres: the mean of each group's points, pushed `body_radius` farther along
+    /// the beam.
     pub fn measurements(&self, scan: &Scan) -> Result<Measurements> {
         let rows: Vec<[f64; 2]> = self
             .person_segments(scan)?
             .iter()
-            .map(|s| {
-                let [x, y] = s.center;
+            .map(|g| {
+                let n = g.len() as f64;
+                let (x, y) = g
+                    .iter()
+                    .fold((0.0, 0.0), |(sx, sy), p| (sx + p[0] / n, sy + p[1] / n));
                 [x.hypot(y) + self.config.body_radius, y.atan2(x)]
             })
             .collect();
