@@ -29,6 +29,10 @@ struct Args {
     /// Seed of the first run (run i uses seed + i).
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Robot pose handed to the tracker: `odometry` (noisy, drifting — what a robot has) or
+    /// `truth` (the simulator's pose, to judge the tracker apart from localisation).
+    #[arg(long, default_value = "odometry")]
+    pose: String,
     /// Print one JSON object.
     #[arg(long)]
     json: bool,
@@ -66,8 +70,14 @@ fn main() -> Result<()> {
         let mut est_frames = Vec::new();
         let t0 = Instant::now();
         let mut all_est = Vec::new();
-        for scan in &run.scans {
-            all_est.push(tracker.step(scan)?);
+        for (k, scan) in run.scans.iter().enumerate() {
+            let mut scan = scan.clone();
+            match args.pose.as_str() {
+                "odometry" => {}
+                "truth" => scan.odometry = Some(run.robot_truth[k]),
+                other => anyhow::bail!("--pose {other}: expected odometry or truth"),
+            }
+            all_est.push(tracker.step(&scan)?);
         }
         seconds += t0.elapsed().as_secs_f64();
         scans += run.scans.len();
@@ -113,7 +123,7 @@ fn main() -> Result<()> {
     if args.json {
         println!(
             "{}",
-            serde_json::json!({ "scenario": args.scenario, "runs": args.runs, "seed": args.seed, "lmb": lmb })
+            serde_json::json!({ "scenario": args.scenario, "runs": args.runs, "seed": args.seed, "pose": args.pose, "lmb": lmb })
         );
     } else {
         println!(

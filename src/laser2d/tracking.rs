@@ -98,6 +98,14 @@ impl PeopleTrackerConfig {
     }
 }
 
+fn root(owner: &mut [usize], mut i: usize) -> usize {
+    while owner[i] != i {
+        owner[i] = owner[owner[i]];
+        i = owner[i];
+    }
+    i
+}
+
 fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
 }
@@ -158,17 +166,42 @@ impl PeopleTracker {
     }
 
     /// Range-bearing measurements (sensor frame, bearing from the sensor's x axis) of the
-    /// people's centres: the mean of each group's points, pushed `body_radius` farther along
-    /// the beam.
+    /// people's centres. Groups whose point means lie within `merge_gap` of each other are one
+    /// person (single linkage: noise can split an outline into pieces that are not neighbours
+    /// in the scan when another person's beams fall between them); each person's centre is the
+    /// mean of its points pushed `body_radius` farther along the beam.
     pub fn measurements(&self, scan: &Scan) -> Result<Measurements> {
-        let rows: Vec<[f64; 2]> = self
-            .person_segments(scan)?
+        let groups = self.person_segments(scan)?;
+        let stats: Vec<(f64, f64, f64)> = groups
             .iter()
             .map(|g| {
                 let n = g.len() as f64;
                 let (x, y) = g
                     .iter()
                     .fold((0.0, 0.0), |(sx, sy), p| (sx + p[0] / n, sy + p[1] / n));
+                (x, y, n)
+            })
+            .collect();
+        let mut owner: Vec<usize> = (0..stats.len()).collect();
+        for i in 0..stats.len() {
+            for j in 0..i {
+                if dist([stats[i].0, stats[i].1], [stats[j].0, stats[j].1]) <= self.config.merge_gap
+                {
+                    let (a, b) = (root(&mut owner, i), root(&mut owner, j));
+                    owner[a.max(b)] = a.min(b);
+                }
+            }
+        }
+        let mut merged: Vec<(f64, f64, f64)> = vec![(0.0, 0.0, 0.0); stats.len()];
+        for (i, &(x, y, n)) in stats.iter().enumerate() {
+            let m = &mut merged[root(&mut owner, i)];
+            *m = (m.0 + x * n, m.1 + y * n, m.2 + n);
+        }
+        let rows: Vec<[f64; 2]> = merged
+            .into_iter()
+            .filter(|m| m.2 > 0.0)
+            .map(|(sx, sy, n)| {
+                let (x, y) = (sx / n, sy / n);
                 [x.hypot(y) + self.config.body_radius, y.atan2(x)]
             })
             .collect();
