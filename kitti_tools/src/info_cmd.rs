@@ -10,6 +10,7 @@ use nalgebra::Isometry3;
 use serde::Serialize;
 use smc_lmb::kitti::drive::{CALIB_CAM_TO_CAM, CALIB_IMU_TO_VELO, CALIB_VELO_TO_CAM};
 use smc_lmb::kitti::{Issue, RawDrive, Timestamps};
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 /// Flags of `info`.
@@ -54,7 +55,8 @@ struct Report {
     velodyne_frames: usize,
     oxts_packets: usize,
     time_span: Option<TimeSpan>,
-    calibration: Vec<(String, bool)>,
+    /// Calibration file name → present.
+    calibration: BTreeMap<String, bool>,
     /// `velodyne` (poses of the Velodyne frame, needs the IMU→Velodyne calibration) or `imu`.
     pose_frame: Option<&'static str>,
     first_pose: Option<PoseSummary>,
@@ -91,9 +93,12 @@ fn summary(pose: &Isometry3<f64>) -> PoseSummary {
 }
 
 fn report(drive: &RawDrive) -> Report {
-    let time_span = drive
-        .timestamps()
-        .ok()
+    let velodyne_stamps = if drive.has_velodyne() {
+        drive.timestamps().ok()
+    } else {
+        None
+    };
+    let time_span = velodyne_stamps
         .and_then(|s| span("velodyne", &s))
         .or_else(|| drive.oxts_timestamps().ok().and_then(|s| span("oxts", &s)));
     let calibration = [CALIB_IMU_TO_VELO, CALIB_VELO_TO_CAM, CALIB_CAM_TO_CAM]
