@@ -19,7 +19,7 @@ pub fn label_colour(label: u32) -> [u8; 3] {
     // whose hues come close are still told apart by brightness.
     let golden = 0.618_033_988_749_895_f64;
     let hue = (f64::from(label) * golden).fract();
-    let (s, v) = if (label / 7) % 2 == 0 {
+    let (s, v) = if (label / 7).is_multiple_of(2) {
         (0.80, 0.95)
     } else {
         (0.65, 0.75)
