@@ -1,7 +1,9 @@
 //! `kitti-tools`: the command-line face of smc-lmb. Each subcommand parses its flags, builds a
 //! configuration and calls the library; no pipeline lives here.
 
+mod convert_cmd;
 mod detections_cmd;
+mod info_cmd;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
@@ -22,10 +24,16 @@ enum Command {
     /// Run the filter on your own per-frame detections (JSON or CSV) with a model config
     /// (TOML or JSON); write per-frame estimates and, given truth, print OSPA/GOSPA.
     Detections(detections_cmd::Args),
+    /// Convert a point cloud between KITTI .bin, .las and .ply (by extension).
+    Convert(convert_cmd::Args),
+    /// Describe a KITTI raw drive: frame counts, time span, calibration, poses, issues.
+    Info(info_cmd::Args),
 }
 
 fn main() -> Result<()> {
     match Cli::parse().command {
         Command::Detections(args) => detections_cmd::run(args),
+        Command::Convert(args) => convert_cmd::run(args),
+        Command::Info(args) => info_cmd::run(args),
     }
 }

@@ -1,5 +1,5 @@
 //! Point clouds: the [`PointCloud`] type (structure of arrays, f32) and the KITTI Velodyne
-//! `.bin` reader and writer,
+//! `.bin` reader and writer, LAS and PLY import/export (optionally coloured by label),
 //! and Euclidean clustering of points into object candidates.
 //!
 //! Not for: finding the frames of a recording (see [`crate::kitti`]) or fitting
@@ -7,9 +7,15 @@
 
 pub mod cluster;
 pub mod kitti_bin;
+pub mod las_io;
+pub mod palette;
 pub mod planes;
+pub mod ply_io;
 pub mod points;
 
 pub use cluster::{euclidean_clusters, euclidean_clusters_of, Cluster, ClusterParams};
 pub use kitti_bin::{read_kitti_bin, read_kitti_bin_with, write_kitti_bin, BinScan, NonFinite};
+pub use las_io::{read_las, write_las, write_las_labelled};
+pub use palette::label_colour;
+pub use ply_io::{read_ply, write_ply, write_ply_labelled};
 pub use points::{Bounds, Point, PointCloud};
