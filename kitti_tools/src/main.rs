@@ -2,6 +2,7 @@
 //! configuration and calls the library; no pipeline lives here.
 
 mod detections_cmd;
+mod planes_cmd;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
@@ -22,10 +23,14 @@ enum Command {
     /// Run the filter on your own per-frame detections (JSON or CSV) with a model config
     /// (TOML or JSON); write per-frame estimates and, given truth, print OSPA/GOSPA.
     Detections(detections_cmd::Args),
+    /// Segment building walls in consecutive Velodyne frames of a drive or odometry
+    /// sequence, predict them one frame ahead and print area, vertex and normal errors.
+    Planes(planes_cmd::Args),
 }
 
 fn main() -> Result<()> {
     match Cli::parse().command {
         Command::Detections(args) => detections_cmd::run(args),
+        Command::Planes(args) => planes_cmd::run(args),
     }
 }
