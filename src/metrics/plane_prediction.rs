@@ -136,7 +136,8 @@ pub fn associate_planes(
     max_centre_distance: f64,
 ) -> Vec<(usize, usize)> {
     let (n, m) = (predicted.len(), segmented.len());
-    if n == 0 || m == 0 || !(max_angle > 0.0) || !(max_centre_distance > 0.0) {
+    let usable = |g: f64| g > 0.0;
+    if n == 0 || m == 0 || !usable(max_angle) || !usable(max_centre_distance) {
         return Vec::new();
     }
     // Columns: the m segmented patches, then n "unpaired" columns.
