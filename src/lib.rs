@@ -13,6 +13,7 @@ pub mod kitti;
 pub mod laser2d;
 pub mod metrics;
 pub mod models;
+pub mod pipeline;
 pub mod rng;
 pub mod sim;
 

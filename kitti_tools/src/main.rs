@@ -4,6 +4,7 @@
 mod convert_cmd;
 mod detections_cmd;
 mod info_cmd;
+mod planes_cmd;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
@@ -28,6 +29,9 @@ enum Command {
     Convert(convert_cmd::Args),
     /// Describe a KITTI raw drive: frame counts, time span, calibration, poses, issues.
     Info(info_cmd::Args),
+    /// Segment building walls in consecutive Velodyne frames of a drive or odometry
+    /// sequence, predict them one frame ahead and print area, vertex and normal errors.
+    Planes(planes_cmd::Args),
 }
 
 fn main() -> Result<()> {
@@ -35,5 +39,6 @@ fn main() -> Result<()> {
         Command::Detections(args) => detections_cmd::run(args),
         Command::Convert(args) => convert_cmd::run(args),
         Command::Info(args) => info_cmd::run(args),
+        Command::Planes(args) => planes_cmd::run(args),
     }
 }

@@ -10,6 +10,7 @@
 //! | [`ospa2`](mod@ospa2) | OSPA(2) between sets of tracks over a time window (and a sliding series) |
 //! | [`cardinality`] | Per-step and mean error in the number of objects |
 //! | [`labels`] | Label switches and label persistence of estimates matched to truth |
+//! | [`plane_prediction`] | Area, vertex-distance and normal-angle errors of predicted plane patches |
 //! | [`rmse`] | RMS error of error vectors and the averaged-NIS consistency check |
 //!
 //! Points are slices of `f64` coordinates of any (common) dimension; all distances between
@@ -26,6 +27,7 @@ pub mod gospa;
 pub mod labels;
 pub mod ospa;
 pub mod ospa2;
+pub mod plane_prediction;
 mod points;
 pub mod rmse;
 
@@ -34,4 +36,5 @@ pub use gospa::{gospa, Gospa};
 pub use labels::{LabelConsistency, LabelStats, TruthLabels};
 pub use ospa::{ospa, Ospa};
 pub use ospa2::{ospa2, ospa2_parts, ospa2_series, tracks_from_frames, TrackHistory};
+pub use plane_prediction::{associate_planes, percentile, PlanePairError, PlanePredictionSummary};
 pub use rmse::{average_nis, chi_square_quantile, rms_error, NisCheck};

@@ -1,0 +1,156 @@
+//! `kitti-tools planes`: segment building walls in consecutive Velodyne frames, predict them
+//! one frame ahead and print the errors the way seed 001 reports them (areas, vertex
+//! distances, normal angle, prediction time).
+
+use anyhow::{bail, Context, Result};
+use smc_lmb::kitti::{OdometrySequence, RawDrive};
+use smc_lmb::metrics::{PlanePairError, PlanePredictionSummary};
+use smc_lmb::pipeline::{
+    predict_drive_pairs, predict_odometry_pairs, PairPrediction, PlanePredictionConfig,
+};
+use std::path::PathBuf;
+
+/// Flags of `planes`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// A KITTI raw drive folder (`.../2011_09_26/2011_09_26_drive_0001_sync`).
+    #[arg(long, conflicts_with = "odometry")]
+    drive: Option<PathBuf>,
+    /// A KITTI odometry root (holding `sequences/` and `poses/`); needs `--sequence`.
+    #[arg(long, requires = "sequence")]
+    odometry: Option<PathBuf>,
+    /// Odometry sequence number.
+    #[arg(long)]
+    sequence: Option<u32>,
+    /// Predict frame K into frame K + 1.
+    #[arg(long, default_value_t = 0)]
+    frame: usize,
+    /// Monte-Carlo runs per frame pair.
+    #[arg(long, default_value_t = 100)]
+    runs: usize,
+    /// Every consecutive frame pair instead of one, with the error distribution.
+    #[arg(long)]
+    all: bool,
+    /// Use the measured poses instead of the vehicle motion model (raw drives).
+    #[arg(long)]
+    measured: bool,
+    /// Random seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Runs the command.
+pub fn run(args: Args) -> Result<()> {
+    let config = PlanePredictionConfig {
+        use_vehicle_model: !args.measured,
+        ..PlanePredictionConfig::default()
+    };
+    let frames = if args.all {
+        None
+    } else {
+        Some(args.frame..args.frame + 1)
+    };
+    let mut rng = smc_lmb::rng::seeded(args.seed);
+    let results: Vec<PairPrediction> = match (&args.drive, &args.odometry) {
+        (Some(dir), _) => {
+            let drive =
+                RawDrive::open(dir).with_context(|| format!("opening drive {}", dir.display()))?;
+            predict_drive_pairs(&drive, frames, &config, args.runs, &mut rng)
+                .with_context(|| format!("predicting planes of drive {}", dir.display()))?
+        }
+        (None, Some(root)) => {
+            let Some(number) = args.sequence else {
+                bail!("--odometry needs --sequence");
+            };
+            let seq = OdometrySequence::open(root, number).with_context(|| {
+                format!(
+                    "opening odometry sequence {number:02} of {}",
+                    root.display()
+                )
+            })?;
+            predict_odometry_pairs(&seq, frames, &config, args.runs, &mut rng).with_context(
+                || {
+                    format!(
+                        "predicting planes of odometry sequence {number:02} of {}",
+                        root.display()
+                    )
+                },
+            )?
+        }
+        (None, None) => bail!("give --drive DIR or --odometry ROOT --sequence NN"),
+    };
+    let pairs: Vec<PlanePairError> = results.iter().flat_map(|r| r.pairs.clone()).collect();
+    let timings: Vec<f64> = results
+        .iter()
+        .flat_map(|r| r.prediction_ms.iter().copied())
+        .collect();
+    let summary = PlanePredictionSummary::from_pairs(&pairs, &timings);
+    if args.json {
+        let out = serde_json::json!({
+            "pairs": pairs,
+            "summary": {
+                "median_normal_angle_deg": summary.median_normal_angle_deg,
+                "p90_normal_angle_deg": summary.p90_normal_angle_deg,
+                "median_vertex_distance_m": summary.median_vertex_distance_m,
+                "p90_vertex_distance_m": summary.p90_vertex_distance_m,
+                "mean_prediction_ms": summary.mean_prediction_ms,
+                "pairs": summary.pairs,
+            },
+        });
+        println!("{}", serde_json::to_string_pretty(&out)?);
+        return Ok(());
+    }
+    println!(
+        "{:>6} {:>10} {:>10} {:>8} {:>8} {:>8} {:>8} {:>9} {:>8} {:>9}",
+        "frame",
+        "pred m²",
+        "seg m²",
+        "v1 m",
+        "v2 m",
+        "v3 m",
+        "v4 m",
+        "angle rad",
+        "angle °",
+        "pred ms"
+    );
+    for r in &results {
+        if r.pairs.is_empty() {
+            println!(
+                "{:>6} (no associated walls: {} predicted, {} segmented)",
+                r.frame, r.predicted, r.segmented
+            );
+        }
+        for p in &r.pairs {
+            let [a, b, c, d] = p.vertex_distances;
+            println!(
+                "{:>6} {:>10.2} {:>10.2} {:>8.4} {:>8.4} {:>8.4} {:>8.4} {:>9.5} {:>8.3} {:>9.4}",
+                p.frame,
+                p.predicted_area,
+                p.segmented_area,
+                a,
+                b,
+                c,
+                d,
+                p.normal_angle_rad,
+                p.normal_angle_deg,
+                r.mean_prediction_ms()
+            );
+        }
+    }
+    if args.all {
+        println!(
+            "{} pairs over {} frame pairs: normal angle median {:.3}° p90 {:.3}°, vertex distance median {:.3} m p90 {:.3} m, prediction {:.4} ms",
+            summary.pairs,
+            results.len(),
+            summary.median_normal_angle_deg,
+            summary.p90_normal_angle_deg,
+            summary.median_vertex_distance_m,
+            summary.p90_vertex_distance_m,
+            summary.mean_prediction_ms
+        );
+    }
+    Ok(())
+}

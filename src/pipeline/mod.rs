@@ -1,0 +1,12 @@
+//! End-to-end processing chains that combine readers, detectors, models and metrics, e.g.
+//! segmenting walls in consecutive LiDAR frames, predicting them forward and scoring the
+//! prediction ([`plane_prediction`]).
+//!
+//! Not for: the filter itself (see [`crate::filter`]) or command-line parsing.
+
+pub mod plane_prediction;
+
+pub use plane_prediction::{
+    predict_drive_pairs, predict_odometry_pairs, predict_planes_between, predict_walls,
+    segment_walls, EgoMotion, PairPrediction, PlanePredictionConfig,
+};

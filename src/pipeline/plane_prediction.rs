@@ -1,0 +1,389 @@
+//! Plane prediction between consecutive LiDAR frames, scored as in seed 001 (Sec. 5,
+//! Algorithm 1, Tables 1–6).
+//!
+//! For a frame pair (k, k + 1):
+//! 1. the building walls of both frames are segmented with
+//!    [`extract_planes`](crate::cloud::planes::extract_planes);
+//! 2. every wall patch of frame k is moved into the sensor frame of k + 1 with the ego motion
+//!    M = T_{k+1}⁻¹ T_k ([`relative_motion`]). With [`EgoMotion::Measured`] M comes from the
+//!    measured poses. With [`EgoMotion::Sampled`] (Algorithm 1) each Monte-Carlo run draws
+//!    the vehicle state at k + 1 from the state at k with
+//!    [`ExtendedConstantTurn::sample_step`], takes M_vehicle = P(s_{k+1})⁻¹ P(s_k)
+//!    ([`ExtendedConstantTurn::pose_of`]) and expresses it in the sensor frame,
+//!    M = C M_vehicle C⁻¹ with C the vehicle → sensor calibration;
+//! 3. the predicted patches are associated with the segmented walls of k + 1
+//!    ([`associate_planes`]) and each pair's errors are computed ([`PlanePairError`]).
+//!
+//! The prediction step (drawing the vehicle state and moving the patches) is timed per run
+//! with [`std::time::Instant`]. Errors of a pair (predicted index, segmented index) are
+//! averaged over the runs in which the pair was associated; pairs associated in fewer than
+//! half of the runs are dropped.
+//!
+//! Not for: tracking planes over many frames (that is the filter with
+//! [`PlaneTransition`](crate::models::PlaneTransition)).
+
+use crate::cloud::planes::{extract_planes, PlaneConfig};
+use crate::cloud::PointCloud;
+use crate::error::{Error, Result};
+use crate::geometry::PlanePatch;
+use crate::kitti::{OdometrySequence, RawDrive};
+use crate::metrics::plane_prediction::{associate_planes, PlanePairError};
+use crate::models::plane::relative_motion;
+use crate::models::ExtendedConstantTurn;
+use crate::rng::FilterRng;
+use nalgebra::Isometry3;
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+/// Parameters of plane prediction. Angles in radians, lengths in metres, times in seconds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlanePredictionConfig {
+    /// Plane segmentation of every frame.
+    pub planes: PlaneConfig,
+    /// Vehicle motion model for the Monte-Carlo prediction.
+    pub ect: ExtendedConstantTurn,
+    /// Step length used when no timestamps give it (s); KITTI records at 10 Hz.
+    pub dt: f64,
+    /// Vehicle (IMU) → sensor (Velodyne) transform C: `p_sensor = C p_vehicle`.
+    pub vehicle_to_sensor: Isometry3<f64>,
+    /// Association gate on the angle between normals (rad).
+    pub max_angle: f64,
+    /// Association gate on the distance between patch centres (m).
+    pub max_centre_distance: f64,
+    /// Whether the drive functions predict with the vehicle model (Algorithm 1) when vehicle
+    /// states are available, instead of with the measured poses.
+    pub use_vehicle_model: bool,
+}
+
+impl Default for PlanePredictionConfig {
+    fn default() -> Self {
+        PlanePredictionConfig {
+            planes: PlaneConfig::default(),
+            ect: ExtendedConstantTurn::new(0.5, 0.1)
+                .expect("constant noise levels are finite and non-negative"),
+            dt: 0.1,
+            vehicle_to_sensor: Isometry3::identity(),
+            max_angle: 10f64.to_radians(),
+            max_centre_distance: 5.0,
+            use_vehicle_model: true,
+        }
+    }
+}
+
+impl PlanePredictionConfig {
+    /// Checks the fields for usable values.
+    pub fn validate(&self) -> Result<()> {
+        self.planes.validate()?;
+        for (name, v) in [
+            ("dt", self.dt),
+            ("max_angle", self.max_angle),
+            ("max_centre_distance", self.max_centre_distance),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::invalid(
+                    format!("plane prediction config field {name}"),
+                    format!("must be finite and positive, got {v}"),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// How frame k is moved into the sensor frame of k + 1.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub enum EgoMotion {
+    /// A fixed motion M = T_{k+1}⁻¹ T_k (sensor frame k → sensor frame k + 1).
+    Measured(Isometry3<f64>),
+    /// Monte-Carlo prediction from the vehicle state at k (seed 001, Algorithm 1).
+    Sampled {
+        /// Vehicle motion model.
+        ect: ExtendedConstantTurn,
+        /// Vehicle state `[X, Ẋ, Y, Ẏ, φ, φ̇]` at k.
+        vehicle_state: [f64; 6],
+        /// Step length (s).
+        dt: f64,
+        /// Vehicle → sensor transform C.
+        vehicle_to_sensor: Isometry3<f64>,
+    },
+}
+
+impl EgoMotion {
+    /// One draw of the motion M (sensor frame k → sensor frame k + 1).
+    fn draw(&self, rng: &mut FilterRng) -> Isometry3<f64> {
+        match self {
+            EgoMotion::Measured(m) => *m,
+            EgoMotion::Sampled {
+                ect,
+                vehicle_state,
+                dt,
+                vehicle_to_sensor,
+            } => {
+                let next = ect.sample_step(vehicle_state, *dt, rng);
+                let m = relative_motion(
+                    &ExtendedConstantTurn::pose_of(vehicle_state),
+                    &ExtendedConstantTurn::pose_of(&next),
+                );
+                vehicle_to_sensor * m * vehicle_to_sensor.inverse()
+            }
+        }
+    }
+}
+
+/// The result of predicting one frame pair.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PairPrediction {
+    /// Frame k + 1 (the frame predicted into).
+    pub frame: usize,
+    /// Errors of the associated pairs, averaged over the runs, by predicted index.
+    pub pairs: Vec<PlanePairError>,
+    /// Execution time of the prediction step of each run (ms).
+    pub prediction_ms: Vec<f64>,
+    /// Number of wall patches segmented in frame k (and predicted).
+    pub predicted: usize,
+    /// Number of wall patches segmented in frame k + 1.
+    pub segmented: usize,
+}
+
+impl PairPrediction {
+    /// Mean execution time of the prediction step (ms); NaN without runs.
+    pub fn mean_prediction_ms(&self) -> f64 {
+        if self.prediction_ms.is_empty() {
+            return f64::NAN;
+        }
+        self.prediction_ms.iter().sum::<f64>() / self.prediction_ms.len() as f64
+    }
+}
+
+/// The wall patches of one cloud.
+pub fn segment_walls(
+    cloud: &PointCloud,
+    config: &PlaneConfig,
+    rng: &mut FilterRng,
+) -> Result<Vec<PlanePatch>> {
+    let seg = extract_planes(cloud, config, rng)?;
+    Ok(seg.walls.into_iter().map(|w| w.patch).collect())
+}
+
+/// Predicts the wall patches `walls_k` into frame `frame` (= k + 1) `runs` times (at least
+/// once) and scores them against `walls_k1`.
+pub fn predict_walls(
+    walls_k: &[PlanePatch],
+    walls_k1: &[PlanePatch],
+    ego: &EgoMotion,
+    frame: usize,
+    config: &PlanePredictionConfig,
+    runs: usize,
+    rng: &mut FilterRng,
+) -> PairPrediction {
+    let runs = runs.max(1);
+    let mut per_pair: BTreeMap<(usize, usize), Vec<PlanePairError>> = BTreeMap::new();
+    let mut prediction_ms = Vec::with_capacity(runs);
+    for _ in 0..runs {
+        let start = Instant::now();
+        let m = ego.draw(rng);
+        let predicted: Vec<PlanePatch> = walls_k.iter().map(|p| p.transform(&m)).collect();
+        prediction_ms.push(start.elapsed().as_secs_f64() * 1e3);
+        for (i, j) in associate_planes(
+            &predicted,
+            walls_k1,
+            config.max_angle,
+            config.max_centre_distance,
+        ) {
+            per_pair
+                .entry((i, j))
+                .or_default()
+                .push(PlanePairError::between(frame, &predicted[i], &walls_k1[j]));
+        }
+    }
+    let pairs = per_pair
+        .values()
+        .filter(|errs| 2 * errs.len() >= runs)
+        .filter_map(|errs| PlanePairError::mean(errs))
+        .collect();
+    PairPrediction {
+        frame,
+        pairs,
+        prediction_ms,
+        predicted: walls_k.len(),
+        segmented: walls_k1.len(),
+    }
+}
+
+/// Segments two consecutive clouds and predicts the walls of `cloud_k` into the frame of
+/// `cloud_k1` (frame number `frame_k + 1`).
+///
+/// `pose_k`, `pose_k1` are the sensor poses (sensor → world) of the two frames. Given a
+/// `vehicle_state_k`, the prediction follows Algorithm 1 with `config.ect`, `config.dt` and
+/// `config.vehicle_to_sensor` over `runs` Monte-Carlo runs and the poses are not used;
+/// otherwise the measured motion T_{k+1}⁻¹ T_k is applied (the runs then only repeat the
+/// timing).
+#[allow(clippy::too_many_arguments)]
+pub fn predict_planes_between(
+    frame_k: usize,
+    cloud_k: &PointCloud,
+    cloud_k1: &PointCloud,
+    pose_k: &Isometry3<f64>,
+    pose_k1: &Isometry3<f64>,
+    vehicle_state_k: Option<[f64; 6]>,
+    config: &PlanePredictionConfig,
+    runs: usize,
+    rng: &mut FilterRng,
+) -> Result<PairPrediction> {
+    config.validate()?;
+    let walls_k = segment_walls(cloud_k, &config.planes, rng)?;
+    let walls_k1 = segment_walls(cloud_k1, &config.planes, rng)?;
+    let ego = ego_for(pose_k, pose_k1, vehicle_state_k, config.dt, config);
+    Ok(predict_walls(
+        &walls_k,
+        &walls_k1,
+        &ego,
+        frame_k + 1,
+        config,
+        runs,
+        rng,
+    ))
+}
+
+fn ego_for(
+    pose_k: &Isometry3<f64>,
+    pose_k1: &Isometry3<f64>,
+    vehicle_state_k: Option<[f64; 6]>,
+    dt: f64,
+    config: &PlanePredictionConfig,
+) -> EgoMotion {
+    match vehicle_state_k {
+        Some(vehicle_state) => EgoMotion::Sampled {
+            ect: config.ect,
+            vehicle_state,
+            dt,
+            vehicle_to_sensor: config.vehicle_to_sensor,
+        },
+        None => EgoMotion::Measured(relative_motion(pose_k, pose_k1)),
+    }
+}
+
+/// Runs the prediction over consecutive frame pairs `(k, k + 1)` for `k` in `frames`, given a
+/// frame loader, sensor poses, optional vehicle states and step lengths. Each frame is
+/// segmented once.
+#[allow(clippy::too_many_arguments)]
+fn predict_sequence(
+    frames: std::ops::Range<usize>,
+    load: &dyn Fn(usize) -> Result<PointCloud>,
+    poses: &[Isometry3<f64>],
+    states: Option<&[[f64; 6]]>,
+    dts: &[f64],
+    config: &PlanePredictionConfig,
+    runs: usize,
+    rng: &mut FilterRng,
+) -> Result<Vec<PairPrediction>> {
+    config.validate()?;
+    let mut out = Vec::new();
+    let mut previous: Option<(usize, Vec<PlanePatch>)> = None;
+    for k in frames {
+        let walls_k = match previous.take() {
+            Some((f, w)) if f == k => w,
+            _ => segment_walls(&load(k)?, &config.planes, rng)?,
+        };
+        let walls_k1 = segment_walls(&load(k + 1)?, &config.planes, rng)?;
+        let dt = dts
+            .get(k)
+            .copied()
+            .filter(|d| d.is_finite() && *d > 0.0)
+            .unwrap_or(config.dt);
+        let state = states.map(|s| s[k]);
+        let ego = ego_for(&poses[k], &poses[k + 1], state, dt, config);
+        out.push(predict_walls(
+            &walls_k,
+            &walls_k1,
+            &ego,
+            k + 1,
+            config,
+            runs,
+            rng,
+        ));
+        previous = Some((k + 1, walls_k1));
+    }
+    Ok(out)
+}
+
+/// Checks that `frames` (pairs `(k, k + 1)`) fit in `count` frames, naming `source`.
+fn check_range(frames: &std::ops::Range<usize>, count: usize, source: &str) -> Result<()> {
+    if frames.start < frames.end && frames.end + 1 > count {
+        return Err(Error::invalid(
+            format!("frame pairs {}..{} of {source}", frames.start, frames.end),
+            format!("need frames up to {}, but there are {count}", frames.end),
+        ));
+    }
+    Ok(())
+}
+
+/// Plane prediction over the consecutive frame pairs `(k, k + 1)`, `k ∈ frames`, of a KITTI
+/// raw drive. `None` means every pair. Uses the Velodyne poses from OXTS; with
+/// `config.use_vehicle_model` the prediction follows Algorithm 1 from the OXTS vehicle
+/// states, the OXTS step lengths and the drive's IMU → Velodyne calibration (overriding
+/// `config.vehicle_to_sensor`).
+pub fn predict_drive_pairs(
+    drive: &RawDrive,
+    frames: Option<std::ops::Range<usize>>,
+    config: &PlanePredictionConfig,
+    runs: usize,
+    rng: &mut FilterRng,
+) -> Result<Vec<PairPrediction>> {
+    let poses = drive.poses()?;
+    let count = drive.frame_count().min(poses.len());
+    let frames = frames.unwrap_or(0..count.saturating_sub(1));
+    check_range(&frames, count, &drive.dir().display().to_string())?;
+    let mut config = config.clone();
+    let (states, dts) = if config.use_vehicle_model {
+        let states: Vec<[f64; 6]> = drive
+            .vehicle_states()?
+            .iter()
+            .map(|s| s.to_array())
+            .collect();
+        config.vehicle_to_sensor = drive.calib_imu_to_velo()?.isometry;
+        let dts = drive.oxts_timestamps()?.intervals();
+        (Some(states), dts)
+    } else {
+        (None, Vec::new())
+    };
+    predict_sequence(
+        frames,
+        &|k| drive.velodyne(k),
+        &poses,
+        states.as_deref(),
+        &dts,
+        &config,
+        runs,
+        rng,
+    )
+}
+
+/// Plane prediction over the consecutive frame pairs of a KITTI odometry sequence (ground-truth
+/// poses, so sequences 00–10 only), always with the measured poses. `None` means every pair.
+pub fn predict_odometry_pairs(
+    sequence: &OdometrySequence,
+    frames: Option<std::ops::Range<usize>>,
+    config: &PlanePredictionConfig,
+    runs: usize,
+    rng: &mut FilterRng,
+) -> Result<Vec<PairPrediction>> {
+    let poses = sequence.velodyne_poses()?;
+    let count = sequence.frame_count().min(poses.len());
+    let frames = frames.unwrap_or(0..count.saturating_sub(1));
+    check_range(
+        &frames,
+        count,
+        &format!("odometry sequence {}", sequence.dir().display()),
+    )?;
+    predict_sequence(
+        frames,
+        &|k| sequence.velodyne(k),
+        &poses,
+        None,
+        &[],
+        config,
+        runs,
+        rng,
+    )
+}
