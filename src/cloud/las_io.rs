@@ -79,12 +79,7 @@ pub fn write_las_labelled(
     cloud: &PointCloud,
     labels: &[u32],
 ) -> Result<()> {
-    if labels.len() != cloud.len() {
-        return Err(Error::invalid(
-            "labels",
-            format!("{} labels for {} points", labels.len(), cloud.len()),
-        ));
-    }
+    super::palette::check_label_count(labels, cloud.len())?;
     if let Some(i) = labels.iter().position(|&l| l > u32::from(u16::MAX)) {
         return Err(Error::invalid(
             "labels",

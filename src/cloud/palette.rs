@@ -47,6 +47,18 @@ fn hsv_to_rgb(h: f64, s: f64, v: f64) -> [u8; 3] {
     [byte(r), byte(g), byte(b)]
 }
 
+/// Checks that there is one label per point.
+pub(crate) fn check_label_count(labels: &[u32], points: usize) -> crate::Result<()> {
+    if labels.len() == points {
+        Ok(())
+    } else {
+        Err(crate::Error::invalid(
+            "labels",
+            format!("{} labels for {points} points", labels.len()),
+        ))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

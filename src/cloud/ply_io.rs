@@ -139,12 +139,7 @@ pub fn write_ply_labelled(
     cloud: &PointCloud,
     labels: &[u32],
 ) -> Result<()> {
-    if labels.len() != cloud.len() {
-        return Err(Error::invalid(
-            "labels",
-            format!("{} labels for {} points", labels.len(), cloud.len()),
-        ));
-    }
+    super::palette::check_label_count(labels, cloud.len())?;
     write(path.as_ref(), cloud, Some(labels))
 }
 
