@@ -195,23 +195,22 @@ fn parse_row(text: &str, path: &Path, line: usize) -> Result<Scan> {
             .map_err(|_| err(&format!("range[{j}]"), format!("`{c}` is not a number")))?;
         ranges.push(r);
     }
-    let scan = Scan {
+    let mut scan = Scan::new(
         time,
         angle_min,
         angle_increment,
         ranges,
         range_min,
         range_max,
-        odometry,
-        laser_pose: None,
-    };
-    scan.validate().map_err(|e| {
+    )
+    .map_err(|e| {
         let reason = match e {
             Error::InvalidInput { reason, .. } => reason,
             other => other.to_string(),
         };
         err("header values", reason)
     })?;
+    scan.odometry = odometry;
     Ok(scan)
 }
 

@@ -461,24 +461,21 @@ fn laser_scan_to_scan(data: &[u8], receive_ns: u64) -> DecodeResult<Scan> {
             ),
         ));
     }
-    let scan = Scan {
+    Scan::new(
         time,
         angle_min,
         angle_increment,
         ranges,
         range_min,
         range_max,
-        odometry: None,
-        laser_pose: None,
-    };
-    scan.validate().map_err(|e| {
+    )
+    .map_err(|e| {
         let reason = match e {
             Error::InvalidInput { reason, .. } => reason,
             other => other.to_string(),
         };
         ("header values".to_string(), reason)
-    })?;
-    Ok(scan)
+    })
 }
 
 /// Decodes a `nav_msgs/Odometry` into a planar [`OdometryRecord`].
