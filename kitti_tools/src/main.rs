@@ -5,6 +5,7 @@ mod convert_cmd;
 mod detections_cmd;
 mod info_cmd;
 mod planes_cmd;
+mod synth_cmd;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
@@ -32,6 +33,9 @@ enum Command {
     /// Segment building walls in consecutive Velodyne frames of a drive or odometry
     /// sequence, predict them one frame ahead and print area, vertex and normal errors.
     Planes(planes_cmd::Args),
+    /// Simulate a street drive (lidar, OXTS, walls, cars, pedestrians) in the KITTI raw
+    /// layout, with a ground-truth JSON.
+    Synth(synth_cmd::Args),
 }
 
 fn main() -> Result<()> {
@@ -40,5 +44,6 @@ fn main() -> Result<()> {
         Command::Convert(args) => convert_cmd::run(args),
         Command::Info(args) => info_cmd::run(args),
         Command::Planes(args) => planes_cmd::run(args),
+        Command::Synth(args) => synth_cmd::run(args),
     }
 }

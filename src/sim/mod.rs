@@ -9,10 +9,14 @@
 //! robot, in the two scenarios of the ML-RANSAC paper, with exact ray casting, noisy
 //! odometry and per-scan ground truth and visibility.
 //!
+//! [`street`] simulates a KITTI-style street drive (HDL-64E-like lidar, OXTS) with walls, cars
+//! and pedestrians, written in the KITTI raw layout with a ground-truth file.
+//!
 //! Not for: reading recorded data sets or scoring estimates (see [`crate::metrics`]).
 
 pub mod people2d;
 pub mod rfs_benchmark;
+pub mod street;
 
 pub use people2d::{
     OdometryNoise, People2dRun, PeopleScenario, PersonLeg, PersonSpec, RobotLeg, RobotSpec,

@@ -1,0 +1,498 @@
+//! The simulated street scene in the world frame (x east, y north, z up, ground z = 0): the
+//! street segments that follow the ego route, building walls along both sides, and the
+//! parked cars, moving cars and pedestrians with their motion.
+//!
+//! **Layout.** Each straight stretch of the ego route is one street segment; its centreline is
+//! the ego's straight line shifted by the ego lane offset. Consecutive segments meet at a
+//! corner, the intersection of their centrelines. Building walls stand on lines parallel to
+//! the centreline at ±(road half-width + sidewalk width); along each side they run from the
+//! side's corner with the previous segment to the side's corner with the next one (so walls of
+//! consecutive segments meet at building corners), cut into pieces of random length with random
+//! gaps, each piece a vertical rectangle of random height.
+//!
+//! **Objects.** Parked cars stand at the kerb; moving cars drive at constant speed in a lane
+//! (right of the centreline in the ego's direction, left against it), never in the ego's lane;
+//! pedestrians walk along the sidewalks. Positions are drawn at random near the ego's path and
+//! rejected when too close to a corner, to another object of the same row, or (at any frame)
+//! to the ego vehicle. A moving object exists while it is on its segment and more than the
+//! corner clearance away from the segment's corners.
+//!
+//! Not for: ray casting (see [`super::lidar`]) or the ego motion (see [`super::ego`]).
+
+use super::lidar::{Geometry, Shape, Surface};
+use super::StreetConfig;
+use crate::error::{Error, Result};
+use crate::rng::FilterRng;
+use rand::RngExt;
+use serde::{Deserialize, Serialize};
+
+/// One straight street segment: centreline `point + s·dir`, between corners at `s_start` and
+/// `s_end`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Segment {
+    /// A point on the centreline (s = 0), metres.
+    pub point: [f64; 2],
+    /// Unit direction of travel of the ego.
+    pub dir: [f64; 2],
+    /// Along-street coordinate of the corner with the previous segment (or the start).
+    pub s_start: f64,
+    /// Along-street coordinate of the corner with the next segment (or the end).
+    pub s_end: f64,
+}
+
+impl Segment {
+    /// Unit vector to the left of the direction of travel.
+    pub fn left(&self) -> [f64; 2] {
+        [-self.dir[1], self.dir[0]]
+    }
+
+    /// World point at along-street coordinate `s` and lateral offset `lateral` (left > 0).
+    pub fn at(&self, s: f64, lateral: f64) -> [f64; 2] {
+        let l = self.left();
+        [
+            self.point[0] + s * self.dir[0] + lateral * l[0],
+            self.point[1] + s * self.dir[1] + lateral * l[1],
+        ]
+    }
+}
+
+/// A building wall: the vertical rectangle over the ground segment `base`…`base + length·along`,
+/// from z = 0 to `height`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Wall {
+    /// Identifier (index in the street's wall list).
+    pub id: u32,
+    /// One ground corner, metres.
+    pub base: [f64; 2],
+    /// Unit horizontal direction along the wall.
+    pub along: [f64; 2],
+    /// Length along the wall, metres.
+    pub length: f64,
+    /// Height, metres.
+    pub height: f64,
+    /// Unit horizontal normal, pointing towards the street.
+    pub normal: [f64; 2],
+    /// Reflectance of the facade.
+    pub reflectance: f32,
+}
+
+impl Wall {
+    /// The four corners: ground start, ground end, top end, top start.
+    pub fn vertices(&self) -> [[f64; 3]; 4] {
+        let (b, a, l, h) = (self.base, self.along, self.length, self.height);
+        let e = [b[0] + l * a[0], b[1] + l * a[1]];
+        [
+            [b[0], b[1], 0.0],
+            [e[0], e[1], 0.0],
+            [e[0], e[1], h],
+            [b[0], b[1], h],
+        ]
+    }
+
+    /// Plane offset d of n·p + d = 0 with the street-facing normal.
+    pub fn offset(&self) -> f64 {
+        -(self.normal[0] * self.base[0] + self.normal[1] * self.base[1])
+    }
+}
+
+/// What an object is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ObjectKind {
+    /// A moving car (oriented box).
+    Car,
+    /// A walking pedestrian (vertical cylinder).
+    Pedestrian,
+    /// A parked car (oriented box, never moves).
+    ParkedCar,
+}
+
+/// A car or pedestrian moving at constant velocity along its street segment.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Object {
+    /// Identifier.
+    pub id: u32,
+    /// Kind.
+    pub kind: ObjectKind,
+    /// Length, width, height (a pedestrian: diameter, diameter, height), metres.
+    pub size: [f64; 3],
+    /// Segment the object moves on.
+    pub segment: usize,
+    /// Along-street coordinate at time 0.
+    pub s0: f64,
+    /// Lateral offset from the centreline (left > 0).
+    pub lateral: f64,
+    /// Signed speed along the segment direction, m/s.
+    pub speed: f64,
+    /// Heading, rad (counter-clockwise from east).
+    pub yaw: f64,
+    /// The object exists while its along-street coordinate is within this range.
+    pub s_range: (f64, f64),
+    /// Reflectance of the surface.
+    pub reflectance: f32,
+}
+
+impl Object {
+    /// Ground position (centre of the footprint) and velocity at time `t`, or `None` when the
+    /// object does not exist then.
+    pub fn state_at(&self, segments: &[Segment], t: f64) -> Option<([f64; 2], [f64; 2])> {
+        let s = self.s0 + self.speed * t;
+        if s < self.s_range.0 || s > self.s_range.1 {
+            return None;
+        }
+        let seg = &segments[self.segment];
+        let v = [self.speed * seg.dir[0], self.speed * seg.dir[1]];
+        Some((seg.at(s, self.lateral), v))
+    }
+
+    /// The object's shape at time `t` if it exists then.
+    pub fn shape_at(&self, segments: &[Segment], t: f64) -> Option<Shape> {
+        let (p, _) = self.state_at(segments, t)?;
+        let geometry = match self.kind {
+            ObjectKind::Pedestrian => Geometry::Cylinder {
+                centre: p,
+                radius: 0.5 * self.size[0],
+                height: self.size[2],
+            },
+            ObjectKind::Car | ObjectKind::ParkedCar => Geometry::Box {
+                centre: p,
+                yaw: self.yaw,
+                half_length: 0.5 * self.size[0],
+                half_width: 0.5 * self.size[1],
+                height: self.size[2],
+            },
+        };
+        Some(Shape {
+            surface: Surface::Object(self.id),
+            geometry,
+            reflectance: self.reflectance,
+        })
+    }
+}
+
+/// The whole static and moving scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Street {
+    /// Street segments in route order.
+    pub segments: Vec<Segment>,
+    /// Building walls.
+    pub walls: Vec<Wall>,
+    /// Cars and pedestrians.
+    pub objects: Vec<Object>,
+}
+
+impl Street {
+    /// Walls and existing objects at time `t`, as shapes for the ray caster.
+    pub fn shapes_at(&self, t: f64) -> Vec<Shape> {
+        let walls = self.walls.iter().map(|w| Shape {
+            surface: Surface::Wall(w.id),
+            geometry: Geometry::Wall {
+                base: w.base,
+                along: w.along,
+                length: w.length,
+                height: w.height,
+                normal: w.normal,
+            },
+            reflectance: w.reflectance,
+        });
+        let objects = self
+            .objects
+            .iter()
+            .filter_map(|o| o.shape_at(&self.segments, t));
+        walls.chain(objects).collect()
+    }
+}
+
+fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
+    a[0] * b[1] - a[1] * b[0]
+}
+
+/// Along-coordinate on line (p, d) of its intersection with line (q, e).
+fn intersect(p: [f64; 2], d: [f64; 2], q: [f64; 2], e: [f64; 2]) -> f64 {
+    cross([q[0] - p[0], q[1] - p[1]], e) / cross(d, e)
+}
+
+fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+fn uniform(rng: &mut FilterRng, range: [f64; 2]) -> f64 {
+    if range[1] > range[0] {
+        rng.random_range(range[0]..range[1])
+    } else {
+        range[0]
+    }
+}
+
+/// Builds the street around the ego's straight lines (`lines`, see
+/// [`super::ego::EgoTrajectory::straight_lines`]) for a drive whose ego positions are `ego` at
+/// times `times`.
+///
+/// Errors: a route leg too short for the street width, so that consecutive corners overlap.
+pub fn build_street(
+    config: &StreetConfig,
+    lines: &[([f64; 2], [f64; 2])],
+    ego: &[[f64; 2]],
+    times: &[f64],
+    rng: &mut FilterRng,
+) -> Result<Street> {
+    let layout = &config.street;
+    let centre_shift = -layout.ego_lane_offset;
+    let segments_raw: Vec<([f64; 2], [f64; 2])> = lines
+        .iter()
+        .map(|&(p, d)| {
+            let l = [-d[1], d[0]];
+            ([p[0] + centre_shift * l[0], p[1] + centre_shift * l[1]], d)
+        })
+        .collect();
+    let n = segments_raw.len();
+    let last_ego = *ego.last().unwrap_or(&segments_raw[0].0);
+    // Along-coordinate of a line's intersection with the neighbour, for a lateral offset.
+    let corner = |j: usize, k: usize, lateral: f64| -> f64 {
+        let (p, d) = segments_raw[j];
+        let (q, e) = segments_raw[k];
+        let (lp, le) = ([-d[1], d[0]], [-e[1], e[0]]);
+        let p = [p[0] + lateral * lp[0], p[1] + lateral * lp[1]];
+        let q = [q[0] + lateral * le[0], q[1] + lateral * le[1]];
+        intersect(p, d, q, e)
+    };
+    let end_s = |j: usize| -> f64 {
+        let (p, d) = segments_raw[j];
+        (last_ego[0] - p[0]) * d[0] + (last_ego[1] - p[1]) * d[1] + layout.beyond_end
+    };
+    let extent = |j: usize, lateral: f64| -> (f64, f64) {
+        let start = if j == 0 {
+            -layout.behind_start
+        } else {
+            corner(j, j - 1, lateral)
+        };
+        let end = if j + 1 == n {
+            end_s(j).max(start + layout.beyond_end)
+        } else {
+            corner(j, j + 1, lateral)
+        };
+        (start, end)
+    };
+    let wall_offset = layout.road_half_width + layout.sidewalk_width;
+    let mut segments = Vec::with_capacity(n);
+    for j in 0..n {
+        let (s_start, s_end) = extent(j, 0.0);
+        for lateral in [-wall_offset, 0.0, wall_offset] {
+            let (a, b) = extent(j, lateral);
+            if b - a < 1.0 {
+                return Err(Error::invalid(
+                    format!("route leg {j}"),
+                    format!(
+                        "too short for a street {:.1} m wide between walls: its corners overlap \
+                         (lengthen the straight or soften the turns)",
+                        2.0 * wall_offset
+                    ),
+                ));
+            }
+        }
+        let (point, dir) = segments_raw[j];
+        segments.push(Segment {
+            point,
+            dir,
+            s_start,
+            s_end,
+        });
+    }
+
+    let mut walls = Vec::new();
+    for (j, seg) in segments.iter().enumerate() {
+        for side in [1.0, -1.0] {
+            let lateral = side * wall_offset;
+            let (a, b) = extent(j, lateral);
+            let mut s = a;
+            let normal_dir = [-side * seg.left()[0], -side * seg.left()[1]];
+            while s < b {
+                let end = (s + uniform(rng, layout.wall_length)).min(b);
+                if end - s >= layout.min_wall_piece {
+                    walls.push(Wall {
+                        id: walls.len() as u32,
+                        base: seg.at(s, lateral),
+                        along: seg.dir,
+                        length: end - s,
+                        height: uniform(rng, layout.wall_height),
+                        normal: normal_dir,
+                        reflectance: rng.random_range(0.15f32..0.6),
+                    });
+                }
+                s = end + uniform(rng, layout.wall_gap);
+            }
+        }
+    }
+
+    let objects = place_objects(config, &segments, ego, times, rng);
+    Ok(Street {
+        segments,
+        walls,
+        objects,
+    })
+}
+
+/// One row of objects: where on the street and how it moves.
+struct Row {
+    kind: ObjectKind,
+    lateral: f64,
+    speed: f64,
+    min_spacing: f64,
+    clearance_to_ego: f64,
+}
+
+fn place_objects(
+    config: &StreetConfig,
+    segments: &[Segment],
+    ego: &[[f64; 2]],
+    times: &[f64],
+    rng: &mut FilterRng,
+) -> Vec<Object> {
+    let layout = &config.street;
+    let traffic = &config.traffic;
+    let wall_offset = layout.road_half_width + layout.sidewalk_width;
+    let lane = layout.lane_width;
+    let ego_lane = layout.ego_lane_offset;
+    // Lanes other than the ego's: centres at ±(i + 1/2)·lane inside the road.
+    let mut lanes = Vec::new();
+    let mut c = 0.5 * lane;
+    while c + 0.5 * traffic.car_size[1] <= layout.road_half_width - traffic.car_size[1] - 0.2 {
+        for lat in [c, -c] {
+            if (lat - ego_lane).abs() > 0.5 * lane {
+                lanes.push(lat);
+            }
+        }
+        c += lane;
+    }
+    // Per (segment, lane) speed, so cars of one lane never run into each other.
+    let lane_speeds: Vec<Vec<f64>> = segments
+        .iter()
+        .map(|_| {
+            lanes
+                .iter()
+                .map(|_| uniform(rng, traffic.car_speed))
+                .collect()
+        })
+        .collect();
+    let kerb = layout.road_half_width - 0.5 * traffic.car_size[1] - 0.1;
+    let mut objects: Vec<Object> = Vec::new();
+    let kinds = std::iter::repeat_n(ObjectKind::ParkedCar, traffic.parked_cars)
+        .chain(std::iter::repeat_n(ObjectKind::Car, traffic.moving_cars))
+        .chain(std::iter::repeat_n(
+            ObjectKind::Pedestrian,
+            traffic.pedestrians,
+        ));
+    for kind in kinds {
+        for _attempt in 0..2000 {
+            let j = rng.random_range(0..segments.len());
+            let seg = &segments[j];
+            let side: f64 = if rng.random_range(0..2) == 0 {
+                1.0
+            } else {
+                -1.0
+            };
+            let row = match kind {
+                ObjectKind::ParkedCar => Row {
+                    kind,
+                    lateral: side * kerb,
+                    speed: 0.0,
+                    min_spacing: traffic.car_size[0] + 1.5,
+                    clearance_to_ego: 2.0,
+                },
+                ObjectKind::Car => {
+                    if lanes.is_empty() {
+                        break;
+                    }
+                    let i = rng.random_range(0..lanes.len());
+                    let lateral = lanes[i];
+                    let v = lane_speeds[j][i];
+                    Row {
+                        kind,
+                        lateral,
+                        // Right of the centreline: the ego's direction; left: against it.
+                        speed: if lateral < 0.0 { v } else { -v },
+                        min_spacing: 2.0 * traffic.car_size[0],
+                        clearance_to_ego: 4.0,
+                    }
+                }
+                ObjectKind::Pedestrian => {
+                    let forward = rng.random_range(0..2) == 0;
+                    let v = uniform(rng, traffic.pedestrian_speed);
+                    // Two walking rows per sidewalk, one per direction.
+                    let depth = if forward { 1.0 } else { 2.0 };
+                    Row {
+                        kind,
+                        lateral: side * (wall_offset - depth),
+                        speed: if forward { v } else { -v },
+                        min_spacing: 2.0,
+                        clearance_to_ego: 2.0,
+                    }
+                }
+            };
+            let clear = traffic.corner_clearance;
+            let (lo, hi) = (seg.s_start + clear, seg.s_end - clear);
+            if hi <= lo {
+                continue;
+            }
+            let s0 = rng.random_range(lo..hi);
+            let p0 = seg.at(s0, row.lateral);
+            if !ego.iter().any(|e| dist(*e, p0) <= traffic.spawn_radius) {
+                continue;
+            }
+            let crowded = objects.iter().any(|o| {
+                o.segment == j
+                    && (o.lateral - row.lateral).abs() < 0.5
+                    && times.iter().any(|&t| {
+                        let a = o.s0 + o.speed * t;
+                        let b = s0 + row.speed * t;
+                        (a - b).abs() < row.min_spacing
+                    })
+            });
+            if crowded {
+                continue;
+            }
+            let mut object = Object {
+                id: objects.len() as u32,
+                kind: row.kind,
+                size: match kind {
+                    ObjectKind::Pedestrian => [
+                        2.0 * traffic.pedestrian_radius,
+                        2.0 * traffic.pedestrian_radius,
+                        traffic.pedestrian_height,
+                    ],
+                    _ => traffic.car_size,
+                },
+                segment: j,
+                s0,
+                lateral: row.lateral,
+                speed: row.speed,
+                yaw: 0.0,
+                s_range: if row.speed == 0.0 {
+                    (f64::NEG_INFINITY, f64::INFINITY)
+                } else {
+                    (lo, hi)
+                },
+                reflectance: rng.random_range(0.1f32..0.9),
+            };
+            let backwards = row.speed < 0.0
+                || (row.speed == 0.0 && rng.random_range(0..2) == 0 && kind != ObjectKind::Car);
+            let heading = seg.dir[1].atan2(seg.dir[0]);
+            object.yaw = if backwards {
+                crate::kitti::poses::wrap_angle(heading + std::f64::consts::PI)
+            } else {
+                heading
+            };
+            let hits_ego = ego.iter().zip(times).any(|(e, &t)| {
+                object
+                    .state_at(segments, t)
+                    .is_some_and(|(p, _)| dist(*e, p) < row.clearance_to_ego + 2.5)
+            });
+            if hits_ego {
+                continue;
+            }
+            objects.push(object);
+            break;
+        }
+    }
+    objects
+}
