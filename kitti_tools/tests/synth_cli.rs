@@ -1,0 +1,89 @@
+//! `kitti-tools synth` through the built binary: a small drive that `info` then reads without
+//! issues, a configuration file, and refused arguments.
+
+use std::process::{Command, Output};
+
+fn run(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_kitti-tools"))
+        .args(args)
+        .output()
+        .expect("run kitti-tools")
+}
+
+fn ok(out: &Output) -> String {
+    assert!(
+        out.status.success(),
+        "stdout: {}\nstderr: {}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+#[test]
+fn synth_then_info() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("street.toml");
+    std::fs::write(
+        &config,
+        "speed = 8.0\n[lidar]\ncolumns = 400\n[recording]\ndrive_number = 42\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let text = ok(&run(&[
+        "synth",
+        "--out",
+        out.to_str().unwrap(),
+        "--frames",
+        "4",
+        "--seed",
+        "3",
+        "--config",
+        config.to_str().unwrap(),
+        "--quiet",
+    ]));
+    let drive = out.join("2020_01_01/2020_01_01_drive_0042_sync");
+    assert!(text.contains(drive.to_str().unwrap()), "{text}");
+    assert!(text.contains("8.0 m/s"), "{text}");
+    assert!(drive.join("truth.json").is_file());
+    let info = ok(&run(&[
+        "info",
+        "--drive",
+        drive.to_str().unwrap(),
+        "--json",
+    ]));
+    let report: serde_json::Value = serde_json::from_str(&info).unwrap();
+    assert_eq!(report["velodyne_frames"], 4, "{info}");
+    assert_eq!(report["oxts_packets"], 4, "{info}");
+    assert_eq!(report["errors"], 0, "{info}");
+    assert_eq!(report["issues"].as_array().unwrap().len(), 0, "{info}");
+    // 3 intervals at 8 m/s and 10 Hz.
+    let length = report["path_length_m"].as_f64().unwrap();
+    assert!((length - 2.4).abs() < 0.01, "{length}");
+}
+
+#[test]
+fn bad_arguments_are_refused_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let zero = run(&["synth", "--out", out, "--frames", "0"]);
+    assert!(!zero.status.success());
+    let err = String::from_utf8_lossy(&zero.stderr);
+    assert!(err.contains("--frames must be at least 1"), "{err}");
+
+    let config = dir.path().join("bad.toml");
+    std::fs::write(&config, "[lidar]\ncolums = 400\n").unwrap();
+    let bad = run(&["synth", "--out", out, "--config", config.to_str().unwrap()]);
+    assert!(!bad.status.success());
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        err.contains("bad.toml:2") && err.contains("colums"),
+        "{err}"
+    );
+
+    std::fs::write(&config, "[lidar]\ndropout = 1.5\n").unwrap();
+    let bad = run(&["synth", "--out", out, "--config", config.to_str().unwrap()]);
+    assert!(!bad.status.success());
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(err.contains("lidar.dropout"), "{err}");
+}
