@@ -40,7 +40,12 @@ fn read_config(path: &Path) -> Result<StreetConfig> {
         "toml" => toml::from_str(&text).map_err(|e| {
             let line = e
                 .span()
-                .map(|s| text[..s.start.min(text.len())].lines().count().max(1))
+                .map(|s| {
+                    1 + text.as_bytes()[..s.start.min(text.len())]
+                        .iter()
+                        .filter(|&&b| b == b'\n')
+                        .count()
+                })
                 .unwrap_or(0);
             anyhow::anyhow!("{}:{line}: {}", path.display(), e.message())
         })?,
