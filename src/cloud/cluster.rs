@@ -202,7 +202,8 @@ fn grid_components(points: &[[f32; 3]], tolerance: f32) -> Option<Vec<u32>> {
         }
     }
     let inv = 1.0 / cell;
-    if (0..3).any(|a| !((hi[a] - lo[a]) * inv < GRID_AXIS_LIMIT)) {
+    // (The points are finite, so the extents are too.)
+    if (0..3).any(|a| (hi[a] - lo[a]) * inv >= GRID_AXIS_LIMIT) {
         return None;
     }
     // Cell coordinates start at 2 so that offsets down to −2 stay non-negative.

@@ -53,15 +53,20 @@ pub(super) fn hull_candidates(plane: &Plane, idx: &[u32], pts: &[[f32; 3]]) -> V
         [0.0, -1.0],
         [1.0, -1.0],
     ];
+    // One pass for the extreme point in every direction (ties: the earliest point).
+    let mut best = [(f64::NEG_INFINITY, [0.0f64; 2]); 8];
+    for q in &uv {
+        for (b, d) in best.iter_mut().zip(&DIRS) {
+            let s = q[0] * d[0] + q[1] * d[1];
+            if s > b.0 {
+                *b = (s, *q);
+            }
+        }
+    }
     let mut poly: Vec<[f64; 2]> = Vec::with_capacity(8);
-    for d in DIRS {
-        let best = uv
-            .iter()
-            .max_by(|a, b| (a[0] * d[0] + a[1] * d[1]).total_cmp(&(b[0] * d[0] + b[1] * d[1])))
-            .copied()
-            .unwrap_or([0.0, 0.0]);
-        if poly.last() != Some(&best) && poly.first() != Some(&best) {
-            poly.push(best);
+    for (_, q) in best {
+        if poly.last() != Some(&q) && poly.first() != Some(&q) {
+            poly.push(q);
         }
     }
     if poly.len() < 3 {
