@@ -1,5 +1,8 @@
 //! Euclidean clustering of a point cloud: the connected components of the graph that joins
-//! every two points at most `tolerance` apart, found by flood fill over a k-d tree (kiddo).
+//! every two points at most `tolerance` apart (`dx² + dy² + dz² ≤ tolerance²` in f32). They
+//! are found exactly on a voxel grid of edge `tolerance/√3` (every cell is connected within
+//! itself; neighbouring cells are joined by a union-find when one point pair is close enough),
+//! or by flood fill over a k-d tree (kiddo) when the grid does not apply (zero tolerance).
 //! Each kept component becomes a [`Cluster`] with its point indices, centroid and
 //! axis-aligned extent — the object detections of a lidar frame once ground and walls have
 //! been removed.
@@ -108,7 +111,7 @@ pub fn euclidean_clusters_of(
     Ok(cluster_indices(cloud, &sorted, params))
 }
 
-/// Flood fill over `subset` (ascending, distinct, in range).
+/// Components of `subset` (ascending, distinct, in range), size-filtered and summarised.
 fn cluster_indices(cloud: &PointCloud, subset: &[u32], params: &ClusterParams) -> Vec<Cluster> {
     let (xs, ys, zs, _) = cloud.columns();
     // local position → cloud index, finite points only
@@ -130,50 +133,206 @@ fn cluster_indices(cloud: &PointCloud, subset: &[u32], params: &ClusterParams) -
             [xs[i], ys[i], zs[i]]
         })
         .collect();
-    let tree = match ImmutableKdTree::<f32, 3>::new_from_slice(&points) {
-        Ok(t) => t,
-        Err(_) => return Vec::new(),
+    let labels = grid_components(&points, params.tolerance)
+        .unwrap_or_else(|| kdtree_components(&points, params.tolerance));
+    // Number the components by their first (smallest) local position, then bucket the
+    // members: local positions ascend with cloud indices, so clusters come out ordered by
+    // smallest index with ascending indices inside.
+    let mut ordinal = vec![u32::MAX; points.len()];
+    let mut sizes: Vec<usize> = Vec::new();
+    let mut of_point = Vec::with_capacity(points.len());
+    for &l in &labels {
+        let o = &mut ordinal[l as usize];
+        if *o == u32::MAX {
+            *o = sizes.len() as u32;
+            sizes.push(0);
+        }
+        sizes[*o as usize] += 1;
+        of_point.push(*o);
+    }
+    let mut buckets: Vec<Vec<u32>> = sizes
+        .iter()
+        .map(|&n| {
+            if n >= params.min_points && n <= params.max_points {
+                Vec::with_capacity(n)
+            } else {
+                Vec::new()
+            }
+        })
+        .collect();
+    for (&o, &cloud_index) in of_point.iter().zip(&members) {
+        let n = sizes[o as usize];
+        if n >= params.min_points && n <= params.max_points {
+            buckets[o as usize].push(cloud_index);
+        }
+    }
+    buckets
+        .into_iter()
+        .filter(|b| !b.is_empty())
+        .map(|b| summarise(b.into_iter(), xs, ys, zs))
+        .collect()
+}
+
+/// Cells per axis above which the grid is not used (coordinates are packed 21 bits each).
+const GRID_AXIS_LIMIT: f64 = ((1u64 << 21) - 8) as f64;
+
+/// Components by a voxel grid: a component label (a local position) for every point, or
+/// `None` when the tolerance is zero or the cloud spans too many cells for the packed keys.
+///
+/// Cells have edge `tolerance/√3` (shrunk by 10⁻⁴ against rounding), so any two points of a
+/// cell are within the tolerance and each occupied cell is connected as a whole. Two points
+/// within the tolerance lie at most two cells apart on every axis, so only the 124
+/// surrounding cells can hold a neighbour; each pair of occupied cells is examined once (the
+/// 62 "forward" offsets) and joined in a union-find as soon as one point pair is within the
+/// tolerance, with the same `dx² + dy² + dz² ≤ tol²` test (f32) as the definition. Cells are
+/// sorted by packed key (z, y, x major to minor); for each forward row offset a cursor walks
+/// the sorted cells in step with the current cell, so neighbours are found without hashing.
+fn grid_components(points: &[[f32; 3]], tolerance: f32) -> Option<Vec<u32>> {
+    if tolerance <= 0.0 {
+        return None;
+    }
+    let r2 = tolerance * tolerance;
+    let cell = tolerance as f64 / 3f64.sqrt() * (1.0 - 1e-4);
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in points {
+        for a in 0..3 {
+            lo[a] = lo[a].min(p[a] as f64);
+            hi[a] = hi[a].max(p[a] as f64);
+        }
+    }
+    let inv = 1.0 / cell;
+    // (The points are finite, so the extents are too.)
+    if (0..3).any(|a| (hi[a] - lo[a]) * inv >= GRID_AXIS_LIMIT) {
+        return None;
+    }
+    // Cell coordinates start at 2 so that offsets down to −2 stay non-negative.
+    let key_of = |p: &[f32; 3]| -> u64 {
+        let c = |a: usize| (((p[a] as f64 - lo[a]) * inv) as u64) + 2;
+        (c(2) << 42) | (c(1) << 21) | c(0)
     };
-    let r2 = params.tolerance * params.tolerance;
-    let mut visited = vec![false; points.len()];
+    // (cell key, local position) packed into one u128, so the sort compares plain integers.
+    let mut packed: Vec<u128> = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| ((key_of(p) as u128) << 32) | i as u128)
+        .collect();
+    packed.sort_unstable();
+    let order: Vec<(u64, u32)> = packed
+        .iter()
+        .map(|&k| ((k >> 32) as u64, k as u32))
+        .collect();
+    drop(packed);
+    // Occupied cells: key and range into `sorted`.
+    let sorted: Vec<[f32; 3]> = order.iter().map(|&(_, i)| points[i as usize]).collect();
+    let mut cell_keys: Vec<u64> = Vec::new();
+    let mut cell_start: Vec<u32> = Vec::new();
+    for (k, &(key, _)) in order.iter().enumerate() {
+        if cell_keys.last() != Some(&key) {
+            cell_keys.push(key);
+            cell_start.push(k as u32);
+        }
+    }
+    cell_start.push(order.len() as u32);
+    let n_cells = cell_keys.len();
+    let members = |c: usize| &sorted[cell_start[c] as usize..cell_start[c + 1] as usize];
+    let touches = |a: usize, b: usize| {
+        let pb = members(b);
+        members(a).iter().any(|p| {
+            pb.iter().any(|q| {
+                let (dx, dy, dz) = (p[0] - q[0], p[1] - q[1], p[2] - q[2]);
+                dx * dx + dy * dy + dz * dz <= r2
+            })
+        })
+    };
+    let mut parent: Vec<u32> = (0..n_cells as u32).collect();
+    fn find(parent: &mut [u32], mut i: u32) -> u32 {
+        while parent[i as usize] != i {
+            let up = parent[parent[i as usize] as usize];
+            parent[i as usize] = up;
+            i = up;
+        }
+        i
+    }
+    // Forward rows: (dy, dz) with dz > 0, or dz = 0 and dy > 0; dx from −2 to 2.
+    let rows: Vec<u64> = (0..=2i64)
+        .flat_map(|dz| (-2..=2i64).map(move |dy| (dz, dy)))
+        .filter(|&(dz, dy)| dz > 0 || dy > 0)
+        .map(|(dz, dy)| ((dz << 42) + (dy << 21)) as u64)
+        .collect();
+    let mut cursors = vec![0usize; rows.len()];
+    for c in 0..n_cells {
+        let key = cell_keys[c];
+        let visit = |d: usize, parent: &mut Vec<u32>| {
+            let (rc, rd) = (find(parent, c as u32), find(parent, d as u32));
+            if rc != rd && touches(c, d) {
+                parent[rc.max(rd) as usize] = rc.min(rd);
+            }
+        };
+        // Same row, dx = 1, 2.
+        let mut d = c + 1;
+        while d < n_cells && cell_keys[d] <= key + 2 {
+            visit(d, &mut parent);
+            d += 1;
+        }
+        for (row, cur) in rows.iter().zip(cursors.iter_mut()) {
+            // Cell (x − 2, y + dy, z + dz); no field under- or overflows (coordinates start
+            // at 2 and stay below 2²¹ − 4).
+            let start = key + row - 2;
+            let end = start + 4;
+            while *cur < n_cells && cell_keys[*cur] < start {
+                *cur += 1;
+            }
+            let mut d = *cur;
+            while d < n_cells && cell_keys[d] <= end {
+                visit(d, &mut parent);
+                d += 1;
+            }
+        }
+    }
+    let mut labels = vec![0u32; points.len()];
+    for c in 0..n_cells {
+        let root = find(&mut parent, c as u32);
+        // Any point of the root cell labels the whole component.
+        let rep = order[cell_start[root as usize] as usize].1;
+        for &(_, i) in &order[cell_start[c] as usize..cell_start[c + 1] as usize] {
+            labels[i as usize] = rep;
+        }
+    }
+    Some(labels)
+}
+
+/// Components by flood fill over a k-d tree (kiddo): a component label (a local position)
+/// for every point. Used when the grid cannot be (zero tolerance, enormous extent).
+fn kdtree_components(points: &[[f32; 3]], tolerance: f32) -> Vec<u32> {
+    let mut labels = vec![u32::MAX; points.len()];
+    let tree = match ImmutableKdTree::<f32, 3>::new_from_slice(points) {
+        Ok(t) => t,
+        // Each point alone (kiddo refuses only degenerate inputs).
+        Err(_) => return (0..points.len() as u32).collect(),
+    };
+    let r2 = tolerance * tolerance;
     let mut queue: Vec<u32> = Vec::new();
-    let mut component: Vec<u32> = Vec::new();
-    let mut out = Vec::new();
     for seed in 0..points.len() {
-        if visited[seed] {
+        if labels[seed] != u32::MAX {
             continue;
         }
-        visited[seed] = true;
-        queue.clear();
-        component.clear();
+        labels[seed] = seed as u32;
         queue.push(seed as u32);
         while let Some(local) = queue.pop() {
-            component.push(local);
             tree.query(&points[local as usize])
                 .within::<SquaredEuclidean<f32>>(r2)
                 .unsorted()
                 .visit(|hit| {
                     let j = hit.item as usize;
-                    if !visited[j] {
-                        visited[j] = true;
+                    if labels[j] == u32::MAX {
+                        labels[j] = seed as u32;
                         queue.push(j as u32);
                     }
                 });
         }
-        if component.len() < params.min_points || component.len() > params.max_points {
-            continue;
-        }
-        // local positions are in ascending cloud-index order, so sorting them sorts indices
-        component.sort_unstable();
-        out.push(summarise(
-            component.iter().map(|&l| members[l as usize]),
-            xs,
-            ys,
-            zs,
-        ));
     }
-    // seeds run in ascending index order, so clusters already come by smallest index
-    out
+    labels
 }
 
 fn summarise(indices: impl Iterator<Item = u32>, xs: &[f32], ys: &[f32], zs: &[f32]) -> Cluster {
@@ -289,6 +448,87 @@ mod tests {
                 .collect();
             assert_eq!(got, reference, "subset trial {trial}");
         }
+    }
+
+    /// Partition of local positions implied by a label vector, in the reference's order.
+    fn partition(labels: &[u32]) -> Vec<Vec<u32>> {
+        let mut groups: std::collections::BTreeMap<u32, Vec<u32>> = Default::default();
+        for (i, &l) in labels.iter().enumerate() {
+            groups.entry(l).or_default().push(i as u32);
+        }
+        let mut out: Vec<Vec<u32>> = groups.into_values().collect();
+        out.sort_by_key(|g| g[0]);
+        out
+    }
+
+    #[test]
+    fn grid_matches_brute_force_on_dense_blobs_and_boundary_distances() {
+        let mut rng = seeded(8);
+        for trial in 0..20 {
+            // Dense blobs (many points per cell) plus points on a lattice whose spacing is
+            // exactly the tolerance, so that many pairs sit on the boundary of the test.
+            let tol = rng.random_range(0.1f32..1.0);
+            let mut cloud = PointCloud::new();
+            for _ in 0..4 {
+                let c: [f32; 3] = [
+                    rng.random_range(0.0..10.0),
+                    rng.random_range(0.0..10.0),
+                    rng.random_range(0.0..2.0),
+                ];
+                for _ in 0..150 {
+                    cloud.push(
+                        c[0] + rng.random_range(-0.5..0.5),
+                        c[1] + rng.random_range(-0.5..0.5),
+                        c[2] + rng.random_range(-0.2..0.2),
+                        0.0,
+                    );
+                }
+            }
+            for i in 0..10 {
+                for j in 0..3 {
+                    cloud.push(20.0 + i as f32 * tol, j as f32 * tol * 1.5, 1.0, 0.0);
+                }
+            }
+            let (xs, ys, zs, _) = cloud.columns();
+            let pts: Vec<[f32; 3]> = (0..cloud.len()).map(|i| [xs[i], ys[i], zs[i]]).collect();
+            let all: Vec<u32> = (0..cloud.len() as u32).collect();
+            let want = brute_force(&cloud, &all, tol);
+            let grid = grid_components(&pts, tol).expect("grid applies");
+            assert_eq!(partition(&grid), want, "grid, trial {trial}");
+            assert_eq!(
+                partition(&kdtree_components(&pts, tol)),
+                want,
+                "k-d tree, trial {trial}"
+            );
+        }
+    }
+
+    #[test]
+    fn zero_tolerance_and_huge_extent_use_the_kdtree() {
+        let mut cloud = PointCloud::new();
+        cloud.push(1.0, 1.0, 1.0, 0.0);
+        cloud.push(1.0, 1.0, 1.0, 0.0);
+        cloud.push(1.0, 1.0, 1.5, 0.0);
+        cloud.push(3.0e9, 0.0, 0.0, 0.0);
+        cloud.push(3.0e9, 0.0, 0.0, 0.0);
+        let (xs, ys, zs, _) = cloud.columns();
+        let pts: Vec<[f32; 3]> = (0..cloud.len()).map(|i| [xs[i], ys[i], zs[i]]).collect();
+        assert!(grid_components(&pts, 0.0).is_none());
+        assert!(grid_components(&pts, 0.5).is_none());
+        let params = |tolerance| ClusterParams {
+            tolerance,
+            min_points: 1,
+            max_points: 10,
+        };
+        let sets = |tol| -> Vec<Vec<u32>> {
+            euclidean_clusters(&cloud, &params(tol))
+                .unwrap()
+                .into_iter()
+                .map(|c| c.indices)
+                .collect()
+        };
+        assert_eq!(sets(0.0), vec![vec![0, 1], vec![2], vec![3, 4]]);
+        assert_eq!(sets(0.5), vec![vec![0, 1, 2], vec![3, 4]]);
     }
 
     #[test]

@@ -1,0 +1,391 @@
+//! One round of the sequential RANSAC of plane segmentation: subsample and its voxel grid,
+//! hypotheses from point triples, preemptive vectorised scoring, the MSSE inlier threshold
+//! and least-squares refits, with sums over points combined in a fixed chunk order.
+//!
+//! Not for: the sequence of rounds or the classification of planes (see the parent module).
+
+use super::PlaneConfig;
+use crate::geometry::Plane;
+use crate::rng::FilterRng;
+use nalgebra::{Matrix3, Point3, Vector3};
+use rand::RngExt;
+use rayon::prelude::*;
+
+/// Number of points per chunk for parallel passes over points. Fixed, so that sums are
+/// combined in the same order for every thread count.
+const CHUNK: usize = 4096;
+
+/// Plane with f32 coefficients for fast residuals.
+#[derive(Copy, Clone)]
+pub(super) struct PlaneF32 {
+    n: [f32; 3],
+    d: f32,
+}
+
+impl PlaneF32 {
+    pub(super) fn new(p: &Plane) -> Self {
+        PlaneF32 {
+            n: [p.normal.x as f32, p.normal.y as f32, p.normal.z as f32],
+            d: p.offset as f32,
+        }
+    }
+    #[inline]
+    pub(super) fn residual_signed(&self, p: &[f32; 3]) -> f32 {
+        self.n[0] * p[0] + self.n[1] * p[1] + self.n[2] * p[2] + self.d
+    }
+    #[inline]
+    fn residual(&self, p: &[f32; 3]) -> f32 {
+        (self.n[0] * p[0] + self.n[1] * p[1] + self.n[2] * p[2] + self.d).abs()
+    }
+}
+
+/// One RANSAC round on the pool `active`: the refined plane and its inliers (local indices),
+/// or `None` when no plane with `min_points` inliers is found.
+pub(super) fn one_round(
+    pts: &[[f32; 3]],
+    active: &[u32],
+    pool: &[u32],
+    min_tilt: f64,
+    config: &PlaneConfig,
+    rng: &mut FilterRng,
+) -> Option<(Plane, Vec<u32>)> {
+    // 1. Subsample (with replacement when the pool is small) and voxel grid.
+    let m = config.score_sample.min(pool.len());
+    let sample: Vec<[f32; 3]> = if m == pool.len() {
+        pool.iter().map(|&i| pts[i as usize]).collect()
+    } else {
+        (0..m)
+            .map(|_| pts[pool[rng.random_range(0..pool.len())] as usize])
+            .collect()
+    };
+    let cells = SampleCells::new(&sample, config.sample_cell as f32);
+
+    // 2. Hypotheses, drawn sequentially.
+    let mut hyps: Vec<PlaneF32> = Vec::with_capacity(config.hypotheses);
+    let mut attempts = 0usize;
+    while hyps.len() < config.hypotheses && attempts < config.hypotheses * 20 {
+        attempts += 1;
+        let a = rng.random_range(0..m);
+        let cell = cells.members_with(a);
+        if cell.len() < 3 {
+            continue;
+        }
+        let b = cell[rng.random_range(0..cell.len())] as usize;
+        let c = cell[rng.random_range(0..cell.len())] as usize;
+        if a == b || b == c || a == c {
+            continue;
+        }
+        let to64 = |p: &[f32; 3]| Vector3::new(p[0] as f64, p[1] as f64, p[2] as f64);
+        let (pa, pb, pc) = (to64(&sample[a]), to64(&sample[b]), to64(&sample[c]));
+        let n = (pb - pa).cross(&(pc - pa));
+        if n.norm() < 1e-6 {
+            continue;
+        }
+        if let Ok(p) = Plane::from_point_normal(&Point3::from(pa), n) {
+            if p.tilt() >= min_tilt {
+                hyps.push(PlaneF32::new(&p));
+            }
+        }
+    }
+    if hyps.is_empty() {
+        return None;
+    }
+
+    // 3. Score in parallel into an ordered vector; best = most support, earliest on ties.
+    let thr = config.score_threshold as f32;
+    let stride = m.div_ceil(config.preemptive_sample);
+    if hyps.len() > config.preemptive_keep && stride > 1 {
+        let part: Vec<[f32; 3]> = sample.iter().step_by(stride).copied().collect();
+        let part = Columns::of(&part);
+        let pre: Vec<usize> = hyps
+            .par_iter()
+            .with_min_len(8)
+            .map(|h| part.support(h, thr))
+            .collect();
+        let mut rank: Vec<usize> = (0..hyps.len()).collect();
+        rank.sort_by(|&a, &b| pre[b].cmp(&pre[a]).then(a.cmp(&b)));
+        rank.truncate(config.preemptive_keep);
+        rank.sort_unstable();
+        hyps = rank.into_iter().map(|k| hyps[k]).collect();
+    }
+    let soa = Columns::of(&sample);
+    let scores: Vec<usize> = hyps
+        .par_iter()
+        .with_min_len(4)
+        .map(|h| soa.support(h, thr))
+        .collect();
+    let (best, best_score) = scores
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.cmp(b.1).then(b.0.cmp(&a.0)))
+        .map(|(i, s)| (i, *s))?;
+    // Expected support in the whole pool far below min_points: stop early.
+    let expected = best_score as f64 * pool.len() as f64 / m as f64;
+    if expected < 0.5 * config.min_points as f64 {
+        return None;
+    }
+
+    // 4. MSSE threshold, inliers, refit; twice.
+    let mut plane = hyps[best];
+    let mut fitted: Option<Plane> = None;
+    let mut inliers: Vec<u32> = Vec::new();
+    for _ in 0..2 {
+        let residuals = residuals_chunked(pts, active, &plane);
+        let tau = msse_threshold(&residuals, config);
+        inliers = active
+            .iter()
+            .zip(&residuals)
+            .filter(|(_, &r)| r <= tau)
+            .map(|(&i, _)| i)
+            .collect();
+        if inliers.len() < config.min_points {
+            return None;
+        }
+        let p = fit_chunked(pts, &inliers)?;
+        plane = PlaneF32::new(&p);
+        fitted = Some(p);
+    }
+    fitted.map(|p| (p, inliers))
+}
+
+/// The subsample's voxel grid: sample indices sorted by cell (ascending within a cell), so
+/// that the members of the cell of any sample point are one contiguous slice.
+struct SampleCells {
+    /// Sample indices ordered by (cell, index).
+    order: Vec<u32>,
+    /// Per sample index: the range of its cell in `order`.
+    range_of: Vec<(u32, u32)>,
+}
+
+impl SampleCells {
+    fn new(sample: &[[f32; 3]], cell: f32) -> Self {
+        let inv = 1.0 / cell;
+        // (cell x, cell y, cell z, index) packed into one u128 whose order is the order of
+        // the tuple: flipping the sign bit maps i32 order onto u32 order.
+        let ordered = |v: f32| (floor_i32(v * inv) as u32 ^ 0x8000_0000) as u128;
+        let mut keyed: Vec<u128> = sample
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                (ordered(p[0]) << 96) | (ordered(p[1]) << 64) | (ordered(p[2]) << 32) | i as u128
+            })
+            .collect();
+        keyed.sort_unstable();
+        let order: Vec<u32> = keyed.iter().map(|&k| k as u32).collect();
+        let mut range_of = vec![(0u32, 0u32); sample.len()];
+        let mut start = 0usize;
+        while start < keyed.len() {
+            let cell_of = |k: u128| k >> 32;
+            let key = cell_of(keyed[start]);
+            let mut end = start + 1;
+            while end < keyed.len() && cell_of(keyed[end]) == key {
+                end += 1;
+            }
+            for &i in &order[start..end] {
+                range_of[i as usize] = (start as u32, end as u32);
+            }
+            start = end;
+        }
+        SampleCells { order, range_of }
+    }
+
+    /// Sample indices in the cell of sample point `i`, ascending.
+    fn members_with(&self, i: usize) -> &[u32] {
+        let (a, b) = self.range_of[i];
+        &self.order[a as usize..b as usize]
+    }
+}
+
+/// `v.floor() as i32` (saturating) without a libm call.
+#[inline]
+fn floor_i32(v: f32) -> i32 {
+    let t = v as i32;
+    t.saturating_sub((v < t as f32) as i32)
+}
+
+/// Points as three contiguous coordinate columns, for vectorised residual counts.
+struct Columns {
+    x: Vec<f32>,
+    y: Vec<f32>,
+    z: Vec<f32>,
+}
+
+impl Columns {
+    fn of(points: &[[f32; 3]]) -> Self {
+        Columns {
+            x: points.iter().map(|p| p[0]).collect(),
+            y: points.iter().map(|p| p[1]).collect(),
+            z: points.iter().map(|p| p[2]).collect(),
+        }
+    }
+
+    /// Number of points with `|n·p + d| < thr` (the same arithmetic as
+    /// [`PlaneF32::residual`]), written as a plain indexed reduction so that it vectorises.
+    fn support(&self, h: &PlaneF32, thr: f32) -> usize {
+        let [a, b, c] = h.n;
+        let d = h.d;
+        let n = self.x.len();
+        let (xs, ys, zs) = (&self.x[..n], &self.y[..n], &self.z[..n]);
+        let mut count = 0u32;
+        for i in 0..n {
+            count += ((a * xs[i] + b * ys[i] + c * zs[i] + d).abs() < thr) as u32;
+        }
+        count as usize
+    }
+}
+
+/// Absolute residuals of the points `idx` to `plane`, in the order of `idx`.
+fn residuals_chunked(pts: &[[f32; 3]], idx: &[u32], plane: &PlaneF32) -> Vec<f32> {
+    let mut out = vec![0.0f32; idx.len()];
+    out.par_chunks_mut(CHUNK)
+        .zip(idx.par_chunks(CHUNK))
+        .for_each(|(o, ix)| {
+            for (r, &i) in o.iter_mut().zip(ix) {
+                *r = plane.residual(&pts[i as usize]);
+            }
+        });
+    out
+}
+
+/// Inlier threshold from the MSSE scale of the sorted residuals (see the module docs).
+fn msse_threshold(residuals: &[f32], config: &PlaneConfig) -> f32 {
+    let (lo, hi) = (config.min_threshold, config.max_threshold);
+    // The residuals up to `lo` only enter through their count and sum of squares; only those
+    // in (lo, hi] need sorting. Residuals are non-negative, so their bit patterns sort like
+    // their values.
+    let mut low = 0usize;
+    let mut low_sq = 0.0f64;
+    let mut high: Vec<u32> = Vec::new();
+    for &r in residuals {
+        let x = r as f64;
+        if x <= lo {
+            low += 1;
+            low_sq += x * x;
+        } else if x <= hi {
+            high.push(r.to_bits());
+        }
+    }
+    high.sort_unstable();
+    let high: Vec<f64> = high.iter().map(|&b| f32::from_bits(b) as f64).collect();
+    if low >= MSSE_START {
+        return msse_grow(low, low_sq, &high, config);
+    }
+    // Fewer than MSSE_START residuals below `lo`: start from the smallest MSSE_START overall.
+    let take = (MSSE_START - low).min(high.len());
+    let sq: f64 = high[..take].iter().map(|x| x * x).sum();
+    if low + take < MSSE_START {
+        return hi as f32;
+    }
+    msse_grow(low + take, low_sq + sq, &high[take..], config)
+}
+
+/// Parameters of the fitted model (a plane) in the MSSE scale `σ_k² = Σ r² / (k − P)`.
+const MSSE_P: usize = 3;
+/// Smallest number of residuals the MSSE scale starts from.
+const MSSE_START: usize = MSSE_P + 2;
+
+/// MSSE growth from the `k` smallest residuals (sum of squares `sum_sq`) through the next
+/// ones, `rest`, ascending: stops before the first residual above `T·σ_k`.
+fn msse_grow(mut k: usize, mut sum_sq: f64, rest: &[f64], config: &PlaneConfig) -> f32 {
+    let (lo, hi, t) = (config.min_threshold, config.max_threshold, config.msse_t);
+    let mut next = 0;
+    while next < rest.len() {
+        let r = rest[next];
+        let sigma2 = sum_sq / (k - MSSE_P) as f64;
+        if r * r > t * t * sigma2 {
+            break;
+        }
+        sum_sq += r * r;
+        k += 1;
+        next += 1;
+    }
+    if next == rest.len() {
+        return hi as f32;
+    }
+    let sigma = (sum_sq / (k - MSSE_P) as f64).sqrt();
+    (t * sigma).clamp(lo, hi) as f32
+}
+
+/// Least-squares plane through the points `idx`, with sums per fixed chunk combined in order.
+pub(super) fn fit_chunked(pts: &[[f32; 3]], idx: &[u32]) -> Option<Plane> {
+    if idx.len() < 3 {
+        return None;
+    }
+    // Shift by the first point for numerical accuracy.
+    let o = pts[idx[0] as usize];
+    let partial: Vec<([f64; 3], [f64; 6])> = idx
+        .par_chunks(CHUNK)
+        .map(|ix| {
+            let mut s = [0.0f64; 3];
+            let mut q = [0.0f64; 6];
+            for &i in ix {
+                let p = pts[i as usize];
+                let (x, y, z) = (
+                    (p[0] - o[0]) as f64,
+                    (p[1] - o[1]) as f64,
+                    (p[2] - o[2]) as f64,
+                );
+                s[0] += x;
+                s[1] += y;
+                s[2] += z;
+                q[0] += x * x;
+                q[1] += x * y;
+                q[2] += x * z;
+                q[3] += y * y;
+                q[4] += y * z;
+                q[5] += z * z;
+            }
+            (s, q)
+        })
+        .collect();
+    let mut s = [0.0f64; 3];
+    let mut q = [0.0f64; 6];
+    for (ps, pq) in &partial {
+        for k in 0..3 {
+            s[k] += ps[k];
+        }
+        for k in 0..6 {
+            q[k] += pq[k];
+        }
+    }
+    let n = idx.len() as f64;
+    let c = Vector3::new(s[0] / n, s[1] / n, s[2] / n);
+    let cov = Matrix3::new(
+        q[0] / n - c.x * c.x,
+        q[1] / n - c.x * c.y,
+        q[2] / n - c.x * c.z,
+        q[1] / n - c.x * c.y,
+        q[3] / n - c.y * c.y,
+        q[4] / n - c.y * c.z,
+        q[2] / n - c.x * c.z,
+        q[4] / n - c.y * c.z,
+        q[5] / n - c.z * c.z,
+    );
+    let centroid = c + Vector3::new(o[0] as f64, o[1] as f64, o[2] as f64);
+    Plane::from_moments(&centroid, &cov).ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::seeded;
+    use rand_distr::{Distribution, Normal};
+
+    #[test]
+    fn msse_threshold_tracks_noise_scale() {
+        let mut rng = seeded(3);
+        let noise = Normal::new(0.0, 0.03).unwrap();
+        let mut r: Vec<f32> = (0..5000)
+            .map(|_| (noise.sample(&mut rng) as f32).abs())
+            .collect();
+        r.extend((0..5000).map(|_| rng.random_range(0.0f32..5.0)));
+        let cfg = PlaneConfig {
+            min_threshold: 0.01,
+            max_threshold: 0.5,
+            ..Default::default()
+        };
+        let t = msse_threshold(&r, &cfg);
+        // About 2.5 σ of a Gaussian with σ = 0.03.
+        assert!(t > 0.05 && t < 0.11, "{t}");
+    }
+}
