@@ -20,8 +20,14 @@
 //! assert_eq!(segments.len(), 1);
 //! ```
 
+pub mod background;
 pub mod carmen;
 pub mod csv;
+pub mod features;
+pub mod fuzzy_art;
+pub mod icp;
+pub mod moving;
+pub mod rigid;
 pub mod rosbag;
 pub mod scan;
 pub mod segment;
