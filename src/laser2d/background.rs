@@ -21,12 +21,17 @@
 //!    (0.4 m) and `σ` the standard deviation of the beam's last ten background ranges
 //!    (capped at [`BackgroundConfig::max_spread`]): `r < r_b − τ` is *foreground* (a
 //!    candidate), `r ≥ r_b + τ` is *beyond* (the background was not static), anything else
-//!    is *background*. A "no return" reading counts as `r = +∞`.
+//!    is *background*. A "no return" reading counts as `r = +∞`. With
+//!    [`BackgroundConfig::neighbour_beams`] `k > 0` the foreground test uses the nearest
+//!    background among the beams `i − k ..= i + k` instead of `r_b` (not in the seed: it
+//!    keeps bearing noise at depth edges and on grazing walls from making candidates).
 //! 3. [`BackgroundMap::update`] applies seed 003 eqs. 4 and 6: background → `r_b = r`,
 //!    weight + 1 (at most 20); beyond → `r_b = r`, weight 20; foreground → `r_b` kept, weight
 //!    − 1 (at least 1), and once the weight is 1 the background is renewed with `r`.
 //!    Foreground beams the caller marks as occluded by a verified target keep their weight
-//!    (end of Sec. II-C). The resulting `r_b` joins the beam's history.
+//!    (end of Sec. II-C). *Uncertain* beams (see [`BeamClass::Uncertain`]) change nothing:
+//!    taking their return as background would let an object's own returns spread into the
+//!    background of its neighbours. The resulting `r_b` joins the beam's history.
 //!
 //! The history of the last ten values stays with the beam *index* (a fixed bearing in the
 //! sensor frame) and is not moved in step 1, so that it widens the tolerance while the robot
@@ -54,6 +59,10 @@ pub struct BackgroundConfig {
     /// Empty beams after propagation are filled from neighbours up to this many beams away.
     /// Default 2.
     pub fill_gap: usize,
+    /// A return is foreground only when it is nearer than the background of every beam
+    /// within ±this many beams (by more than the tolerance). 0 is seed 003's beam-by-beam
+    /// test; a few beams absorb bearing noise at depth edges and grazing walls. Default 0.
+    pub neighbour_beams: usize,
 }
 
 impl Default for BackgroundConfig {
@@ -63,6 +72,7 @@ impl Default for BackgroundConfig {
             max_weight: 20,
             max_spread: 1.0,
             fill_gap: 2,
+            neighbour_beams: 0,
         }
     }
 }
@@ -91,6 +101,10 @@ pub enum BeamClass {
     Beyond,
     /// Nearer than the background by more than the tolerance: a moving-object candidate.
     Foreground,
+    /// Nearer than its own beam's background by more than the tolerance, but not nearer
+    /// than a neighbouring beam's (only with [`BackgroundConfig::neighbour_beams`] > 0):
+    /// no candidate, and the beam's background and weight stay as they are.
+    Uncertain,
 }
 
 /// The background map; see the module documentation.
@@ -314,15 +328,23 @@ impl BackgroundMap {
                 ),
             ));
         }
+        let k = self.config.neighbour_beams;
         for i in 0..n {
             let tau = self.config.delta + self.spread(i).min(self.config.max_spread);
             self.tolerance[i] = tau as f32;
             let rb = f64::from(self.range[i]);
             let r = f64::from(reading(scan, i));
+            // The nearest background within ±k beams (NaN = new beams are skipped).
+            let near_b = self.range[i.saturating_sub(k)..(i + k + 1).min(n)]
+                .iter()
+                .filter(|v| !v.is_nan())
+                .fold(f64::INFINITY, |m, &v| m.min(f64::from(v)));
             self.class[i] = if rb.is_nan() || (r.is_infinite() && rb.is_infinite()) {
                 BeamClass::Background
-            } else if r < rb - tau {
+            } else if r < near_b - tau {
                 BeamClass::Foreground
+            } else if r < rb - tau {
+                BeamClass::Uncertain
             } else if r >= rb + tau {
                 BeamClass::Beyond
             } else {
@@ -364,6 +386,7 @@ impl BackgroundMap {
                     self.range[i] = r;
                     self.weight[i] = max_w;
                 }
+                BeamClass::Uncertain => {}
                 BeamClass::Foreground => {
                     if !occluded_by_target.get(i).copied().unwrap_or(false) {
                         self.weight[i] = self.weight[i].saturating_sub(1).max(1);

@@ -167,6 +167,16 @@ impl Icp {
         Ok(())
     }
 
+    /// Distance from `p` to the nearest target point, `None` without a target.
+    pub fn nearest_target_distance(&self, p: [f64; 2]) -> Option<f64> {
+        let tree = self.tree.as_ref()?;
+        let nn = tree
+            .query(&p)
+            .nearest_one::<SquaredEuclidean<f64>>()
+            .execute();
+        Some(nn.distance.sqrt())
+    }
+
     /// Aligns `source` to the current target starting from `initial`. Errors when the
     /// target is empty, a source point is not finite, or fewer than
     /// [`IcpConfig::min_pairs`] pairs survive the gates.

@@ -9,16 +9,20 @@
 //!
 //! 1. **Pose.** The sensor pose is the odometry pose composed with the mounting offset. The
 //!    odometry increment since the previous scan predicts the new sensor pose from the
-//!    previous *corrected* one; ICP then aligns the scan's returns with the current key scan
-//!    (seed 003 uses the previous scan; matching against a key scan that is replaced only
-//!    after [`MovingDetectorConfig::keyframe_distance`] or
-//!    [`MovingDetectorConfig::keyframe_angle`] keeps per-scan matching noise from adding up).
+//!    previous *corrected* one; ICP then aligns the scan's returns with a local map of the
+//!    static returns seen so far (cell means, see the local-map module). Seed 003 matches
+//!    against the previous scan only; with a noisy scanner the per-pair errors of
+//!    scan-to-scan matching add up to more drift than the odometry has, while the map's
+//!    averaged cells keep the error bounded. Scans with fewer than
+//!    [`MovingDetectorConfig::min_icp_points`] returns are not matched.
 //!    The ICP result is used when it converged within the gates
 //!    [`MovingDetectorConfig::max_correction`] / [`MovingDetectorConfig::max_correction_angle`]
 //!    of the prediction with at least [`MovingDetectorConfig::min_inlier_fraction`] inliers;
-//!    otherwise the prediction stands and the key scan is replaced.
+//!    otherwise the prediction stands.
 //! 2. **Background** (Sec. II): the background map is carried along the corrected motion and
-//!    splits the beams; foreground returns are the candidates.
+//!    splits the beams; foreground returns are the candidates, unless they lie within
+//!    [`MovingDetectorConfig::static_map_radius`] of the local map (static surfaces seen
+//!    before, now reappearing from a new viewpoint; not in the seed).
 //! 3. **Clusters** (Sec. III): candidates closer than [`MovingDetectorConfig::cluster_gap`]
 //!    to one of the candidates up to [`MovingDetectorConfig::cluster_window`] beams before
 //!    them share a cluster; clusters with fewer than
@@ -39,6 +43,8 @@
 //!    moving target when its category is dominant and, with
 //!    [`MovingDetectorConfig::require_persistence`], it persists.
 //! 5. The background is updated (eqs. 4, 6); beams of moving targets keep their weights.
+//!    Returns that are not foreground and whose beam weight reached
+//!    [`MovingDetectorConfig::map_min_weight`] join the local map (world frame).
 //!
 //! Everything is deterministic: no randomness, fixed iteration orders.
 
@@ -46,6 +52,7 @@ use super::background::{BackgroundConfig, BackgroundMap, BeamClass};
 use super::features::{normalise, segment_features, Features, SegmentContext, NUM_FEATURES};
 use super::fuzzy_art::{FuzzyArt, FuzzyArtConfig};
 use super::icp::{Icp, IcpConfig, IcpFit};
+use super::local_map::LocalMap;
 use super::rigid::{between, compose, inverse, transform_point};
 use super::scan::{Pose2, Scan};
 use crate::error::{ensure_positive, Error, Result};
@@ -57,23 +64,35 @@ pub struct MovingDetectorConfig {
     pub mount: [f64; 2],
     /// ICP parameters.
     pub icp: IcpConfig,
-    /// A new key scan after the sensor moved this far from the current one (m). Default 1 m.
-    pub keyframe_distance: f64,
-    /// ... or turned this much (rad). Default 0.3 rad.
-    pub keyframe_angle: f64,
+    /// Side of the local map's cells (m). Default 0.2 m.
+    pub map_cell: f64,
+    /// Returns enter the map once their beam's background weight reaches this. Default 2
+    /// (so the first scan builds the map).
+    pub map_min_weight: u8,
+    /// Map cells farther than this from the sensor are dropped every 20 scans (m).
+    /// Default 30 m.
+    pub map_radius: f64,
+    /// Scans with fewer returns are not matched (odometry only). Default 80.
+    pub min_icp_points: usize,
     /// ICP results farther than this from the odometry prediction are rejected (m).
-    /// Default 0.5 m.
+    /// Default 0.3 m.
     pub max_correction: f64,
-    /// ... or turning more than this away from it (rad). Default 0.1 rad.
+    /// ... or turning more than this away from it (rad). Default 0.05 rad.
     pub max_correction_angle: f64,
     /// ICP results with fewer inliers (fraction of the scan's returns) are rejected.
-    /// Default 0.3.
+    /// Default 0.5.
     pub min_inlier_fraction: f64,
     /// The background map.
     pub background: BackgroundConfig,
-    /// Largest distance between neighbouring candidates of one cluster (m). Default 0.5 m.
+    /// Foreground returns closer than this to a cell of the local map (static returns seen
+    /// before, world frame) are not candidates (m); 0 turns the test off. Not in seed 003:
+    /// it removes static surfaces that reappear in front of the propagated background as the
+    /// robot's viewpoint changes. Default 0.3 m.
+    pub static_map_radius: f64,
+    /// Largest distance between neighbouring candidates of one cluster (m). Default 0.6 m.
     pub cluster_gap: f64,
-    /// Candidates are linked to candidates up to this many beams back. Default 3.
+    /// Candidates are linked to candidates up to this many beams back. Default 12 (bearing
+    /// noise shuffles the beam order of a small object's returns).
     pub cluster_window: usize,
     /// Smallest cluster (points). Default 3.
     pub min_cluster_points: usize,
@@ -101,14 +120,17 @@ impl Default for MovingDetectorConfig {
         MovingDetectorConfig {
             mount: [0.0, 0.0],
             icp: IcpConfig::default(),
-            keyframe_distance: 1.0,
-            keyframe_angle: 0.3,
-            max_correction: 0.5,
-            max_correction_angle: 0.1,
-            min_inlier_fraction: 0.3,
+            map_cell: 0.2,
+            map_min_weight: 2,
+            map_radius: 30.0,
+            min_icp_points: 80,
+            max_correction: 0.3,
+            max_correction_angle: 0.05,
+            min_inlier_fraction: 0.5,
             background: BackgroundConfig::default(),
-            cluster_gap: 0.5,
-            cluster_window: 3,
+            static_map_radius: 0.3,
+            cluster_gap: 0.6,
+            cluster_window: 12,
             min_cluster_points: 3,
             smoothing: 2,
             minima_window: 4,
@@ -123,6 +145,28 @@ impl Default for MovingDetectorConfig {
 }
 
 impl MovingDetectorConfig {
+    /// Defaults for a scanner with bearing noise `sigma_bearing` (rad) and beam spacing
+    /// `angle_increment` (rad) mounted at `mount` on the robot: the background's
+    /// neighbourhood test spans one bearing standard deviation, `⌈σ_b / |Δθ|⌉` beams (at
+    /// most 10; on the simulated scanner, σ_b = 2° and 0.5° beams, 4 beams gave the best
+    /// precision for its recall among 0, 2, 3, 4 and 6).
+    pub fn for_scanner(sigma_bearing: f64, angle_increment: f64, mount: [f64; 2]) -> Self {
+        let beams = (sigma_bearing / angle_increment.abs()).ceil();
+        let neighbour_beams = if beams.is_finite() && beams > 0.0 {
+            (beams as usize).min(10)
+        } else {
+            0
+        };
+        MovingDetectorConfig {
+            mount,
+            background: BackgroundConfig {
+                neighbour_beams,
+                ..BackgroundConfig::default()
+            },
+            ..MovingDetectorConfig::default()
+        }
+    }
+
     /// Checks every part.
     pub fn validate(&self) -> Result<()> {
         if !self.mount.iter().all(|v| v.is_finite()) {
@@ -135,8 +179,8 @@ impl MovingDetectorConfig {
         self.background.validate()?;
         self.art.validate()?;
         for (name, v) in [
-            ("keyframe_distance", self.keyframe_distance),
-            ("keyframe_angle", self.keyframe_angle),
+            ("map_cell", self.map_cell),
+            ("map_radius", self.map_radius),
             ("max_correction", self.max_correction),
             ("max_correction_angle", self.max_correction_angle),
             ("cluster_gap", self.cluster_gap),
@@ -144,6 +188,10 @@ impl MovingDetectorConfig {
         ] {
             ensure_positive(&format!("MovingDetectorConfig::{name}"), v)?;
         }
+        crate::error::ensure_non_negative(
+            "MovingDetectorConfig::static_map_radius",
+            self.static_map_radius,
+        )?;
         if !(0.0..=1.0).contains(&self.min_inlier_fraction) {
             return Err(Error::invalid(
                 "MovingDetectorConfig::min_inlier_fraction",
@@ -194,7 +242,7 @@ pub struct MovingDetections {
     pub kept_clusters: usize,
     /// Returns classified as foreground (candidates).
     pub candidate_points: usize,
-    /// Returns classified as background or beyond.
+    /// Returns not classified as foreground.
     pub background_points: usize,
 }
 
@@ -219,7 +267,7 @@ pub struct MovingObjectDetector {
     scans: u64,
     /// Previous scan: raw odometry sensor pose, corrected sensor pose, time.
     previous: Option<(Pose2, Pose2, f64)>,
-    keyframe_pose: Pose2,
+    map: LocalMap,
     previous_centroids: Vec<[f64; 2]>,
     // Scratch.
     points: Vec<[f64; 2]>,
@@ -239,7 +287,7 @@ impl MovingObjectDetector {
             votes: Vec::new(),
             scans: 0,
             previous: None,
-            keyframe_pose: Pose2::new(0.0, 0.0, 0.0),
+            map: LocalMap::new(config.map_cell)?,
             previous_centroids: Vec::new(),
             points: Vec::new(),
             sensor_points: Vec::new(),
@@ -286,20 +334,14 @@ impl MovingObjectDetector {
         }
         // 1. Pose.
         let (sensor_pose, icp_fit, dt) = match self.previous {
-            None => {
-                self.reset_keyframe(sensor_odometry)?;
-                (sensor_odometry, None, 0.0)
-            }
+            None => (sensor_odometry, None, 0.0),
             Some((prev_odometry, prev_corrected, prev_time)) => {
                 let predicted = compose(prev_corrected, between(prev_odometry, sensor_odometry));
-                let (pose, fit) = self.correct(predicted);
-                let pose_from_key = between(self.keyframe_pose, pose);
-                if fit.is_none()
-                    || pose_from_key.x.hypot(pose_from_key.y) > self.config.keyframe_distance
-                    || pose_from_key.theta.abs() > self.config.keyframe_angle
-                {
-                    self.reset_keyframe(pose)?;
-                }
+                let (pose, fit) = if self.points.len() >= self.config.min_icp_points {
+                    self.correct(predicted)
+                } else {
+                    (predicted, None)
+                };
                 self.background.propagate(between(prev_corrected, pose))?;
                 (pose, fit, scan.time - prev_time)
             }
@@ -309,10 +351,16 @@ impl MovingObjectDetector {
         let mut candidates = Vec::new();
         let mut background_points = 0;
         for (i, c) in classes.iter().enumerate() {
-            if self.sensor_points[i].is_some() {
-                match c {
-                    BeamClass::Foreground => candidates.push(i),
-                    _ => background_points += 1,
+            if let Some(p) = self.sensor_points[i] {
+                let on_map = self.config.static_map_radius > 0.0
+                    && self
+                        .icp
+                        .nearest_target_distance(transform_point(sensor_pose, p))
+                        .is_some_and(|d| d <= self.config.static_map_radius);
+                if *c == BeamClass::Foreground && !on_map {
+                    candidates.push(i);
+                } else {
+                    background_points += 1;
                 }
             }
         }
@@ -374,8 +422,9 @@ impl MovingObjectDetector {
         self.previous_centroids.clear();
         self.previous_centroids
             .extend(kept.iter().map(|k| k.centroid));
-        // 5. Background update.
+        // 5. Background update, then the map for the next scan's ICP.
         self.background.update(scan, &self.occluded)?;
+        self.grow_map(sensor_pose)?;
         self.previous = Some((sensor_odometry, sensor_pose, scan.time));
         Ok(MovingDetections {
             pose: compose(sensor_pose, inverse(mount)),
@@ -388,10 +437,10 @@ impl MovingObjectDetector {
         })
     }
 
-    /// ICP of the scan's returns against the key scan from the predicted pose; the corrected
-    /// pose and the fit when it passed the gates, else the prediction.
+    /// ICP of the scan's returns against the local map from the predicted pose; the
+    /// corrected pose and the fit when it passed the gates, else the prediction.
     fn correct(&mut self, predicted: Pose2) -> (Pose2, Option<IcpFit>) {
-        let initial = between(self.keyframe_pose, predicted);
+        let initial = predicted;
         let c = self.config;
         match self.icp.align(&self.points, initial) {
             Ok(fit) => {
@@ -401,7 +450,7 @@ impl MovingObjectDetector {
                     && d.theta.abs() <= c.max_correction_angle
                     && fit.inlier_fraction >= c.min_inlier_fraction;
                 if ok {
-                    (compose(self.keyframe_pose, fit.transform), Some(fit))
+                    (fit.transform, Some(fit))
                 } else {
                     (predicted, None)
                 }
@@ -410,9 +459,25 @@ impl MovingObjectDetector {
         }
     }
 
-    fn reset_keyframe(&mut self, pose: Pose2) -> Result<()> {
-        self.keyframe_pose = pose;
-        self.icp.set_target(&self.points)
+    /// Adds the scan's settled static returns to the local map, prunes it now and then and
+    /// makes it the ICP target.
+    fn grow_map(&mut self, sensor_pose: Pose2) -> Result<()> {
+        let classes = self.background.classes();
+        let weights = self.background.weights();
+        for (i, p) in self.sensor_points.iter().enumerate() {
+            if let Some(p) = *p {
+                let settled = matches!(classes[i], BeamClass::Background | BeamClass::Beyond);
+                if settled && weights[i] >= self.config.map_min_weight {
+                    self.map.insert(transform_point(sensor_pose, p));
+                }
+            }
+        }
+        if self.scans.is_multiple_of(20) {
+            self.map
+                .prune([sensor_pose.x, sensor_pose.y], self.config.map_radius);
+        }
+        let target = self.map.means(1);
+        self.icp.set_target(target)
     }
 
     /// Distance clustering of the candidate beams (see the module docs); clusters in order
@@ -578,7 +643,7 @@ mod tests {
             let person = (k >= 5).then(|| [3.0, -2.0 + 0.1 * k as f64]);
             let d = det.process(&room_scan(t, person), still).unwrap();
             // A static robot in a static room: the pose never moves.
-            assert!(d.pose.x.abs() < 1e-6 && d.pose.y.abs() < 1e-6 && d.pose.theta.abs() < 1e-6);
+            assert!(d.pose.x.abs() < 0.01 && d.pose.y.abs() < 0.01 && d.pose.theta.abs() < 1e-3);
             for c in &d.clusters {
                 let p = person.expect("no detection without a person");
                 let err = (c.centroid[0] - p[0]).hypot(c.centroid[1] - p[1]);
@@ -604,7 +669,8 @@ mod tests {
                 "{:?}",
                 d.pose
             );
-            assert!(d.pose.theta.abs() < 1e-3, "{:?}", d.pose);
+            // The drift the odometry would have reached by the last scan: 3.8°.
+            assert!(d.pose.theta.abs() < 3e-3, "{:?}", d.pose);
             assert!(d.clusters.is_empty());
         }
     }
