@@ -100,8 +100,13 @@ fn lobby_static_structure_is_removed_and_people_are_found() {
             score.visible
         );
         assert!(score.visible > 500);
-        assert!(score.precision() >= 0.0, "precision {}", score.precision());
-        assert!(score.recall() >= 0.0, "recall {}", score.recall());
+        // Measured (seeds 1, 2): precision 0.867 and 0.895, recall 0.225 and 0.190. The
+        // simulated scanner's 2° bearing noise scatters the 3–6 returns of a person more than
+        // 4 m away over as many beams as the person covers, so most distant people never form
+        // a cluster of three candidates holding a local minimum; nearly every reported
+        // cluster is a person. Bounds leave margin for other noise draws.
+        assert!(score.precision() >= 0.75, "precision {}", score.precision());
+        assert!(score.recall() >= 0.12, "recall {}", score.recall());
     }
 }
 
@@ -134,6 +139,7 @@ fn icp_keeps_the_pose_closer_to_the_truth_than_odometry() {
         });
     }
     let lobby = PeopleScenario::two();
+    let (mut sum_odometry, mut sum_corrected) = (0.0, 0.0);
     for (name, scenario) in [("open", &base), ("hall", &hall), ("lobby", &lobby)] {
         for seed in [1u64, 2] {
             let run = scenario.generate(seed).unwrap();
@@ -150,7 +156,23 @@ fn icp_keeps_the_pose_closer_to_the_truth_than_odometry() {
                 "{name} seed {seed}: final error odometry {odo:.3} m, \
                  corrected {cor:.3} m (max {max_cor:.3} m)"
             );
-            assert!(odo > 0.0);
+            if name == "open" {
+                // Too few returns to match: the detector keeps the odometry as it is.
+                assert!((cor - odo).abs() < 1e-9, "{cor} vs {odo}");
+            } else {
+                // Measured: at most 0.99 m over the hall and lobby runs, while the odometry
+                // drifts without bound (1.31 m after 30 s in the hall, seed 1).
+                assert!(max_cor < 1.2, "{name} seed {seed}: {max_cor}");
+                sum_odometry += odo;
+                sum_corrected += cor;
+            }
         }
     }
+    // Measured: 1.79 m against 2.76 m over the four runs. The map-matched pose does not
+    // reach a third of the odometry error in every run (the odometry of seed 2 happens to
+    // drift only 0.22–0.28 m), so the bound is on the sum.
+    assert!(
+        sum_corrected < 0.8 * sum_odometry,
+        "{sum_corrected} vs {sum_odometry}"
+    );
 }
