@@ -509,13 +509,13 @@ impl MovingObjectDetector {
         }
         let mut out: Vec<Vec<usize>> = Vec::new();
         let mut slot = vec![usize::MAX; n];
-        for k in 0..n {
+        for (k, &beam) in candidates.iter().enumerate() {
             let r = root(&mut parent, k);
             if slot[r] == usize::MAX {
                 slot[r] = out.len();
                 out.push(Vec::new());
             }
-            out[slot[r]].push(candidates[k]);
+            out[slot[r]].push(beam);
         }
         out
     }
