@@ -8,9 +8,13 @@
 //! * [`rosbag`]: `sensor_msgs/LaserScan` and `nav_msgs/Odometry` from ROS 1 bags.
 //! * [`csv`]: the project's own one-scan-per-line text format, read and written.
 //! * [`segment`]: the adaptive breakpoint detector (seed 000, eq. 15) and [`Segment`]s.
+//! * [`moving`]: moving-object detection from a moving platform (seed 003), built from
+//!   [`rigid`] (planar motions), [`icp`] (scan matching), [`local_map`] (averaged static
+//!   points), [`background`] (per-beam background map), [`features`] (segment shape
+//!   features) and [`fuzzy_art`] (on-line shape categories).
 //!
-//! Not for: background subtraction, shape features, tracking or mapping — segments are the
-//! hand-over point to the detectors and the filter.
+//! Not for: tracking or global mapping — segments and moving clusters are the hand-over
+//! point to the filter.
 //!
 //! ```
 //! use smc_lmb::laser2d::{segment_scan, BreakpointConfig, Scan};
@@ -20,8 +24,15 @@
 //! assert_eq!(segments.len(), 1);
 //! ```
 
+pub mod background;
 pub mod carmen;
 pub mod csv;
+pub mod features;
+pub mod fuzzy_art;
+pub mod icp;
+pub mod local_map;
+pub mod moving;
+pub mod rigid;
 pub mod rosbag;
 pub mod scan;
 pub mod segment;
@@ -32,6 +43,9 @@ pub use self::carmen::{
     TimeOrder,
 };
 pub use self::csv::{read_scan_csv, write_scan_csv};
+pub use self::moving::{
+    MovingCluster, MovingDetections, MovingDetectorConfig, MovingObjectDetector,
+};
 pub use self::rosbag::{bag_topics, read_bag, BagOptions, BagScans, BagTopic, OdometryTopic};
 pub use self::scan::{attach_odometry, OdometryRecord, Pose2, Scan};
 pub use self::segment::{breakpoint_threshold, segment_scan, BreakpointConfig, Segment};
