@@ -42,28 +42,7 @@ pub struct Args {
 
 /// Reads a TOML or JSON run configuration, naming the file and line of any problem.
 pub fn read_config(path: &Path) -> Result<RunConfig> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
-    match ext.as_str() {
-        "toml" => toml::from_str(&text).map_err(|e| {
-            let line = e
-                .span()
-                .map(|s| text[..s.start.min(text.len())].lines().count().max(1))
-                .unwrap_or(0);
-            anyhow::anyhow!("{}:{line}: {}", path.display(), e.message())
-        }),
-        "json" => serde_json::from_str(&text)
-            .map_err(|e| anyhow::anyhow!("{}:{}: {e}", path.display(), e.line())),
-        other => bail!(
-            "{}: unknown config extension `{other}` (expected .toml or .json)",
-            path.display()
-        ),
-    }
+    crate::config_file::read_config(path)
 }
 
 fn positions(config: &RunConfig) -> Vec<usize> {

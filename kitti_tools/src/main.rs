@@ -1,6 +1,7 @@
 //! `kitti-tools`: the command-line face of smc-lmb. Each subcommand parses its flags, builds a
 //! configuration and calls the library; no pipeline lives here.
 
+mod config_file;
 mod convert_cmd;
 mod detections_cmd;
 mod info_cmd;

@@ -29,33 +29,7 @@ pub struct Args {
 
 /// Reads a TOML or JSON street configuration, naming the file and line of any problem.
 fn read_config(path: &Path) -> Result<StreetConfig> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
-    let config: StreetConfig = match ext.as_str() {
-        "toml" => toml::from_str(&text).map_err(|e| {
-            let line = e
-                .span()
-                .map(|s| {
-                    1 + text.as_bytes()[..s.start.min(text.len())]
-                        .iter()
-                        .filter(|&&b| b == b'\n')
-                        .count()
-                })
-                .unwrap_or(0);
-            anyhow::anyhow!("{}:{line}: {}", path.display(), e.message())
-        })?,
-        "json" => serde_json::from_str(&text)
-            .map_err(|e| anyhow::anyhow!("{}:{}: {e}", path.display(), e.line()))?,
-        other => bail!(
-            "{}: unknown config extension `{other}` (expected .toml or .json)",
-            path.display()
-        ),
-    };
+    let config: StreetConfig = crate::config_file::read_config(path)?;
     config
         .validate()
         .with_context(|| format!("checking {}", path.display()))?;
