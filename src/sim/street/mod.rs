@@ -250,7 +250,7 @@ impl StreetConfig {
         ensure_positive("street.road_half_width", s.road_half_width)?;
         ensure_positive("street.sidewalk_width", s.sidewalk_width)?;
         ensure_positive("street.lane_width", s.lane_width)?;
-        if !(s.ego_lane_offset.abs() < s.road_half_width) {
+        if s.ego_lane_offset.is_nan() || s.ego_lane_offset.abs() >= s.road_half_width {
             return Err(Error::invalid(
                 "street.ego_lane_offset",
                 format!("{} is not inside the road", s.ego_lane_offset),
@@ -275,7 +275,7 @@ impl StreetConfig {
         ensure_non_negative("traffic.corner_clearance", t.corner_clearance)?;
         ensure_positive("traffic.spawn_radius", t.spawn_radius)?;
         let l = &self.lidar;
-        if l.beams < 2 || l.beams % 2 != 0 || l.beams > 256 {
+        if l.beams < 2 || !l.beams.is_multiple_of(2) || l.beams > 256 {
             return Err(Error::invalid(
                 "lidar.beams",
                 format!("{} (must be even, 2 to 256)", l.beams),

@@ -275,7 +275,7 @@ pub fn build_street(
     };
     let wall_offset = layout.road_half_width + layout.sidewalk_width;
     let mut segments = Vec::with_capacity(n);
-    for j in 0..n {
+    for (j, &(point, dir)) in segments_raw.iter().enumerate().take(n) {
         let (s_start, s_end) = extent(j, 0.0);
         for lateral in [-wall_offset, 0.0, wall_offset] {
             let (a, b) = extent(j, lateral);
@@ -290,7 +290,6 @@ pub fn build_street(
                 ));
             }
         }
-        let (point, dir) = segments_raw[j];
         segments.push(Segment {
             point,
             dir,
