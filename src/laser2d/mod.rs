@@ -22,6 +22,7 @@
 
 pub mod carmen;
 pub mod csv;
+pub mod evaluate;
 pub mod rosbag;
 pub mod scan;
 pub mod segment;
@@ -35,4 +36,6 @@ pub use self::csv::{read_scan_csv, write_scan_csv};
 pub use self::rosbag::{bag_topics, read_bag, BagOptions, BagScans, BagTopic, OdometryTopic};
 pub use self::scan::{attach_odometry, OdometryRecord, Pose2, Scan};
 pub use self::segment::{breakpoint_threshold, segment_scan, BreakpointConfig, Segment};
-pub use self::tracking::{PeopleTracker, PeopleTrackerConfig};
+pub use self::tracking::{
+    person_measurements, person_segments, PeopleTracker, PeopleTrackerConfig,
+};
