@@ -5,7 +5,7 @@
 //! pair by the squared Mahalanobis distance d² = νᵀ S⁻¹ ν against a χ²₂ threshold; solve the
 //! assignment that minimises the summed d² (Hungarian, [`crate::assignment`]), where a track may
 //! also stay unassigned at the cost of the gate threshold; update assigned tracks (Joseph
-//! form); start a tentative track at every unassigned measurement. Tracks are confirmed after M
+//! form); start a tentative track at every unassigned measurement outside every track's gate. Tracks are confirmed after M
 //! detections in their first N steps and deleted after 3.5 s unobserved
 //! ([`super::lifecycle`]). Only confirmed tracks are reported.
 //!
@@ -159,8 +159,10 @@ impl PointTracker for GnnTracker {
         }
         self.tracks
             .retain(|t| !t.life.is_dead(ctx.time, &cfg.lifecycle));
+        // A measurement inside some track's gate is that track's rival, not a new object.
+        let gated = |j: usize| (0..n).any(|i| cost[i * cols + j].is_finite());
         for (j, zj) in z.iter().enumerate() {
-            if !used[j] {
+            if !used[j] && !gated(j) {
                 self.tracks.push(EkfTrack {
                     label: self.labels.next_label(),
                     density: Gaussian::from_measurement(

@@ -236,8 +236,8 @@ impl JpdaImmTracker {
         }
         for j in 0..m {
             let mut first = None;
-            for i in 0..n {
-                if gated[i][j] {
+            for (i, row) in gated.iter().enumerate() {
+                if row[j] {
                     match first {
                         None => first = Some(i),
                         Some(f) => {
