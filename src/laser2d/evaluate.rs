@@ -226,3 +226,37 @@ pub fn summarise(runs: &[RunMetrics]) -> Result<Summary> {
         nis_window_consistent_fraction: (w_all > 0).then(|| w_ok as f64 / w_all as f64),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(ospa: f64, kept: bool, scans: usize, seconds: f64) -> RunMetrics {
+        RunMetrics {
+            mean_ospa: ospa,
+            ospa2: 2.0 * ospa,
+            label_switches: 3,
+            all_labels_kept: kept,
+            scans,
+            seconds,
+            squared_error_sum: 8.0,
+            innovations: 2,
+            nis: vec![2.0, 2.0],
+            nis_windows: (1, 1),
+        }
+    }
+
+    #[test]
+    fn summary_pools_runs() {
+        let s = summarise(&[run(1.0, true, 100, 1.0), run(0.5, false, 100, 3.0)]).unwrap();
+        assert!((s.mean_ospa - 0.75).abs() < 1e-12 && (s.mean_ospa2 - 1.5).abs() < 1e-12);
+        assert_eq!(s.label_switches, 6);
+        assert_eq!(s.all_labels_kept_fraction, 0.5);
+        // 200 scans in 4 s
+        assert_eq!(s.scans_per_second, 50.0);
+        // √(16 / 4)
+        assert_eq!(s.rms_prediction_error, Some(2.0));
+        assert_eq!(s.nis.unwrap().mean, 2.0);
+        assert!(summarise(&[]).is_err());
+    }
+}

@@ -166,3 +166,22 @@ pub(crate) fn ensure_range_bearing(z: &Measurements) -> Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn step_clock_counts_steps_and_time() {
+        let mut clock = StepClock::new();
+        let a = clock.tick(10.0, None).unwrap();
+        assert_eq!((a.step, a.dt), (0, 0.0));
+        let b = clock.tick(10.125, Some(Pose2::new(1.0, 2.0, 0.5))).unwrap();
+        assert_eq!(b.step, 1);
+        assert!((b.dt - 0.125).abs() < 1e-12);
+        let (x, y, phi) = b.platform_xy_heading();
+        assert!((x - 1.0).abs() < 1e-12 && (y - 2.0).abs() < 1e-12 && (phi - 0.5).abs() < 1e-12);
+        assert!(clock.tick(10.0, None).is_err());
+        assert!(clock.tick(f64::NAN, None).is_err());
+    }
+}
