@@ -1,21 +1,31 @@
 //! Walking people seen by a planar laser on a moving robot (seed 000's simulated scenarios),
-//! tracked with the particle LMB: segment each scan, keep person-sized segments, filter with
-//! constant velocity and range-bearing measurements from the robot's odometry pose.
+//! tracked by the particle LMB and by the seeds' own trackers on the same measurements: GNN
+//! with EKFs, ML-RANSAC (seed 000, Algorithm 2) and JPDA with an IMM (seed 003, Sec. V).
 //!
 //! ```text
 //! cargo run --release --example laser2d -- --scenario one --runs 10 --seed 1 [--json]
+//!     [--trackers lmb,gnn,ml_ransac,jpda_imm] [--pose odometry|truth]
 //! ```
 //!
-//! Reports mean OSPA and OSPA(2) (c = 2 m, p = 1; truth = the people the scanner actually sees,
-//! at least 3 beams), label switches, the fraction of runs in which every person kept a single
-//! label, and scans per second (segmentation + tracking).
+//! Reports per tracker mean OSPA and OSPA(2) (c = 2 m, p = 1; truth = the people the scanner
+//! actually sees, at least 3 beams), label switches, the fraction of runs in which every person
+//! kept a single label, scans per second (segmentation + tracking), and for the Gaussian
+//! trackers the RMS prediction error and the time-averaged NIS with its 95 % interval.
+//! `--json` prints one object with a member per tracker.
 
 use anyhow::{Context, Result};
 use clap::Parser;
-use smc_lmb::laser2d::{PeopleTracker, PeopleTrackerConfig};
-use smc_lmb::metrics::{ospa, ospa2, tracks_from_frames, LabelConsistency};
+use smc_lmb::laser2d::evaluate::{
+    evaluate_run, summarise, EvalConfig, PoseSource, RunMetrics, Summary,
+};
+use smc_lmb::laser2d::PeopleTrackerConfig;
+use smc_lmb::models::RangeBearing;
+use smc_lmb::rng::seeded;
 use smc_lmb::sim::PeopleScenario;
-use std::time::Instant;
+use smc_lmb::trackers::{
+    GnnConfig, GnnTracker, JpdaImmConfig, JpdaImmTracker, LmbTracker, MlRansacConfig,
+    MlRansacTracker, PointTracker,
+};
 
 #[derive(Parser, Debug)]
 #[command(about = "People tracking with a planar laser: simulated scenarios")]
@@ -29,109 +39,173 @@ struct Args {
     /// Seed of the first run (run i uses seed + i).
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Robot pose handed to the tracker: `odometry` (noisy, drifting — what a robot has) or
-    /// `truth` (the simulator's pose, to judge the tracker apart from localisation).
+    /// Robot pose handed to the trackers: `odometry` (noisy, drifting — what a robot has) or
+    /// `truth` (the simulator's pose, to judge the trackers apart from localisation).
     #[arg(long, default_value = "odometry")]
     pose: String,
+    /// Comma-separated trackers to run.
+    #[arg(long, default_value = "lmb,gnn,ml_ransac,jpda_imm")]
+    trackers: String,
     /// Print one JSON object.
     #[arg(long)]
     json: bool,
 }
 
-const C: f64 = 2.0;
-
 fn main() -> Result<()> {
     let args = Args::parse();
+    run_simulated(&args)
+}
+
+/// The simulated scenarios: every tracker on the same runs, pooled per tracker.
+fn run_simulated(args: &Args) -> Result<()> {
     let scenario = match args.scenario.as_str() {
         "one" => PeopleScenario::one(),
         "two" => PeopleScenario::two(),
         other => anyhow::bail!("unknown scenario `{other}` (expected one or two)"),
     };
     anyhow::ensure!(args.runs > 0, "--runs must be at least 1");
-    let (mut ospa_all, mut ospa2_all, mut switches, mut kept, mut scans, mut seconds) =
-        (vec![], vec![], 0, 0, 0, 0.0);
+    let eval = EvalConfig {
+        pose: match args.pose.as_str() {
+            "odometry" => PoseSource::Odometry,
+            "truth" => PoseSource::Truth,
+            other => anyhow::bail!("--pose {other}: expected odometry or truth"),
+        },
+        ..EvalConfig::default()
+    };
+    let names: Vec<&str> = args.trackers.split(',').map(str::trim).collect();
+    let detector = detector_config(&scenario, 0);
+    let mut per_tracker: Vec<Vec<RunMetrics>> = vec![Vec::new(); names.len()];
     for r in 0..args.runs {
         let seed = args.seed + r as u64;
         let run = scenario
             .generate(seed)
             .with_context(|| format!("scenario {} seed {seed}", args.scenario))?;
-        let s = &scenario.scanner;
-        let mut cfg = PeopleTrackerConfig::for_scanner(
-            s.sigma_range,
-            s.sigma_bearing,
-            s.range_max,
-            s.fov / 2.0,
-            scenario.mount,
-        );
-        cfg.filter.seed = seed;
-        let mut tracker = PeopleTracker::new(cfg)?;
-        let mut labels = LabelConsistency::new(C)?;
-        let mut truth_frames = Vec::new();
-        let mut est_frames = Vec::new();
-        let t0 = Instant::now();
-        let mut all_est = Vec::new();
-        for (k, scan) in run.scans.iter().enumerate() {
-            let mut scan = scan.clone();
-            match args.pose.as_str() {
-                "odometry" => {}
-                "truth" => scan.odometry = Some(run.robot_truth[k]),
-                other => anyhow::bail!("--pose {other}: expected odometry or truth"),
+        for (name, results) in names.iter().zip(per_tracker.iter_mut()) {
+            let mut tracker = build_tracker(name, &scenario, seed)?;
+            let m = evaluate_run(tracker.as_mut(), &run, &detector, &eval)
+                .with_context(|| format!("{name} on seed {seed}"))?;
+            if !args.json {
+                eprintln!(
+                    "run {r} {name}: OSPA {:.3}, OSPA(2) {:.3}, label switches {}, all labels kept {}",
+                    m.mean_ospa, m.ospa2, m.label_switches, m.all_labels_kept
+                );
             }
-            all_est.push(tracker.step(&scan)?);
-        }
-        seconds += t0.elapsed().as_secs_f64();
-        scans += run.scans.len();
-        for (k, est) in all_est.iter().enumerate() {
-            let seen = &run.visible[k];
-            let truth: Vec<(u64, Vec<f64>)> = run.people_truth[k]
-                .iter()
-                .filter(|(id, _, _)| seen.contains(id))
-                .map(|(id, p, _)| (*id, p.to_vec()))
-                .collect();
-            let x: Vec<_> = est
-                .iter()
-                .map(|e| (e.label, vec![e.state[0], e.state[2]]))
-                .collect();
-            let tp: Vec<&Vec<f64>> = truth.iter().map(|(_, p)| p).collect();
-            let xp: Vec<&Vec<f64>> = x.iter().map(|(_, p)| p).collect();
-            ospa_all.push(ospa(&tp, &xp, C, 1.0)?.distance);
-            labels.add_step(&truth, &x)?;
-            truth_frames.push(truth);
-            est_frames.push(x);
-        }
-        let tt = tracks_from_frames(&truth_frames)?;
-        let te = tracks_from_frames(&est_frames)?;
-        ospa2_all.push(ospa2(&tt, &te, 0..run.scans.len(), C, 1.0, 1.0)?);
-        let stats = labels.finish();
-        switches += stats.switches;
-        kept += stats.all_kept as usize;
-        if !args.json {
-            eprintln!(
-                "run {r}: label switches {}, all labels kept {}",
-                stats.switches, stats.all_kept
-            );
+            results.push(m);
         }
     }
-    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
-    let lmb = serde_json::json!({
-        "mean_ospa": mean(&ospa_all),
-        "mean_ospa2": mean(&ospa2_all),
-        "label_switches": switches,
-        "all_labels_kept_fraction": kept as f64 / args.runs as f64,
-        "scans_per_second": scans as f64 / seconds,
-    });
+    let summaries: Vec<Summary> = per_tracker
+        .iter()
+        .map(|r| summarise(r))
+        .collect::<smc_lmb::Result<_>>()?;
     if args.json {
-        println!(
-            "{}",
-            serde_json::json!({ "scenario": args.scenario, "runs": args.runs, "seed": args.seed, "pose": args.pose, "lmb": lmb })
-        );
+        print_json(args, &names, &summaries)
     } else {
-        println!(
-            "scenario {}, {} run(s), {} scans",
-            args.scenario, args.runs, scans
-        );
-        println!("LMB: mean OSPA {:.3} m, OSPA(2) {:.3} m (c = {C} m, p = 1), label switches {}, all labels kept in {:.0} % of runs, {:.0} scans/s",
-            mean(&ospa_all), mean(&ospa2_all), switches, 100.0 * kept as f64 / args.runs as f64, scans as f64 / seconds);
+        print_table(args, &names, &summaries);
+        Ok(())
     }
+}
+
+/// Segmentation (and, for the LMB, filter) settings for the scenario's scanner.
+fn detector_config(scenario: &PeopleScenario, seed: u64) -> PeopleTrackerConfig {
+    let s = &scenario.scanner;
+    let mut cfg = PeopleTrackerConfig::for_scanner(
+        s.sigma_range,
+        s.sigma_bearing,
+        s.range_max,
+        s.fov / 2.0,
+        scenario.mount,
+    );
+    cfg.filter.seed = seed;
+    cfg
+}
+
+/// The range-bearing sensor every baseline assumes: the scanner's noise (floored as the LMB
+/// floors it) and its mounting offset.
+fn sensor_model(scenario: &PeopleScenario) -> Result<RangeBearing> {
+    let s = &scenario.scanner;
+    Ok(
+        RangeBearing::new(s.sigma_range.max(0.05), s.sigma_bearing.max(0.005))?
+            .with_offset(scenario.mount[0], scenario.mount[1])?,
+    )
+}
+
+fn build_tracker(
+    name: &str,
+    scenario: &PeopleScenario,
+    seed: u64,
+) -> Result<Box<dyn PointTracker>> {
+    let sensor = sensor_model(scenario)?;
+    Ok(match name {
+        "lmb" => {
+            let cfg = detector_config(scenario, seed);
+            Box::new(LmbTracker::new(cfg.filter.build()?, seeded(seed)))
+        }
+        "gnn" => Box::new(GnnTracker::new(GnnConfig::new(sensor))?),
+        "ml_ransac" => {
+            let mut cfg = MlRansacConfig::new(sensor);
+            cfg.seed = seed;
+            Box::new(MlRansacTracker::new(cfg)?)
+        }
+        "jpda_imm" => {
+            let mut cfg = JpdaImmConfig::new(sensor);
+            let s = &scenario.scanner;
+            cfg.clutter_density = 1.0 / (s.fov * s.range_max);
+            Box::new(JpdaImmTracker::new(cfg)?)
+        }
+        other => {
+            anyhow::bail!("unknown tracker `{other}` (expected lmb, gnn, ml_ransac, jpda_imm)")
+        }
+    })
+}
+
+fn print_json(args: &Args, names: &[&str], summaries: &[Summary]) -> Result<()> {
+    let mut out = serde_json::json!({
+        "scenario": args.scenario, "runs": args.runs, "seed": args.seed, "pose": args.pose,
+    });
+    for (name, s) in names.iter().zip(summaries) {
+        out[*name] = serde_json::to_value(s)?;
+    }
+    println!("{out}");
     Ok(())
+}
+
+fn print_table(args: &Args, names: &[&str], summaries: &[Summary]) {
+    let scans = |s: &Summary| s.runs;
+    println!(
+        "scenario {}, {} run(s) from seed {}, pose {}; OSPA and OSPA(2) with c = 2 m, p = 1",
+        args.scenario,
+        summaries.first().map_or(0, scans),
+        args.seed,
+        args.pose
+    );
+    println!(
+        "{:<10} {:>8} {:>8} {:>9} {:>10} {:>9} {:>8} {:>22}",
+        "tracker",
+        "OSPA",
+        "OSPA(2)",
+        "switches",
+        "all kept",
+        "scans/s",
+        "RMS",
+        "NIS [95 % interval]"
+    );
+    for (name, s) in names.iter().zip(summaries) {
+        let rms = s
+            .rms_prediction_error
+            .map_or("–".to_string(), |v| format!("{v:.3}"));
+        let nis = s.nis.map_or("–".to_string(), |n| {
+            format!("{:.2} [{:.2}, {:.2}]", n.mean, n.lower, n.upper)
+        });
+        println!(
+            "{:<10} {:>8.3} {:>8.3} {:>9} {:>9.0}% {:>9.0} {:>8} {:>22}",
+            name,
+            s.mean_ospa,
+            s.mean_ospa2,
+            s.label_switches,
+            100.0 * s.all_labels_kept_fraction,
+            s.scans_per_second,
+            rms,
+            nis
+        );
+    }
 }

@@ -16,6 +16,7 @@ pub mod models;
 pub mod pipeline;
 pub mod rng;
 pub mod sim;
+pub mod trackers;
 
 pub use error::{Error, Result};
 pub use filter::{Label, ParticleSet};

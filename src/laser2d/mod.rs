@@ -27,6 +27,7 @@
 pub mod background;
 pub mod carmen;
 pub mod csv;
+pub mod evaluate;
 pub mod features;
 pub mod fuzzy_art;
 pub mod icp;
@@ -49,4 +50,6 @@ pub use self::moving::{
 pub use self::rosbag::{bag_topics, read_bag, BagOptions, BagScans, BagTopic, OdometryTopic};
 pub use self::scan::{attach_odometry, OdometryRecord, Pose2, Scan};
 pub use self::segment::{breakpoint_threshold, segment_scan, BreakpointConfig, Segment};
-pub use self::tracking::{PeopleTracker, PeopleTrackerConfig};
+pub use self::tracking::{
+    person_measurements, person_segments, PeopleTracker, PeopleTrackerConfig,
+};

@@ -130,82 +130,14 @@ impl PeopleTracker {
         })
     }
 
-    /// The point groups of `scan` that look like people: breakpoint segments, with
-    /// neighbouring segments merged while their gap is below `merge_gap` and the merged group
-    /// stays within `max_width` (range noise splits a person's outline into pieces), then
-    /// filtered by size.
+    /// The point groups of `scan` that look like people (see [`person_segments`]).
     pub fn person_segments(&self, scan: &Scan) -> Result<Vec<Vec<[f64; 2]>>> {
-        let mut groups: Vec<Vec<[f64; 2]>> = Vec::new();
-        let mut previous: Option<Segment> = None;
-        for s in segment_scan(scan, &self.config.breakpoint)? {
-            let merge = match (&previous, groups.last()) {
-                (Some(p), Some(g)) => {
-                    p.beams.end + 1 >= s.beams.start
-                        && dist(p.last, s.first) <= self.config.merge_gap
-                        && dist(g[0], s.last) <= self.config.max_width
-                }
-                _ => false,
-            };
-            if merge {
-                groups
-                    .last_mut()
-                    .expect("merging into a group")
-                    .extend_from_slice(&s.points);
-            } else {
-                groups.push(s.points.clone());
-            }
-            previous = Some(s);
-        }
-        Ok(groups
-            .into_iter()
-            .filter(|g| {
-                g.len() >= self.config.min_points
-                    && dist(g[0], g[g.len() - 1]) <= self.config.max_width
-            })
-            .collect())
+        person_segments(&self.config, scan)
     }
 
-    /// Range-bearing measurements (sensor frame, bearing from the sensor's x axis) of the
-    /// people's centres. Groups whose point means lie within `merge_gap` of each other are one
-    /// person (single linkage: noise can split an outline into pieces that are not neighbours
-    /// in the scan when another person's beams fall between them); each person's centre is the
-    /// mean of its points pushed `body_radius` farther along the beam.
+    /// Range-bearing measurements of the people's centres (see [`person_measurements`]).
     pub fn measurements(&self, scan: &Scan) -> Result<Measurements> {
-        let groups = self.person_segments(scan)?;
-        let stats: Vec<(f64, f64, f64)> = groups
-            .iter()
-            .map(|g| {
-                let n = g.len() as f64;
-                let (x, y) = g
-                    .iter()
-                    .fold((0.0, 0.0), |(sx, sy), p| (sx + p[0] / n, sy + p[1] / n));
-                (x, y, n)
-            })
-            .collect();
-        let mut owner: Vec<usize> = (0..stats.len()).collect();
-        for i in 0..stats.len() {
-            for j in 0..i {
-                if dist([stats[i].0, stats[i].1], [stats[j].0, stats[j].1]) <= self.config.merge_gap
-                {
-                    let (a, b) = (root(&mut owner, i), root(&mut owner, j));
-                    owner[a.max(b)] = a.min(b);
-                }
-            }
-        }
-        let mut merged: Vec<(f64, f64, f64)> = vec![(0.0, 0.0, 0.0); stats.len()];
-        for (i, &(x, y, n)) in stats.iter().enumerate() {
-            let m = &mut merged[root(&mut owner, i)];
-            *m = (m.0 + x * n, m.1 + y * n, m.2 + n);
-        }
-        let rows: Vec<[f64; 2]> = merged
-            .into_iter()
-            .filter(|m| m.2 > 0.0)
-            .map(|(sx, sy, n)| {
-                let (x, y) = (sx / n, sy / n);
-                [x.hypot(y) + self.config.body_radius, y.atan2(x)]
-            })
-            .collect();
-        Measurements::from_rows(2, &rows)
+        person_measurements(&self.config, scan)
     }
 
     /// One scan: segment, measure, filter. The robot pose is the scan's odometry (the world
@@ -229,6 +161,83 @@ impl PeopleTracker {
     pub fn filter(&self) -> &LmbFilter {
         &self.filter
     }
+}
+
+// Scan → measurements, shared by the filter above and by the baseline trackers
+// (`crate::trackers`), which must see exactly the same measurements.
+
+/// The point groups of `scan` that look like people: breakpoint segments, with
+/// neighbouring segments merged while their gap is below `merge_gap` and the merged group
+/// stays within `max_width` (range noise splits a person's outline into pieces), then
+/// filtered by size.
+pub fn person_segments(config: &PeopleTrackerConfig, scan: &Scan) -> Result<Vec<Vec<[f64; 2]>>> {
+    let mut groups: Vec<Vec<[f64; 2]>> = Vec::new();
+    let mut previous: Option<Segment> = None;
+    for s in segment_scan(scan, &config.breakpoint)? {
+        let merge = match (&previous, groups.last()) {
+            (Some(p), Some(g)) => {
+                p.beams.end + 1 >= s.beams.start
+                    && dist(p.last, s.first) <= config.merge_gap
+                    && dist(g[0], s.last) <= config.max_width
+            }
+            _ => false,
+        };
+        if merge {
+            groups
+                .last_mut()
+                .expect("merging into a group")
+                .extend_from_slice(&s.points);
+        } else {
+            groups.push(s.points.clone());
+        }
+        previous = Some(s);
+    }
+    Ok(groups
+        .into_iter()
+        .filter(|g| g.len() >= config.min_points && dist(g[0], g[g.len() - 1]) <= config.max_width)
+        .collect())
+}
+
+/// Range-bearing measurements (sensor frame, bearing from the sensor's x axis) of the
+/// people's centres. Groups whose point means lie within `merge_gap` of each other are one
+/// person (single linkage: noise can split an outline into pieces that are not neighbours
+/// in the scan when another person's beams fall between them); each person's centre is the
+/// mean of its points pushed `body_radius` farther along the beam.
+pub fn person_measurements(config: &PeopleTrackerConfig, scan: &Scan) -> Result<Measurements> {
+    let groups = person_segments(config, scan)?;
+    let stats: Vec<(f64, f64, f64)> = groups
+        .iter()
+        .map(|g| {
+            let n = g.len() as f64;
+            let (x, y) = g
+                .iter()
+                .fold((0.0, 0.0), |(sx, sy), p| (sx + p[0] / n, sy + p[1] / n));
+            (x, y, n)
+        })
+        .collect();
+    let mut owner: Vec<usize> = (0..stats.len()).collect();
+    for i in 0..stats.len() {
+        for j in 0..i {
+            if dist([stats[i].0, stats[i].1], [stats[j].0, stats[j].1]) <= config.merge_gap {
+                let (a, b) = (root(&mut owner, i), root(&mut owner, j));
+                owner[a.max(b)] = a.min(b);
+            }
+        }
+    }
+    let mut merged: Vec<(f64, f64, f64)> = vec![(0.0, 0.0, 0.0); stats.len()];
+    for (i, &(x, y, n)) in stats.iter().enumerate() {
+        let m = &mut merged[root(&mut owner, i)];
+        *m = (m.0 + x * n, m.1 + y * n, m.2 + n);
+    }
+    let rows: Vec<[f64; 2]> = merged
+        .into_iter()
+        .filter(|m| m.2 > 0.0)
+        .map(|(sx, sy, n)| {
+            let (x, y) = (sx / n, sy / n);
+            [x.hypot(y) + config.body_radius, y.atan2(x)]
+        })
+        .collect();
+    Measurements::from_rows(2, &rows)
 }
 
 #[cfg(test)]

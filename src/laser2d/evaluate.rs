@@ -1,0 +1,262 @@
+//! Scores a people tracker on a simulated run ([`People2dRun`]): every scan is turned into
+//! range-bearing measurements of person-sized segments ([`person_measurements`]), handed with
+//! the robot's pose to any [`PointTracker`], and the estimates are compared with the people the
+//! scanner actually saw (at least three beams on them).
+//!
+//! Per run: mean OSPA and OSPA(2) (cut-off c and order p, seed-independent defaults c = 2 m,
+//! p = 1), label switches and whether every person kept one label ([`LabelConsistency`]),
+//! scans per second of segmentation plus tracking, and, for trackers that report innovations,
+//! the RMS prediction error (measured minus predicted position) and the time-averaged NIS with
+//! its two-sided 95 % χ² interval, over the whole run and over windows of K steps (seed 003,
+//! appendix, K = 20). [`summarise`] pools runs.
+//!
+//! Not for: real recordings without ground truth.
+
+use super::{person_measurements, PeopleTrackerConfig};
+use crate::error::{Error, Result};
+use crate::metrics::{average_nis, ospa, ospa2, tracks_from_frames, LabelConsistency, NisCheck};
+use crate::sim::People2dRun;
+use crate::trackers::{PointTracker, StepClock};
+use serde::Serialize;
+use std::time::Instant;
+
+/// Which robot pose the tracker is given.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PoseSource {
+    /// The scan's noisy, drifting odometry (what a robot has).
+    #[default]
+    Odometry,
+    /// The simulator's true robot pose (judges the tracker apart from localisation).
+    Truth,
+}
+
+/// How runs are scored.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct EvalConfig {
+    /// OSPA / OSPA(2) cut-off (m); also the label-matching distance. Default 2 m.
+    pub cutoff: f64,
+    /// OSPA order. Default 1.
+    pub order: f64,
+    /// Robot pose source. Default odometry.
+    pub pose: PoseSource,
+    /// Steps K per time-averaged NIS window. Default 20.
+    pub nis_window: usize,
+}
+
+impl Default for EvalConfig {
+    fn default() -> Self {
+        EvalConfig {
+            cutoff: 2.0,
+            order: 1.0,
+            pose: PoseSource::Odometry,
+            nis_window: 20,
+        }
+    }
+}
+
+/// The scores of one run.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RunMetrics {
+    /// Mean over scans of the OSPA distance (m).
+    pub mean_ospa: f64,
+    /// OSPA(2) over the whole run (m).
+    pub ospa2: f64,
+    /// Label switches summed over people.
+    pub label_switches: usize,
+    /// Whether every person that was ever matched kept a single label.
+    pub all_labels_kept: bool,
+    /// Scans processed.
+    pub scans: usize,
+    /// Wall-clock seconds of segmentation and tracking.
+    pub seconds: f64,
+    /// Squared position innovations summed, and their number (for the RMS prediction error).
+    pub squared_error_sum: f64,
+    /// Number of innovations.
+    pub innovations: usize,
+    /// Every NIS value of the run, in order.
+    #[serde(skip)]
+    pub nis: Vec<f64>,
+    /// NIS windows of K steps with at least one value, and how many of them lay inside their
+    /// 95 % interval.
+    pub nis_windows: (usize, usize),
+}
+
+impl RunMetrics {
+    /// RMS prediction error (m), or `None` without innovations.
+    pub fn rms_prediction_error(&self) -> Option<f64> {
+        (self.innovations > 0).then(|| (self.squared_error_sum / self.innovations as f64).sqrt())
+    }
+}
+
+/// Runs `tracker` over `run`, measuring with `detector` (its segmentation settings).
+pub fn evaluate_run(
+    tracker: &mut dyn PointTracker,
+    run: &People2dRun,
+    detector: &PeopleTrackerConfig,
+    config: &EvalConfig,
+) -> Result<RunMetrics> {
+    let (c, p) = (config.cutoff, config.order);
+    let mut labels = LabelConsistency::new(c)?;
+    let mut clock = StepClock::new();
+    let (mut truth_frames, mut est_frames) = (Vec::new(), Vec::new());
+    let mut ospa_sum = 0.0;
+    let mut seconds = 0.0;
+    let (mut sq, mut count) = (0.0, 0usize);
+    let mut nis = Vec::new();
+    let mut windows = (0, 0);
+    let mut window: Vec<f64> = Vec::new();
+    for (k, scan) in run.scans.iter().enumerate() {
+        let pose = match config.pose {
+            PoseSource::Odometry => scan.odometry,
+            PoseSource::Truth => Some(*run.robot_truth.get(k).ok_or_else(|| {
+                Error::invalid("people run", format!("no true robot pose for scan {k}"))
+            })?),
+        };
+        let ctx = clock.tick(scan.time, pose)?;
+        let t0 = Instant::now();
+        let z = person_measurements(detector, scan)?;
+        let est = tracker.step(&z, &ctx)?;
+        seconds += t0.elapsed().as_secs_f64();
+        for inn in tracker.innovations() {
+            sq += inn.position_error[0].powi(2) + inn.position_error[1].powi(2);
+            count += 1;
+            if inn.nis.is_finite() {
+                nis.push(inn.nis);
+                window.push(inn.nis);
+            }
+        }
+        if (k + 1) % config.nis_window.max(1) == 0 && !window.is_empty() {
+            windows.0 += 1;
+            windows.1 += average_nis(&window, 2)?.consistent as usize;
+            window.clear();
+        }
+        let seen = run.visible.get(k).map(Vec::as_slice).unwrap_or(&[]);
+        let truth: Vec<(u64, Vec<f64>)> = run
+            .people_truth
+            .get(k)
+            .into_iter()
+            .flatten()
+            .filter(|(id, _, _)| seen.contains(id))
+            .map(|(id, p, _)| (*id, p.to_vec()))
+            .collect();
+        let x: Vec<_> = est
+            .iter()
+            .map(|e| (e.label, vec![e.state[0], e.state[2]]))
+            .collect();
+        let tp: Vec<&Vec<f64>> = truth.iter().map(|(_, p)| p).collect();
+        let xp: Vec<&Vec<f64>> = x.iter().map(|(_, p)| p).collect();
+        ospa_sum += ospa(&tp, &xp, c, p)?.distance;
+        labels.add_step(&truth, &x)?;
+        truth_frames.push(truth);
+        est_frames.push(x);
+    }
+    let steps = run.scans.len();
+    let tt = tracks_from_frames(&truth_frames)?;
+    let te = tracks_from_frames(&est_frames)?;
+    let stats = labels.finish();
+    Ok(RunMetrics {
+        mean_ospa: ospa_sum / steps.max(1) as f64,
+        ospa2: ospa2(&tt, &te, 0..steps, c, p, 1.0)?,
+        label_switches: stats.switches,
+        all_labels_kept: stats.all_kept,
+        scans: steps,
+        seconds,
+        squared_error_sum: sq,
+        innovations: count,
+        nis,
+        nis_windows: windows,
+    })
+}
+
+/// Runs pooled per tracker.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Summary {
+    /// Runs pooled.
+    pub runs: usize,
+    /// Mean over runs of the per-run mean OSPA (m).
+    pub mean_ospa: f64,
+    /// Mean over runs of OSPA(2) (m).
+    pub mean_ospa2: f64,
+    /// Label switches summed over runs.
+    pub label_switches: usize,
+    /// Fraction of runs in which every person kept one label.
+    pub all_labels_kept_fraction: f64,
+    /// Scans per second of segmentation plus tracking.
+    pub scans_per_second: f64,
+    /// RMS prediction error over all innovations of all runs (m).
+    pub rms_prediction_error: Option<f64>,
+    /// Time-averaged NIS over all runs with its 95 % interval (2 degrees of freedom per value).
+    pub nis: Option<NisCheck>,
+    /// Fraction of K-step NIS windows inside their 95 % interval.
+    pub nis_window_consistent_fraction: Option<f64>,
+}
+
+/// Pools the runs of one tracker; an error for no runs.
+pub fn summarise(runs: &[RunMetrics]) -> Result<Summary> {
+    if runs.is_empty() {
+        return Err(Error::invalid("run summary", "no runs"));
+    }
+    let n = runs.len() as f64;
+    let scans: usize = runs.iter().map(|r| r.scans).sum();
+    let seconds: f64 = runs.iter().map(|r| r.seconds).sum();
+    let count: usize = runs.iter().map(|r| r.innovations).sum();
+    let sq: f64 = runs.iter().map(|r| r.squared_error_sum).sum();
+    let all_nis: Vec<f64> = runs.iter().flat_map(|r| r.nis.iter().copied()).collect();
+    let (w_all, w_ok) = runs.iter().fold((0, 0), |(a, b), r| {
+        (a + r.nis_windows.0, b + r.nis_windows.1)
+    });
+    Ok(Summary {
+        runs: runs.len(),
+        mean_ospa: runs.iter().map(|r| r.mean_ospa).sum::<f64>() / n,
+        mean_ospa2: runs.iter().map(|r| r.ospa2).sum::<f64>() / n,
+        label_switches: runs.iter().map(|r| r.label_switches).sum(),
+        all_labels_kept_fraction: runs.iter().filter(|r| r.all_labels_kept).count() as f64 / n,
+        scans_per_second: if seconds > 0.0 {
+            scans as f64 / seconds
+        } else {
+            f64::INFINITY
+        },
+        rms_prediction_error: (count > 0).then(|| (sq / count as f64).sqrt()),
+        nis: if all_nis.is_empty() {
+            None
+        } else {
+            Some(average_nis(&all_nis, 2)?)
+        },
+        nis_window_consistent_fraction: (w_all > 0).then(|| w_ok as f64 / w_all as f64),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(ospa: f64, kept: bool, scans: usize, seconds: f64) -> RunMetrics {
+        RunMetrics {
+            mean_ospa: ospa,
+            ospa2: 2.0 * ospa,
+            label_switches: 3,
+            all_labels_kept: kept,
+            scans,
+            seconds,
+            squared_error_sum: 8.0,
+            innovations: 2,
+            nis: vec![2.0, 2.0],
+            nis_windows: (1, 1),
+        }
+    }
+
+    #[test]
+    fn summary_pools_runs() {
+        let s = summarise(&[run(1.0, true, 100, 1.0), run(0.5, false, 100, 3.0)]).unwrap();
+        assert!((s.mean_ospa - 0.75).abs() < 1e-12 && (s.mean_ospa2 - 1.5).abs() < 1e-12);
+        assert_eq!(s.label_switches, 6);
+        assert_eq!(s.all_labels_kept_fraction, 0.5);
+        // 200 scans in 4 s
+        assert_eq!(s.scans_per_second, 50.0);
+        // √(16 / 4)
+        assert_eq!(s.rms_prediction_error, Some(2.0));
+        assert_eq!(s.nis.unwrap().mean, 2.0);
+        assert!(summarise(&[]).is_err());
+    }
+}
