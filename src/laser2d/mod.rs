@@ -8,6 +8,9 @@
 //! * [`rosbag`]: `sensor_msgs/LaserScan` and `nav_msgs/Odometry` from ROS 1 bags.
 //! * [`csv`]: the project's own one-scan-per-line text format, read and written.
 //! * [`segment`]: the adaptive breakpoint detector (seed 000, eq. 15) and [`Segment`]s.
+//! * [`tracking`]: people tracking with the LMB filter; [`people_birth`] its birth model,
+//!   [`motion_state`] the static/dynamic classification of its tracks, [`person_groups`]
+//!   the grouping of returns into person candidates.
 //!
 //! Not for: background subtraction, shape features, tracking or mapping — segments are the
 //! hand-over point to the detectors and the filter.
@@ -22,6 +25,9 @@
 
 pub mod carmen;
 pub mod csv;
+pub mod motion_state;
+pub mod people_birth;
+pub mod person_groups;
 pub mod rosbag;
 pub mod scan;
 pub mod segment;
@@ -32,7 +38,10 @@ pub use self::carmen::{
     TimeOrder,
 };
 pub use self::csv::{read_scan_csv, write_scan_csv};
+pub use self::motion_state::{probability_moving, MotionClassifier, MotionConfig};
+pub use self::people_birth::PeopleBirth;
+pub use self::person_groups::{person_groups, PersonGroup, PersonGrouping};
 pub use self::rosbag::{bag_topics, read_bag, BagOptions, BagScans, BagTopic, OdometryTopic};
 pub use self::scan::{attach_odometry, OdometryRecord, Pose2, Scan};
 pub use self::segment::{breakpoint_threshold, segment_scan, BreakpointConfig, Segment};
-pub use self::tracking::{PeopleTracker, PeopleTrackerConfig};
+pub use self::tracking::{PeopleTracker, PeopleTrackerConfig, PersonEstimate};
