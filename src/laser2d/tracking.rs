@@ -56,7 +56,7 @@ pub struct PeopleTrackerConfig {
     /// No birth within this distance (m) of a confirmed track. Default 0.8 m.
     pub birth_suppress_radius: f64,
     /// A person is reported by [`PeopleTracker::step`] when the expected share of their
-    /// beams the scanner sees is at least this. Default 0.3.
+    /// beams the scanner sees is at least this. Default 0.5.
     pub min_visibility: f64,
     /// Static/dynamic thresholds.
     pub motion: MotionConfig,
@@ -92,7 +92,7 @@ impl PeopleTrackerConfig {
             occlusion_margin: (3.0 * sigma_range).max(0.15),
             survival_outside: 0.8,
             birth_suppress_radius: 0.8,
-            min_visibility: 0.3,
+            min_visibility: 0.5,
             motion: MotionConfig::default(),
             filter: RunConfig {
                 seed: 0,
@@ -218,7 +218,8 @@ impl PeopleTracker {
         let fov = FieldOfViewDetection::new(p_inside, p_outside, max_range, half_angle)?
             .with_offset(offset[0], offset[1])?;
         let detection =
-            OcclusionDetection::new(fov, config.body_radius.max(1e-3), config.occlusion_margin)?;
+            OcclusionDetection::new(fov, config.body_radius.max(1e-3), config.occlusion_margin)?
+                .with_min_returns(config.min_points as u32);
         let sensor = RangeBearing::new(sigma_range, sigma_bearing)?
             .with_offset(sensor_offset[0], sensor_offset[1])?
             .with_convention(convention);

@@ -18,6 +18,13 @@
 //!
 //! p_D(x) = p_inside · (1 − b / n)  inside the field of view, p_outside elsewhere.
 //!
+//! With `min_returns` = m > 0 the model also accounts for range: a detector that needs m
+//! returns on the object cannot see far objects that catch fewer beams. With bearing noise the
+//! number of beams ending on the disc is close to Poisson with mean μ = (1 − b / n) ·
+//! 2 asin(ρ / d) / |Δθ| (Δθ the beam spacing), and
+//!
+//! p_D(x) = p_inside · P(N ≥ m),  N ~ Poisson(μ),  P(N ≥ m) = 1 − Σ_{j<m} e^(−μ) μ^j / j!.
+//!
 //! Without a view set, no beam is blocked and the model equals the field-of-view model.
 
 use super::detection::FieldOfViewDetection;
@@ -118,7 +125,25 @@ pub struct OcclusionDetection {
     fov: FieldOfViewDetection,
     object_radius: f64,
     margin: f64,
+    min_returns: u32,
     view: Arc<RwLock<BeamView>>,
+}
+
+/// P(N ≥ m) for N ~ Poisson(μ).
+pub fn poisson_at_least(m: u32, mu: f64) -> f64 {
+    if m == 0 {
+        return 1.0;
+    }
+    if !(mu > 0.0) {
+        return 0.0;
+    }
+    let mut term = (-mu).exp();
+    let mut below = term;
+    for j in 1..m {
+        term *= mu / j as f64;
+        below += term;
+    }
+    (1.0 - below).clamp(0.0, 1.0)
 }
 
 impl OcclusionDetection {
@@ -137,8 +162,15 @@ impl OcclusionDetection {
             fov,
             object_radius,
             margin,
+            min_returns: 0,
             view: Arc::new(RwLock::new(BeamView::default())),
         })
+    }
+
+    /// The same model for a detector that needs `m` returns on an object (0: off).
+    pub fn with_min_returns(mut self, m: u32) -> Self {
+        self.min_returns = m;
+        self
     }
 
     /// Sets the scan that the next steps' p_D is computed against (shared by all clones).
@@ -200,10 +232,20 @@ impl DetectionModel for OcclusionDetection {
             };
             let (blocked, total) =
                 view.blocked(ly.atan2(lx), half, d - self.object_radius - self.margin);
-            *o = if total == 0 {
-                p_in
+            let free = if total == 0 {
+                1.0
             } else {
-                p_in * (1.0 - blocked as f64 / total as f64)
+                1.0 - blocked as f64 / total as f64
+            };
+            *o = if self.min_returns == 0 {
+                p_in * free
+            } else {
+                let spacing = view.angle_increment.abs();
+                if spacing > 0.0 {
+                    p_in * poisson_at_least(self.min_returns, free * 2.0 * half / spacing)
+                } else {
+                    p_in * free
+                }
             };
         }
     }
@@ -292,6 +334,32 @@ mod tests {
         let other = m.clone();
         other.update_view(-FRAC_PI_2, PI / 180.0, vec![f64::NAN; 181]);
         assert_eq!(m.at(100.0, 60.0, &ctx), 0.9);
+    }
+
+    #[test]
+    fn poisson_tail_matches_hand_values() {
+        // P(N ≥ 2 | μ = 2) = 1 − e^(−2)(1 + 2) = 0.593994…
+        assert!((poisson_at_least(2, 2.0) - 0.593_994_150_290_161_9).abs() < 1e-12);
+        assert!((poisson_at_least(1, 1.0) - (1.0 - (-1.0f64).exp())).abs() < 1e-15);
+        assert_eq!(poisson_at_least(0, 0.0), 1.0);
+        assert_eq!(poisson_at_least(3, 0.0), 0.0);
+    }
+
+    #[test]
+    fn far_objects_catch_too_few_beams() {
+        // 1° beams, object radius 0.2 m, needs 2 returns. At 10 m: μ = 2 asin(0.02) / 1° =
+        // 2.2920…; at 25 m: μ = 0.9167…
+        let m = model().with_min_returns(2);
+        m.update_view(-FRAC_PI_2, PI / 180.0, vec![30.0; 181]);
+        let ctx = StepContext::new(0, 0.0, 0.1);
+        let mu = |d: f64| 2.0 * (0.2f64 / d).asin() / (PI / 180.0);
+        let (s, c) = 20f64.to_radians().sin_cos();
+        let near = m.at(10.0 * c, 10.0 * s, &ctx);
+        let far = m.at(25.0 * c, 25.0 * s, &ctx);
+        let expect = |mu: f64| 0.9 * (1.0 - (-mu).exp() * (1.0 + mu));
+        assert!((near - expect(mu(10.0))).abs() < 1e-12, "{near}");
+        assert!((far - expect(mu(25.0))).abs() < 1e-12, "{far}");
+        assert!(far < 0.25 && near > 0.6);
     }
 
     #[test]
