@@ -10,7 +10,7 @@
 //! * [`segment`]: the adaptive breakpoint detector (seed 000, eq. 15) and [`Segment`]s.
 //! * [`tracking`]: people tracking with the LMB filter; [`people_birth`] its birth model,
 //!   [`motion_state`] the static/dynamic classification of its tracks, [`person_groups`]
-//!   the grouping of returns into person candidates.
+//!   the grouping of returns into person candidates, [`people_run`] a whole recording.
 //!
 //! Not for: background subtraction, shape features, tracking or mapping — segments are the
 //! hand-over point to the detectors and the filter.
@@ -27,6 +27,7 @@ pub mod carmen;
 pub mod csv;
 pub mod motion_state;
 pub mod people_birth;
+pub mod people_run;
 pub mod person_groups;
 pub mod rosbag;
 pub mod scan;
@@ -40,6 +41,9 @@ pub use self::carmen::{
 pub use self::csv::{read_scan_csv, write_scan_csv};
 pub use self::motion_state::{probability_moving, MotionClassifier, MotionConfig};
 pub use self::people_birth::PeopleBirth;
+pub use self::people_run::{
+    config_for_scans, track_scans, write_people_json, PeopleRun, PersonTrack, ScanPeople,
+};
 pub use self::person_groups::{person_groups, PersonGroup, PersonGrouping};
 pub use self::rosbag::{bag_topics, read_bag, BagOptions, BagScans, BagTopic, OdometryTopic};
 pub use self::scan::{attach_odometry, OdometryRecord, Pose2, Scan};

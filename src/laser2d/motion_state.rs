@@ -4,7 +4,9 @@
 //! probability that the object moves is P(|v| > v_min) = Σᵢ wᵢ · [ẋᵢ² + ẏᵢ² > v_min²].
 //! A track's class switches with hysteresis so that one noisy scan does not flip it: a static
 //! track becomes dynamic when P ≥ `enter`, a dynamic track becomes static again when
-//! P ≤ `exit` (with `exit` < `enter`); in between it keeps its class. New tracks start static.
+//! P ≤ `exit` (with `exit` < `enter`); in between it keeps its class. New tracks start static
+//! and stay so for their first `min_age` scans: a fresh track's velocity is its birth prior
+//! (spread around zero by about a walking speed), which says nothing about the object yet.
 //!
 //! Not for: deciding moving versus static from the scan points themselves (background
 //! models), or for the motion model.
@@ -23,6 +25,8 @@ pub struct MotionConfig {
     pub enter: f64,
     /// P(moving) at or below which a dynamic track becomes static. Default 0.3.
     pub exit: f64,
+    /// Tracks younger than this many scans are static. Default 8.
+    pub min_age: u32,
 }
 
 impl Default for MotionConfig {
@@ -31,6 +35,7 @@ impl Default for MotionConfig {
             v_min: 0.3,
             enter: 0.8,
             exit: 0.3,
+            min_age: 8,
         }
     }
 }
@@ -99,10 +104,13 @@ impl MotionClassifier {
         &self.config
     }
 
-    /// Feeds this scan's P(moving) of track `label`; returns its class (true = dynamic).
-    pub fn update(&mut self, label: Label, p_moving: f64) -> bool {
+    /// Feeds this scan's P(moving) of track `label`, `age` scans old; returns its class
+    /// (true = dynamic).
+    pub fn update(&mut self, label: Label, p_moving: f64, age: u32) -> bool {
         let state = self.moving.entry(label).or_insert(false);
-        if *state {
+        if age < self.config.min_age {
+            *state = false;
+        } else if *state {
             if p_moving <= self.config.exit {
                 *state = false;
             }
@@ -144,17 +152,19 @@ mod tests {
     fn hysteresis_switches_both_ways() {
         let mut c = MotionClassifier::new(MotionConfig::default()).unwrap();
         let l = Label::new(0, 0);
+        // too young: static whatever the velocity says
+        assert!(!c.update(l, 0.95, 3));
         // starts static; 0.6 is between exit and enter → stays static
-        assert!(!c.update(l, 0.6));
-        assert!(c.update(l, 0.85)); // enters dynamic
-        assert!(c.update(l, 0.5)); // in the band: keeps dynamic
-        assert!(!c.update(l, 0.2)); // back to static
-        assert!(!c.update(l, 0.7));
-        assert!(c.update(l, 0.9));
+        assert!(!c.update(l, 0.6, 10));
+        assert!(c.update(l, 0.85, 11)); // enters dynamic
+        assert!(c.update(l, 0.5, 12)); // in the band: keeps dynamic
+        assert!(!c.update(l, 0.2, 13)); // back to static
+        assert!(!c.update(l, 0.7, 14));
+        assert!(c.update(l, 0.9, 15));
         // other labels are independent; forgetting resets to static
-        assert!(!c.update(Label::new(1, 0), 0.5));
+        assert!(!c.update(Label::new(1, 0), 0.5, 20));
         c.retain(|x| x != l);
-        assert!(!c.update(l, 0.5));
+        assert!(!c.update(l, 0.5, 20));
     }
 
     #[test]

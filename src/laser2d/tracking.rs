@@ -364,7 +364,7 @@ impl PeopleTracker {
                 position: [e.state[0], e.state[2]],
                 velocity: [e.state[1], e.state[3]],
                 p_moving,
-                moving: self.motion.update(e.label, p_moving),
+                moving: self.motion.update(e.label, p_moving, e.age),
                 visibility: if p_max > 0.0 {
                     (seen / p_max).clamp(0.0, 1.0)
                 } else {
