@@ -176,7 +176,7 @@ mod recording {
     use plotters::prelude::*;
     use smc_lmb::laser2d::{
         config_for_scans, read_bag, read_carmen, track_scans, write_people_json, BagOptions,
-        CarmenOptions, PeopleRun, Scan,
+        CarmenOptions, PeopleRun, Scan, TimeOrder,
     };
     use std::path::Path;
     use std::time::Instant;
@@ -209,7 +209,12 @@ mod recording {
 
     fn load(args: &Args) -> Result<Vec<Scan>> {
         if let Some(path) = &args.carmen {
-            let log = read_carmen(path, CarmenOptions::default())
+            // Real logs have the odd record whose time stamp steps back: skip it.
+            let options = CarmenOptions {
+                time_order: TimeOrder::Skip,
+                ..CarmenOptions::default()
+            };
+            let log = read_carmen(path, options)
                 .with_context(|| format!("reading {}", path.display()))?;
             return Ok(if log.flaser.is_empty() {
                 log.robot_laser
