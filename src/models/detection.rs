@@ -173,12 +173,19 @@ impl FieldOfViewDetection {
         (px + a * c - b * s, py + a * s + b * c, c, s)
     }
 
+    /// |bearing| ≤ half angle is tested as cos(bearing) ≥ cos(half angle), i.e.
+    /// l_x ≥ d · cos(half angle) (cos falls on [0, π]), which avoids an atan2 per particle.
+    #[inline]
     pub(crate) fn contains_from(&self, x: f64, y: f64, sx: f64, sy: f64, c: f64, s: f64) -> bool {
         let dx = x - sx;
         let dy = y - sy;
         let lx = c * dx + s * dy;
         let ly = -s * dx + c * dy;
-        lx.hypot(ly) <= self.max_range && ly.atan2(lx).abs() <= self.half_angle
+        let d2 = lx * lx + ly * ly;
+        if d2 > self.max_range * self.max_range {
+            return false;
+        }
+        self.half_angle >= std::f64::consts::PI || lx >= d2.sqrt() * self.half_angle.cos()
     }
 }
 
