@@ -83,7 +83,7 @@ pub fn person_groups(scan: &Scan, g: &PersonGrouping) -> Result<Vec<PersonGroup>
     let mut out = Vec::new();
     let all: Vec<usize> = (0..pts.len()).collect();
     split(&pts, &all, g, 0, &mut out);
-    out.sort_by(|a: &(usize, PersonGroup), b| a.0.cmp(&b.0));
+    out.sort_by_key(|a| a.0);
     Ok(out.into_iter().map(|(_, p)| p).collect())
 }
 
@@ -131,9 +131,9 @@ fn split(
         }
     }
     let mut members: Vec<Vec<usize>> = vec![Vec::new(); n];
-    for i in 0..n {
+    for (i, &point) in idx.iter().enumerate() {
         let r = root(&mut owner, i);
-        members[r].push(idx[i]);
+        members[r].push(point);
     }
     for m in members.into_iter().filter(|m| m.len() >= g.min_points) {
         let count = m.len() as f64;

@@ -169,7 +169,7 @@ pub fn poisson_at_least(m: u32, mu: f64) -> f64 {
     if m == 0 {
         return 1.0;
     }
-    if !(mu > 0.0) {
+    if mu.is_nan() || mu <= 0.0 {
         return 0.0;
     }
     let mut term = (-mu).exp();
