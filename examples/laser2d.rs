@@ -5,6 +5,8 @@
 //! ```text
 //! cargo run --release --example laser2d -- --scenario one --runs 10 --seed 1 [--json]
 //!     [--trackers lmb,gnn,ml_ransac,jpda_imm] [--pose odometry|truth]
+//! cargo run --release --example laser2d -- --carmen intel.clf.bz2 --out people.json --plot tracks.svg
+//! cargo run --release --example laser2d -- --bag demo.bag --topic /scan --out people.json --plot tracks.png
 //! ```
 //!
 //! Reports per tracker mean OSPA and OSPA(2) (c = 2 m, p = 1; truth = the people the scanner
@@ -12,6 +14,10 @@
 //! kept a single label, scans per second (segmentation + tracking), and for the Gaussian
 //! trackers the RMS prediction error and the time-averaged NIS with its 95 % interval.
 //! `--json` prints one object with a member per tracker.
+//!
+//! With `--carmen` or `--bag` a recording is tracked end to end instead (LMB only): per-scan
+//! people as JSON (`--out`), a plot of the tracks over the scan points (`--plot`, `.svg` or
+//! `.png`), and a summary of the tracks on standard output.
 
 use anyhow::{Context, Result};
 use clap::Parser;
@@ -49,10 +55,37 @@ struct Args {
     /// Print one JSON object.
     #[arg(long)]
     json: bool,
+    /// Track a CARMEN log (FLASER scans, odometry from the laser lines) instead of simulating.
+    #[arg(long)]
+    carmen: Option<std::path::PathBuf>,
+    /// Track a ROS1 bag (sensor_msgs/LaserScan) instead of simulating.
+    #[arg(long)]
+    bag: Option<std::path::PathBuf>,
+    /// Scan topic of `--bag` (default: the only LaserScan topic).
+    #[arg(long)]
+    topic: Option<String>,
+    /// Per-scan people of a recording, as JSON.
+    #[arg(long)]
+    out: Option<std::path::PathBuf>,
+    /// Plot of a recording's tracks over its scan points (`.svg` or `.png`).
+    #[arg(long)]
+    plot: Option<std::path::PathBuf>,
+    /// Range noise of the recorded scanner (m).
+    #[arg(long, default_value_t = 0.03)]
+    sigma_range: f64,
+    /// Bearing noise of the recorded scanner (rad).
+    #[arg(long, default_value_t = 0.005)]
+    sigma_bearing: f64,
+    /// People farther than this (m) are not tracked in recordings.
+    #[arg(long, default_value_t = 15.0)]
+    max_range: f64,
 }
 
 fn main() -> Result<()> {
     let args = Args::parse();
+    if args.carmen.is_some() || args.bag.is_some() {
+        return recording::run(&args);
+    }
     run_simulated(&args)
 }
 
@@ -207,5 +240,227 @@ fn print_table(args: &Args, names: &[&str], summaries: &[Summary]) {
             rms,
             nis
         );
+    }
+}
+
+/// The `--carmen` / `--bag` path: real recordings, no ground truth.
+mod recording {
+    use super::Args;
+    use anyhow::{Context, Result};
+    use plotters::prelude::*;
+    use smc_lmb::laser2d::{
+        config_for_scans, read_bag, read_carmen, track_scans, write_people_json, BagOptions,
+        CarmenOptions, PeopleRun, Scan, TimeOrder,
+    };
+    use std::path::Path;
+    use std::time::Instant;
+
+    pub fn run(args: &Args) -> Result<()> {
+        let t_read = Instant::now();
+        let scans = load(args)?;
+        let read_s = t_read.elapsed().as_secs_f64();
+        anyhow::ensure!(!scans.is_empty(), "the recording holds no scan");
+        let mut cfg = config_for_scans(
+            &scans,
+            args.sigma_range,
+            args.sigma_bearing,
+            args.max_range,
+            [0.0, 0.0],
+        )?;
+        cfg.filter.seed = args.seed;
+        let t0 = Instant::now();
+        let run = track_scans(&scans, cfg)?;
+        let secs = t0.elapsed().as_secs_f64();
+        if let Some(path) = &args.out {
+            write_people_json(path, &run).with_context(|| format!("writing {}", path.display()))?;
+        }
+        if let Some(path) = &args.plot {
+            plot(path, &scans, &run).with_context(|| format!("plotting {}", path.display()))?;
+        }
+        report(&scans, &run, read_s, secs);
+        Ok(())
+    }
+
+    fn load(args: &Args) -> Result<Vec<Scan>> {
+        if let Some(path) = &args.carmen {
+            // Real logs have the odd record whose time stamp steps back: skip it.
+            let options = CarmenOptions {
+                time_order: TimeOrder::Skip,
+                ..CarmenOptions::default()
+            };
+            let log = read_carmen(path, options)
+                .with_context(|| format!("reading {}", path.display()))?;
+            return Ok(if log.flaser.is_empty() {
+                log.robot_laser
+            } else {
+                log.flaser
+            });
+        }
+        let path = args.bag.as_ref().expect("--bag given");
+        let options = match &args.topic {
+            Some(t) => BagOptions::topic(t.clone()),
+            None => BagOptions::default(),
+        };
+        Ok(read_bag(path, &options)
+            .with_context(|| format!("reading {}", path.display()))?
+            .scans)
+    }
+
+    fn report(scans: &[Scan], run: &PeopleRun, read_s: f64, secs: f64) {
+        let span = scans.last().map_or(0.0, |s| s.time) - scans[0].time;
+        println!(
+            "{} scans over {:.1} s ({} beams); read in {:.2} s, tracked in {:.2} s ({:.0} scans/s)",
+            scans.len(),
+            span,
+            scans[0].len(),
+            read_s,
+            secs,
+            scans.len() as f64 / secs
+        );
+        let per_scan: Vec<usize> = run
+            .scans
+            .iter()
+            .map(|s| s.people.iter().filter(|p| p.visibility >= 0.5).count())
+            .collect();
+        let mean_people = per_scan.iter().sum::<usize>() as f64 / per_scan.len().max(1) as f64;
+        println!(
+            "visible people per scan: mean {mean_people:.2}, max {}",
+            per_scan.iter().max().copied().unwrap_or(0)
+        );
+        for (what, min) in [
+            ("all", 1usize),
+            ("at least 8 scans (1 s at 8 Hz)", 8),
+            ("at least 40 scans", 40),
+        ] {
+            let t: Vec<_> = run.tracks_with(min).collect();
+            let dynamic: Vec<_> = t.iter().filter(|t| t.dynamic_fraction >= 0.5).collect();
+            let median = |mut v: Vec<f64>| {
+                v.sort_by(f64::total_cmp);
+                if v.is_empty() {
+                    f64::NAN
+                } else {
+                    v[v.len() / 2]
+                }
+            };
+            println!(
+                "tracks ({what}): {} ({} mostly dynamic); median length {:.0} scans / {:.1} s; median speed of dynamic ones {:.2} m/s, median displacement {:.1} m",
+                t.len(),
+                dynamic.len(),
+                median(t.iter().map(|t| t.scans as f64).collect()),
+                median(t.iter().map(|t| t.last_time - t.first_time).collect()),
+                median(dynamic.iter().map(|t| t.mean_speed).collect()),
+                median(dynamic.iter().map(|t| t.displacement).collect()),
+            );
+        }
+    }
+
+    /// World points of a scan: the sensor sits at the laser pose when the log has one, else at
+    /// the odometry pose, else at the origin.
+    fn world_points(s: &Scan) -> Vec<(f64, f64)> {
+        let pose = s.laser_pose.or(s.odometry);
+        let (x0, y0, th) = pose.map_or((0.0, 0.0, 0.0), |p| (p.x, p.y, p.theta));
+        let (sn, cs) = th.sin_cos();
+        s.points()
+            .map(|(_, [x, y])| (x0 + cs * x - sn * y, y0 + sn * x + cs * y))
+            .collect()
+    }
+
+    fn plot(path: &Path, scans: &[Scan], run: &PeopleRun) -> Result<()> {
+        let every = (scans.len() / 200).max(1);
+        let points: Vec<(f64, f64)> = scans.iter().step_by(every).flat_map(world_points).collect();
+        let tracks: Vec<&smc_lmb::laser2d::PersonTrack> = run.tracks_with(8).collect();
+        let mut paths: Vec<Vec<(f64, f64)>> = vec![Vec::new(); tracks.len()];
+        for s in &run.scans {
+            for p in s.people.iter().filter(|p| p.visibility >= 0.5) {
+                if let Some(i) = tracks.iter().position(|t| t.label == p.label) {
+                    paths[i].push((p.position[0], p.position[1]));
+                }
+            }
+        }
+        let all = points.iter().chain(paths.iter().flatten());
+        let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+        for &(x, y) in all {
+            x0 = x0.min(x);
+            x1 = x1.max(x);
+            y0 = y0.min(y);
+            y1 = y1.max(y);
+        }
+        anyhow::ensure!(x0 <= x1, "nothing to plot");
+        let size = (
+            1000,
+            (1000.0 * (y1 - y0 + 1.0) / (x1 - x0 + 1.0)).clamp(300.0, 1600.0) as u32,
+        );
+        let png = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        // Draw into a temporary file next to the target, then rename (atomic output).
+        let tmp = path.with_extension(if png { "tmp.png" } else { "tmp.svg" });
+        let frame = (x0, x1, y0, y1);
+        if png {
+            draw(
+                BitMapBackend::new(&tmp, size).into_drawing_area(),
+                &points,
+                &paths,
+                frame,
+                false, // no font engine in the bitmap backend: no axis text
+            )?;
+        } else {
+            draw(
+                SVGBackend::new(&tmp, size).into_drawing_area(),
+                &points,
+                &paths,
+                frame,
+                true,
+            )?;
+        }
+        std::fs::rename(&tmp, path)?;
+        Ok(())
+    }
+
+    fn draw<DB: DrawingBackend>(
+        root: DrawingArea<DB, plotters::coord::Shift>,
+        points: &[(f64, f64)],
+        paths: &[Vec<(f64, f64)>],
+        (x0, x1, y0, y1): (f64, f64, f64, f64),
+        labels: bool,
+    ) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        root.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        let label_space = if labels { 40 } else { 0 };
+        let mut chart = ChartBuilder::on(&root)
+            .margin(10)
+            .x_label_area_size(label_space)
+            .y_label_area_size(label_space)
+            .build_cartesian_2d(x0 - 0.5..x1 + 0.5, y0 - 0.5..y1 + 0.5)
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        if labels {
+            chart
+                .configure_mesh()
+                .x_desc("x (m)")
+                .y_desc("y (m)")
+                .disable_mesh()
+                .draw()
+                .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        }
+        chart
+            .draw_series(
+                points
+                    .iter()
+                    .map(|&p| Pixel::new(p, RGBColor(150, 150, 150))),
+            )
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        for (i, path) in paths.iter().enumerate() {
+            let colour = Palette99::pick(i).to_rgba();
+            chart
+                .draw_series(LineSeries::new(
+                    path.iter().copied(),
+                    colour.stroke_width(2),
+                ))
+                .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        }
+        root.present().map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        Ok(())
     }
 }

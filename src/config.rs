@@ -205,6 +205,13 @@ fn default_turn_std() -> f64 {
 impl RunConfig {
     /// Checks every value and builds the filter. Errors name the offending field.
     pub fn build(&self) -> Result<LmbFilter> {
+        self.builder()?.build()
+    }
+
+    /// Checks every value and returns the filter's builder with every model set, so that a
+    /// caller can replace one model (e.g. a detection model with run-time state) before
+    /// building. Errors name the offending field.
+    pub fn builder(&self) -> Result<crate::filter::LmbFilterBuilder> {
         if !(0.0..=1.0).contains(&self.survival) {
             return Err(Error::invalid(
                 "config field `survival`",
@@ -328,7 +335,7 @@ impl RunConfig {
                 )?)
             }
         };
-        builder.build()
+        Ok(builder)
     }
 }
 

@@ -12,6 +12,9 @@
 //!   [`rigid`] (planar motions), [`icp`] (scan matching), [`local_map`] (averaged static
 //!   points), [`background`] (per-beam background map), [`features`] (segment shape
 //!   features) and [`fuzzy_art`] (on-line shape categories).
+//! * [`tracking`]: people tracking with the LMB filter; [`people_birth`] its birth model,
+//!   [`motion_state`] the static/dynamic classification of its tracks, [`person_groups`]
+//!   the grouping of returns into person candidates, [`people_run`] a whole recording.
 //!
 //! Not for: tracking or global mapping — segments and moving clusters are the hand-over
 //! point to the filter.
@@ -32,7 +35,11 @@ pub mod features;
 pub mod fuzzy_art;
 pub mod icp;
 pub mod local_map;
+pub mod motion_state;
 pub mod moving;
+pub mod people_birth;
+pub mod people_run;
+pub mod person_groups;
 pub mod rigid;
 pub mod rosbag;
 pub mod scan;
@@ -44,12 +51,18 @@ pub use self::carmen::{
     TimeOrder,
 };
 pub use self::csv::{read_scan_csv, write_scan_csv};
+pub use self::motion_state::{probability_moving, MotionClassifier, MotionConfig};
 pub use self::moving::{
     MovingCluster, MovingDetections, MovingDetectorConfig, MovingObjectDetector,
 };
+pub use self::people_birth::PeopleBirth;
+pub use self::people_run::{
+    config_for_scans, track_scans, write_people_json, PeopleRun, PersonTrack, ScanPeople,
+};
+pub use self::person_groups::{person_groups, PersonGroup, PersonGrouping};
 pub use self::rosbag::{bag_topics, read_bag, BagOptions, BagScans, BagTopic, OdometryTopic};
 pub use self::scan::{attach_odometry, OdometryRecord, Pose2, Scan};
 pub use self::segment::{breakpoint_threshold, segment_scan, BreakpointConfig, Segment};
 pub use self::tracking::{
-    person_measurements, person_segments, PeopleTracker, PeopleTrackerConfig,
+    person_measurements, person_segments, PeopleTracker, PeopleTrackerConfig, PersonEstimate,
 };

@@ -1,19 +1,31 @@
 //! People tracking from planar scans with the particle LMB filter: each scan is segmented
 //! (adaptive breakpoints), segments of person size become range-bearing measurements of the
 //! person's centre, and the filter — constant velocity (seed 000, eqs. 6–8), range-bearing from
-//! a sensor mounted at (a, b) on the robot's odometry pose (eqs. 10–11), a field-of-view
-//! detection probability, adaptive birth — follows them with labels.
+//! a sensor mounted at (a, b) on the robot's odometry pose (eqs. 10–11), an occlusion-aware
+//! detection probability ([`crate::models::OcclusionDetection`] against the current scan),
+//! survival that forgets people who left the field of view, and measurement-driven birth that
+//! is suppressed next to confirmed tracks ([`super::people_birth`]) — follows them with labels.
+//! Each scan's output marks every person as static or dynamic ([`super::motion_state`]) and
+//! says how visible the scanner should find them.
 //!
 //! Not for: deciding which segments belong to moving objects on a cluttered map (background
 //! attenuation and shape learning), or the baseline trackers.
 
-use super::{segment_scan, BreakpointConfig, Scan, Segment};
+use super::motion_state::{probability_moving, MotionClassifier, MotionConfig};
+use super::people_birth::PeopleBirth;
+use super::person_groups::{person_groups, PersonGrouping};
+use super::{BreakpointConfig, Scan};
 use crate::config::{
     BirthConfig, ClutterConfig, DetectionConfig, MeasurementConfig, RunConfig, TransitionConfig,
 };
-use crate::error::Result;
-use crate::filter::{AssociationMethod, Estimate, Frame, LmbConfig, LmbFilter, Measurements};
-use crate::models::BearingConvention;
+use crate::error::{Error, Result};
+use crate::filter::{
+    AssociationMethod, Estimate, Frame, Label, LmbConfig, LmbFilter, Measurements,
+};
+use crate::models::{
+    BearingConvention, DetectionModel, FieldOfViewDetection, FieldOfViewSurvival,
+    OcclusionDetection, RangeBearing, StepContext,
+};
 use crate::rng::{seeded, FilterRng};
 use nalgebra::{Isometry3, Vector3};
 
@@ -22,16 +34,35 @@ use nalgebra::{Isometry3, Vector3};
 pub struct PeopleTrackerConfig {
     /// Scan segmentation.
     pub breakpoint: BreakpointConfig,
+    /// Range noise σ_r of one beam (m), for grouping returns into people.
+    pub beam_sigma_range: f64,
+    /// Bearing noise σ_b of one beam (rad), for grouping returns into people.
+    pub beam_sigma_bearing: f64,
     /// Segments wider than this (m) are not people. Default 0.8 m.
     pub max_width: f64,
     /// Groups with fewer points are ignored. Default 2.
     pub min_points: usize,
-    /// Neighbouring segments closer than this (m) are one group. Default 0.6 m.
+    /// Returns closer than this (m) laterally, plus 2 σ_b·r, are one group. Default 0.6 m.
     pub merge_gap: f64,
     /// A segment's middle point lies on the body surface; the centre is this much (m) farther
     /// along the beam. Default 0.2 m.
     pub body_radius: f64,
-    /// The filter: models and tuning (state [x, ẋ, y, ẏ] in the world frame).
+    /// A return blocks the view of a person when it is nearer than the person's surface by
+    /// more than this (m). Default 3 σ_range (at least 0.15 m).
+    pub occlusion_margin: f64,
+    /// Survival per scan of a person outside the field of view (inside it is
+    /// `filter.survival`). Default 0.8: out of sight for 2 s at 8 Hz leaves r ≈ 0.03.
+    pub survival_outside: f64,
+    /// No birth within this distance (m) of a confirmed track. Default 0.8 m.
+    pub birth_suppress_radius: f64,
+    /// A person is reported by [`PeopleTracker::step`] when the expected share of their
+    /// beams the scanner sees is at least this. Default 0.5.
+    pub min_visibility: f64,
+    /// Static/dynamic thresholds.
+    pub motion: MotionConfig,
+    /// The filter: models and tuning (state [x, ẋ, y, ẏ] in the world frame). Its detection
+    /// must be `FieldOfView` (occlusion is added on top) and its birth `Adaptive` (its
+    /// parameters drive [`PeopleBirth`]).
     pub filter: RunConfig,
 }
 
@@ -52,10 +83,17 @@ impl PeopleTrackerConfig {
                 sigma_r: sigma_range.max(BreakpointConfig::default().sigma_r),
                 ..BreakpointConfig::default()
             },
+            beam_sigma_range: sigma_range,
+            beam_sigma_bearing: sigma_bearing,
             max_width: 0.8,
             min_points: 2,
             merge_gap: 0.6,
             body_radius: 0.2,
+            occlusion_margin: (3.0 * sigma_range).max(0.15),
+            survival_outside: 0.8,
+            birth_suppress_radius: 0.8,
+            min_visibility: 0.5,
+            motion: MotionConfig::default(),
             filter: RunConfig {
                 seed: 0,
                 survival: 0.99,
@@ -98,16 +136,30 @@ impl PeopleTrackerConfig {
     }
 }
 
-fn root(owner: &mut [usize], mut i: usize) -> usize {
-    while owner[i] != i {
-        owner[i] = owner[owner[i]];
-        i = owner[i];
-    }
-    i
+fn weighted_mean(w: &[f64], v: &[f64]) -> f64 {
+    w.iter().zip(v).map(|(w, v)| w * v).sum()
 }
 
-fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
-    (a[0] - b[0]).hypot(a[1] - b[1])
+/// One person in one scan's output.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PersonEstimate {
+    /// Track label (birth scan, index).
+    pub label: Label,
+    /// Existence probability.
+    pub existence: f64,
+    /// World position (m).
+    pub position: [f64; 2],
+    /// World velocity (m/s).
+    pub velocity: [f64; 2],
+    /// P(speed > v_min) from the particles.
+    pub p_moving: f64,
+    /// The static/dynamic class after hysteresis (true = dynamic).
+    pub moving: bool,
+    /// Expected share of the person's beams the scanner sees: Σ wᵢ p_D(xᵢ) / p_D,max (0 when
+    /// outside the field of view or hidden behind nearer returns).
+    pub visibility: f64,
+    /// Scans since the track was born.
+    pub age: u32,
 }
 
 /// Turns scans into labelled people estimates.
@@ -116,18 +168,99 @@ pub struct PeopleTracker {
     config: PeopleTrackerConfig,
     filter: LmbFilter,
     rng: FilterRng,
+    detection: OcclusionDetection,
+    birth: PeopleBirth,
+    motion: MotionClassifier,
 }
 
 impl PeopleTracker {
     /// A tracker; the filter's random stream is seeded from `config.filter.seed`.
     pub fn new(config: PeopleTrackerConfig) -> Result<Self> {
-        let filter = config.filter.build()?;
+        let DetectionConfig::FieldOfView {
+            p_inside,
+            p_outside,
+            max_range,
+            half_angle,
+            offset,
+        } = config.filter.detection
+        else {
+            return Err(Error::invalid(
+                "people tracker config field `filter.detection`",
+                "must be FieldOfView (occlusion is added on top)",
+            ));
+        };
+        let BirthConfig::Adaptive {
+            expected_births,
+            max_existence,
+            particles,
+            position_std,
+            velocity_std,
+            ..
+        } = config.filter.birth
+        else {
+            return Err(Error::invalid(
+                "people tracker config field `filter.birth`",
+                "must be Adaptive",
+            ));
+        };
+        let MeasurementConfig::RangeBearing {
+            sigma_range,
+            sigma_bearing,
+            offset: sensor_offset,
+            convention,
+        } = config.filter.measurement
+        else {
+            return Err(Error::invalid(
+                "people tracker config field `filter.measurement`",
+                "must be RangeBearing",
+            ));
+        };
+        let fov = FieldOfViewDetection::new(p_inside, p_outside, max_range, half_angle)?
+            .with_offset(offset[0], offset[1])?;
+        let detection =
+            OcclusionDetection::new(fov, config.body_radius.max(1e-3), config.occlusion_margin)?
+                .with_min_returns(config.min_points as u32);
+        let sensor = RangeBearing::new(sigma_range, sigma_bearing)?
+            .with_offset(sensor_offset[0], sensor_offset[1])?
+            .with_convention(convention);
+        let birth = PeopleBirth::new(
+            sensor,
+            expected_births,
+            max_existence,
+            particles,
+            position_std,
+            velocity_std,
+            config.birth_suppress_radius,
+        )?;
+        let survival =
+            FieldOfViewSurvival::new(fov, config.filter.survival, config.survival_outside)?;
+        let filter = config
+            .filter
+            .builder()?
+            .detection(detection.clone())
+            .survival(survival)
+            .birth(birth.clone())
+            .build()?;
         let rng = seeded(config.filter.seed);
+        let motion = MotionClassifier::new(config.motion)?;
         Ok(PeopleTracker {
             config,
             filter,
             rng,
+            detection,
+            birth,
+            motion,
         })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &PeopleTrackerConfig {
+        &self.config
+    }
+
+    /// The grouping parameters this tracker uses.
+    pub fn grouping(&self) -> PersonGrouping {
+        person_grouping(&self.config)
     }
 
     /// The point groups of `scan` that look like people (see [`person_segments`]).
@@ -140,21 +273,89 @@ impl PeopleTracker {
         person_measurements(&self.config, scan)
     }
 
-    /// One scan: segment, measure, filter. The robot pose is the scan's odometry (the world
-    /// origin when the scan has none).
+    /// One scan: segment, measure, filter. Returns the people the scanner should see now
+    /// (visibility at least `min_visibility`); occluded people and those who left the field
+    /// of view stay in the filter, keep their labels, and come back in the output when they
+    /// reappear. The robot pose is the scan's odometry (the world origin when the scan has
+    /// none).
     pub fn step(&mut self, scan: &Scan) -> Result<Vec<Estimate>> {
+        let people = self.step_people(scan)?;
+        let min = self.config.min_visibility;
+        Ok(people
+            .into_iter()
+            .filter(|p| p.visibility >= min)
+            .map(|p| Estimate {
+                label: p.label,
+                existence: p.existence,
+                state: vec![p.position[0], p.velocity[0], p.position[1], p.velocity[1]],
+                age: p.age,
+            })
+            .collect())
+    }
+
+    /// One scan, with every person of the filter's MAP estimate (visible or not), their
+    /// static/dynamic class and visibility.
+    pub fn step_people(&mut self, scan: &Scan) -> Result<Vec<PersonEstimate>> {
         let measurements = self.measurements(scan)?;
         let platform = scan
             .odometry
             .map(|p| Isometry3::new(Vector3::new(p.x, p.y, 0.0), Vector3::new(0.0, 0.0, p.theta)));
-        self.filter.step(
+        self.detection.update_view(
+            scan.angle_min,
+            scan.angle_increment,
+            (0..scan.len()).map(|i| scan.range(i).unwrap_or(f64::INFINITY)),
+        );
+        self.birth
+            .set_confirmed(self.filter.tracks().iter().map(|t| {
+                let p = &t.particles;
+                (
+                    [
+                        weighted_mean(p.weights(), p.component(0)),
+                        weighted_mean(p.weights(), p.component(2)),
+                    ],
+                    t.existence,
+                )
+            }));
+        let estimates = self.filter.step(
             &Frame {
                 time: scan.time,
                 measurements,
                 platform,
             },
             &mut self.rng,
-        )
+        )?;
+        let mut ctx = StepContext::new(self.filter.steps(), scan.time, 0.0);
+        ctx.platform = platform;
+        let p_max = self.detection.field_of_view().p_inside();
+        let tracks = self.filter.tracks();
+        let mut out = Vec::with_capacity(estimates.len());
+        let mut pd = Vec::new();
+        for e in estimates {
+            let Some(t) = tracks.iter().find(|t| t.label == e.label) else {
+                continue;
+            };
+            let p = &t.particles;
+            pd.resize(p.len(), 0.0);
+            self.detection.detection_probability(p, &ctx, &mut pd);
+            let seen: f64 = p.weights().iter().zip(&pd).map(|(w, d)| w * d).sum();
+            let p_moving = probability_moving(p, self.config.motion.v_min);
+            out.push(PersonEstimate {
+                label: e.label,
+                existence: e.existence,
+                position: [e.state[0], e.state[2]],
+                velocity: [e.state[1], e.state[3]],
+                p_moving,
+                moving: self.motion.update(e.label, p_moving, e.age),
+                visibility: if p_max > 0.0 {
+                    (seen / p_max).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                },
+                age: e.age,
+            });
+        }
+        self.motion.retain(|l| tracks.iter().any(|t| t.label == l));
+        Ok(out)
     }
 
     /// The underlying filter.
@@ -166,76 +367,35 @@ impl PeopleTracker {
 // Scan → measurements, shared by the filter above and by the baseline trackers
 // (`crate::trackers`), which must see exactly the same measurements.
 
-/// The point groups of `scan` that look like people: breakpoint segments, with
-/// neighbouring segments merged while their gap is below `merge_gap` and the merged group
-/// stays within `max_width` (range noise splits a person's outline into pieces), then
-/// filtered by size.
-pub fn person_segments(config: &PeopleTrackerConfig, scan: &Scan) -> Result<Vec<Vec<[f64; 2]>>> {
-    let mut groups: Vec<Vec<[f64; 2]>> = Vec::new();
-    let mut previous: Option<Segment> = None;
-    for s in segment_scan(scan, &config.breakpoint)? {
-        let merge = match (&previous, groups.last()) {
-            (Some(p), Some(g)) => {
-                p.beams.end + 1 >= s.beams.start
-                    && dist(p.last, s.first) <= config.merge_gap
-                    && dist(g[0], s.last) <= config.max_width
-            }
-            _ => false,
-        };
-        if merge {
-            groups
-                .last_mut()
-                .expect("merging into a group")
-                .extend_from_slice(&s.points);
-        } else {
-            groups.push(s.points.clone());
-        }
-        previous = Some(s);
+/// The grouping parameters of `config`.
+pub fn person_grouping(config: &PeopleTrackerConfig) -> PersonGrouping {
+    PersonGrouping {
+        breakpoint: config.breakpoint,
+        body_radius: config.body_radius,
+        max_width: config.max_width,
+        min_points: config.min_points,
+        merge_gap: config.merge_gap,
+        sigma_range: config.beam_sigma_range,
+        sigma_bearing: config.beam_sigma_bearing,
     }
-    Ok(groups
+}
+
+/// The point groups of `scan` that look like people (see [`super::person_groups`]), each as
+/// its points in the sensor frame.
+pub fn person_segments(config: &PeopleTrackerConfig, scan: &Scan) -> Result<Vec<Vec<[f64; 2]>>> {
+    Ok(person_groups(scan, &person_grouping(config))?
         .into_iter()
-        .filter(|g| g.len() >= config.min_points && dist(g[0], g[g.len() - 1]) <= config.max_width)
+        .map(|g| g.points)
         .collect())
 }
 
 /// Range-bearing measurements (sensor frame, bearing from the sensor's x axis) of the
-/// people's centres. Groups whose point means lie within `merge_gap` of each other are one
-/// person (single linkage: noise can split an outline into pieces that are not neighbours
-/// in the scan when another person's beams fall between them); each person's centre is the
-/// mean of its points pushed `body_radius` farther along the beam.
+/// people's centres: one per person group, its mean range pushed `body_radius` farther and
+/// its mean bearing.
 pub fn person_measurements(config: &PeopleTrackerConfig, scan: &Scan) -> Result<Measurements> {
-    let groups = person_segments(config, scan)?;
-    let stats: Vec<(f64, f64, f64)> = groups
-        .iter()
-        .map(|g| {
-            let n = g.len() as f64;
-            let (x, y) = g
-                .iter()
-                .fold((0.0, 0.0), |(sx, sy), p| (sx + p[0] / n, sy + p[1] / n));
-            (x, y, n)
-        })
-        .collect();
-    let mut owner: Vec<usize> = (0..stats.len()).collect();
-    for i in 0..stats.len() {
-        for j in 0..i {
-            if dist([stats[i].0, stats[i].1], [stats[j].0, stats[j].1]) <= config.merge_gap {
-                let (a, b) = (root(&mut owner, i), root(&mut owner, j));
-                owner[a.max(b)] = a.min(b);
-            }
-        }
-    }
-    let mut merged: Vec<(f64, f64, f64)> = vec![(0.0, 0.0, 0.0); stats.len()];
-    for (i, &(x, y, n)) in stats.iter().enumerate() {
-        let m = &mut merged[root(&mut owner, i)];
-        *m = (m.0 + x * n, m.1 + y * n, m.2 + n);
-    }
-    let rows: Vec<[f64; 2]> = merged
+    let rows: Vec<[f64; 2]> = person_groups(scan, &person_grouping(config))?
         .into_iter()
-        .filter(|m| m.2 > 0.0)
-        .map(|(sx, sy, n)| {
-            let (x, y) = (sx / n, sy / n);
-            [x.hypot(y) + config.body_radius, y.atan2(x)]
-        })
+        .map(|g| [g.range, g.bearing])
         .collect();
     Measurements::from_rows(2, &rows)
 }

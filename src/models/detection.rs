@@ -3,7 +3,8 @@
 //!
 //! All three read the position from components 0 and 2 of the state (the layout of the
 //! built-in motion models, see [`crate::models`]); particle sets with fewer than three
-//! components get p_D = 0. Not for: occlusion or appearance-based detectability.
+//! components get p_D = 0. Not for: occlusion (see [`super::occlusion`]) or appearance-based
+//! detectability.
 
 use super::survival::clamp_probability;
 use super::{DetectionModel, StepContext};
@@ -154,20 +155,37 @@ impl FieldOfViewDetection {
         self.contains_from(x, y, sx, sy, c, s)
     }
 
+    /// Probability inside the sector.
+    pub fn p_inside(&self) -> f64 {
+        self.p_inside
+    }
+
+    /// Probability outside the sector.
+    pub fn p_outside(&self) -> f64 {
+        self.p_outside
+    }
+
     /// Sensor position and (cos φ, sin φ) of its heading.
-    fn sensor(&self, ctx: &StepContext) -> (f64, f64, f64, f64) {
+    pub(crate) fn sensor(&self, ctx: &StepContext) -> (f64, f64, f64, f64) {
         let (px, py, phi) = ctx.platform_xy_heading();
         let (s, c) = phi.sin_cos();
         let (a, b) = self.offset;
         (px + a * c - b * s, py + a * s + b * c, c, s)
     }
 
-    fn contains_from(&self, x: f64, y: f64, sx: f64, sy: f64, c: f64, s: f64) -> bool {
+    /// |bearing| ≤ half angle is tested as cos(bearing) ≥ cos(half angle), i.e.
+    /// l_x ≥ d · cos(half angle) (cos falls on [0, π]), which avoids an atan2 per particle.
+    #[inline]
+    pub(crate) fn contains_from(&self, x: f64, y: f64, sx: f64, sy: f64, c: f64, s: f64) -> bool {
         let dx = x - sx;
         let dy = y - sy;
         let lx = c * dx + s * dy;
         let ly = -s * dx + c * dy;
-        lx.hypot(ly) <= self.max_range && ly.atan2(lx).abs() <= self.half_angle
+        let d2 = lx * lx + ly * ly;
+        if d2 > self.max_range * self.max_range {
+            return false;
+        }
+        self.half_angle >= std::f64::consts::PI || lx >= d2.sqrt() * self.half_angle.cos()
     }
 }
 

@@ -146,17 +146,21 @@ pub mod clutter;
 pub mod ct;
 pub mod cv;
 pub mod detection;
+pub mod occlusion;
 pub mod position;
 pub mod range_bearing;
 pub mod survival;
+pub mod view_survival;
 
 pub use clutter::UniformClutter;
 pub use ct::CoordinatedTurn;
 pub use cv::ConstantVelocity;
 pub use detection::{ConstantDetection, FieldOfViewDetection, GaussianRangeDetection};
+pub use occlusion::{BeamView, OcclusionDetection};
 pub use position::PositionMeasurement;
 pub use range_bearing::{wrap_angle, BearingConvention, RangeBearing};
 pub use survival::ConstantSurvival;
+pub use view_survival::FieldOfViewSurvival;
 
 // A boxed model is a model: lets trait objects (e.g. chosen at run time) go wherever a model
 // is expected.

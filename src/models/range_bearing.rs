@@ -203,7 +203,9 @@ impl RangeBearing {
             BearingConvention::FromXAxis => ly.atan2(lx),
             BearingConvention::FromYAxis => lx.atan2(ly),
         };
-        (dx.hypot(dy), bearing)
+        // sqrt, not hypot: no overflow at these scales, and hypot's care costs a third of a
+        // likelihood evaluation
+        ((dx * dx + dy * dy).sqrt(), bearing)
     }
 
     /// The noiseless measurement [range, bearing] of `state` (position in components 0

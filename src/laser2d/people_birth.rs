@@ -1,0 +1,218 @@
+//! Measurement-driven birth for the people tracker: a range-bearing measurement of the previous
+//! scan that no track explained proposes a new person there, unless a confirmed track already
+//! stands close by.
+//!
+//! Two differences from the normalised rule of Reuter et al. (2014, Sec. IV) that
+//! [`crate::filter::AdaptiveBirth`] implements:
+//!
+//! * r_B(z) = min(r_max, λ_B · (1 − r_A(z))), *not* divided by the total unexplained mass
+//!   Σ_ξ (1 − r_A(ξ)). The normalised rule hands out λ_B in total at every scan, so when all
+//!   measurements are well explained their tiny remainders are scaled up to r_max and every
+//!   person spawns a duplicate proposal at every scan.
+//! * Suppression: a measurement within `suppress_radius` of a track whose existence is at
+//!   least `suppress_existence` proposes nothing. A person whose outline the range noise
+//!   breaks into two pieces yields one measurement the track takes and one it cannot; without
+//!   suppression the second piece starts a duplicate that the next split confirms.
+//!
+//! The tracks to suppress around are handed over by the tracker before each step through a
+//! shared list (see [`PeopleBirth::set_confirmed`]). Not for: the filter's other birth models
+//! or deciding what a measurement is.
+
+use crate::error::{ensure_positive, ensure_probability, Result};
+use crate::filter::birth::BirthEvidence;
+use crate::filter::{BirthModel, BirthTrack, ParticleSet};
+use crate::models::{RangeBearing, StepContext};
+use crate::rng::FilterRng;
+use rand_distr::{Distribution, StandardNormal};
+use std::sync::{Arc, RwLock};
+
+/// Measurement-driven birth with suppression near confirmed tracks (module documentation).
+/// Clones share the list of confirmed positions.
+#[derive(Clone, Debug)]
+pub struct PeopleBirth {
+    sensor: RangeBearing,
+    /// λ_B: existence of a proposal from a wholly unexplained measurement, before the cap.
+    pub expected_births: f64,
+    /// r_max.
+    pub max_existence: f64,
+    /// Proposals below this existence are not made.
+    pub min_existence: f64,
+    /// Particles per proposal.
+    pub particles: usize,
+    /// Position spread (m) added to the measurement's own spread.
+    pub position_std: f64,
+    /// Velocity spread (m/s) per axis around zero.
+    pub velocity_std: f64,
+    /// No proposal within this distance (m) of a confirmed track.
+    pub suppress_radius: f64,
+    /// Tracks with at least this existence count as confirmed.
+    pub suppress_existence: f64,
+    confirmed: Arc<RwLock<Vec<[f64; 2]>>>,
+}
+
+impl PeopleBirth {
+    /// Birth for measurements of `sensor` (noise, mount offset, bearing convention).
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        sensor: RangeBearing,
+        expected_births: f64,
+        max_existence: f64,
+        particles: usize,
+        position_std: f64,
+        velocity_std: f64,
+        suppress_radius: f64,
+    ) -> Result<Self> {
+        ensure_positive("expected births", expected_births)?;
+        ensure_probability("maximum birth existence", max_existence)?;
+        ensure_positive("birth particle count", particles as f64)?;
+        crate::error::ensure_finite(
+            "birth spreads",
+            &[position_std, velocity_std, suppress_radius],
+        )?;
+        Ok(PeopleBirth {
+            sensor,
+            expected_births,
+            max_existence,
+            min_existence: 1e-3,
+            particles,
+            position_std: position_std.abs(),
+            velocity_std: velocity_std.abs(),
+            suppress_radius: suppress_radius.max(0.0),
+            suppress_existence: 0.5,
+            confirmed: Arc::new(RwLock::new(Vec::new())),
+        })
+    }
+
+    /// Replaces the list of tracks (world positions at the previous scan, with their existence)
+    /// around which no birth is proposed; tracks below `suppress_existence` are ignored.
+    pub fn set_confirmed(&self, tracks: impl IntoIterator<Item = ([f64; 2], f64)>) {
+        let mut c = self.confirmed.write().unwrap_or_else(|e| e.into_inner());
+        c.clear();
+        c.extend(
+            tracks
+                .into_iter()
+                .filter(|(_, r)| *r >= self.suppress_existence)
+                .map(|(p, _)| p),
+        );
+    }
+
+    /// r_B for an association probability `assigned` (before suppression).
+    pub fn existence(&self, assigned: f64) -> f64 {
+        (self.expected_births * (1.0 - assigned.clamp(0.0, 1.0))).min(self.max_existence)
+    }
+
+    fn sample(&self, z: [f64; 2], ctx: &StepContext, rng: &mut FilterRng) -> ParticleSet {
+        let centre = self.sensor.to_cartesian(z, ctx);
+        let mut set = ParticleSet::gaussian(
+            &[centre[0], 0.0, centre[1], 0.0],
+            &[
+                self.position_std,
+                self.velocity_std,
+                self.position_std,
+                self.velocity_std,
+            ],
+            self.particles,
+            rng,
+        );
+        let (sr, sb) = self.sensor.noise();
+        let mut comps = set.components_mut().into_iter();
+        let (x, _, y) = (
+            comps.next().expect("x"),
+            comps.next(),
+            comps.next().expect("y"),
+        );
+        for (xi, yi) in x.iter_mut().zip(y.iter_mut()) {
+            let er: f64 = StandardNormal.sample(rng);
+            let eb: f64 = StandardNormal.sample(rng);
+            let p = self
+                .sensor
+                .to_cartesian([z[0] + sr * er, z[1] + sb * eb], ctx);
+            *xi += p[0] - centre[0];
+            *yi += p[1] - centre[1];
+        }
+        set
+    }
+}
+
+impl BirthModel for PeopleBirth {
+    fn birth(
+        &self,
+        _: &StepContext,
+        evidence: Option<&BirthEvidence<'_>>,
+        rng: &mut FilterRng,
+    ) -> Vec<BirthTrack> {
+        let Some(ev) = evidence else {
+            return Vec::new();
+        };
+        let confirmed = self.confirmed.read().unwrap_or_else(|e| e.into_inner());
+        let r2 = self.suppress_radius * self.suppress_radius;
+        ev.measurements
+            .iter()
+            .zip(ev.assigned)
+            .filter_map(|(z, &a)| {
+                let r = self.existence(a);
+                if r < self.min_existence || z.len() < 2 {
+                    return None;
+                }
+                let zz = [z[0], z[1]];
+                let p = self.sensor.to_cartesian(zz, ev.context);
+                let near = confirmed.iter().any(|c| {
+                    let (dx, dy) = (c[0] - p[0], c[1] - p[1]);
+                    dx * dx + dy * dy < r2
+                });
+                (!near).then(|| BirthTrack {
+                    existence: r,
+                    particles: self.sample(zz, ev.context, rng),
+                    at_previous_step: true,
+                })
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::filter::Measurements;
+    use crate::rng::seeded;
+
+    fn birth() -> PeopleBirth {
+        let rb = RangeBearing::new(0.1, 0.01).unwrap();
+        PeopleBirth::new(rb, 0.2, 0.2, 400, 0.1, 0.5, 1.0).unwrap()
+    }
+
+    #[test]
+    fn existence_is_not_normalised() {
+        let b = birth();
+        // well explained measurements stay near zero whatever the others do
+        assert!((b.existence(0.99) - 0.002).abs() < 1e-12);
+        assert!((b.existence(0.0) - 0.2).abs() < 1e-12);
+        assert!((b.existence(0.5) - 0.1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn proposals_sit_at_the_measurement_and_avoid_confirmed_tracks() {
+        let b = birth();
+        let ctx = StepContext::new(0, 0.0, 0.1);
+        // (range 5, bearing 0) → (5, 0); (range 4, bearing π/2) → (0, 4)
+        let m =
+            Measurements::from_rows(2, &[[5.0, 0.0], [4.0, std::f64::consts::FRAC_PI_2]]).unwrap();
+        let ev = BirthEvidence {
+            measurements: &m,
+            assigned: &[0.0, 0.0],
+            context: &ctx,
+        };
+        let all = b.birth(&ctx, Some(&ev), &mut seeded(1));
+        assert_eq!(all.len(), 2);
+        let mean = all[0].particles.mean();
+        assert!(
+            (mean[0] - 5.0).abs() < 0.05 && mean[2].abs() < 0.05,
+            "{mean:?}"
+        );
+        // a confirmed track 0.5 m from (0, 4) suppresses that proposal; a weak one does not
+        b.set_confirmed([([0.3, 4.4], 0.9), ([5.0, 0.2], 0.1)]);
+        let some = b.birth(&ctx, Some(&ev), &mut seeded(1));
+        assert_eq!(some.len(), 1);
+        assert!((some[0].particles.mean()[0] - 5.0).abs() < 0.05);
+    }
+}

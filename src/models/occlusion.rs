@@ -1,0 +1,433 @@
+//! Occlusion-aware detection probability for a planar range scanner: p_D(x) is zero outside
+//! the scanner's field of view and range, and inside it falls with the share of the object's
+//! beams that end clearly in front of it in the current scan.
+//!
+//! The model needs the scan the update is about to use; the caller hands it over before every
+//! filter step through a cloned [`OcclusionDetection`] (all clones share one [`BeamView`]).
+//! Not for: appearance or shape-dependent detectability, or deciding which returns belong to
+//! which object.
+//!
+//! # The rule
+//!
+//! A particle at world position (x, y) is seen from the sensor (platform pose of the step moved
+//! by the mounting offset, as in [`FieldOfViewDetection`]) at range d and bearing β. The object
+//! is a disc of radius ρ, so it covers the bearings β ± asin(ρ / d) (at least the beam nearest
+//! to β). A beam of that window is *blocked* when its return is shorter than d − ρ − m, with m
+//! a margin of a few range-noise standard deviations: such a return lies clearly nearer than
+//! the object's own surface. With b blocked beams out of n,
+//!
+//! p_D(x) = p_inside · (1 − b / n)  inside the field of view, p_outside elsewhere.
+//!
+//! With `min_returns` = m > 0 the model also accounts for range: a detector that needs m
+//! returns on the object cannot see far objects that catch fewer beams. With bearing noise the
+//! number of beams ending on the disc is close to Poisson with mean μ = (1 − b / n) ·
+//! 2 asin(ρ / d) / |Δθ| (Δθ the beam spacing), and
+//!
+//! p_D(x) = p_inside · P(N ≥ m),  N ~ Poisson(μ),  P(N ≥ m) = 1 − Σ_{j<m} e^(−μ) μ^j / j!.
+//!
+//! Without a view set, no beam is blocked and the model equals the field-of-view model.
+
+use super::detection::FieldOfViewDetection;
+use super::{DetectionModel, StepContext};
+use crate::error::{ensure_finite, ensure_positive, Error, Result};
+use crate::filter::ParticleSet;
+use std::sync::{Arc, RwLock};
+
+/// The beams of one scan in the sensor frame: bearing of beam i = `angle_min + i · increment`,
+/// its range (`+∞` for "no return").
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BeamView {
+    angle_min: f64,
+    angle_increment: f64,
+    ranges: Vec<f64>,
+}
+
+impl BeamView {
+    /// A view from the scan header and its ranges; non-finite or non-positive ranges mean "no
+    /// return" and never block.
+    pub fn new(angle_min: f64, angle_increment: f64, ranges: &[f64]) -> Result<Self> {
+        ensure_finite("beam view header", &[angle_min, angle_increment])?;
+        if angle_increment == 0.0 && ranges.len() > 1 {
+            return Err(Error::invalid(
+                "beam view",
+                "angle increment is zero with several beams",
+            ));
+        }
+        let mut view = BeamView {
+            angle_min,
+            angle_increment,
+            ranges: Vec::with_capacity(ranges.len()),
+        };
+        view.set_ranges(ranges.iter().copied());
+        Ok(view)
+    }
+
+    /// Replaces the ranges, keeping the header (reuses the buffer).
+    pub fn set_ranges(&mut self, ranges: impl IntoIterator<Item = f64>) {
+        self.ranges.clear();
+        self.ranges.extend(ranges.into_iter().map(|r| {
+            if r.is_finite() && r > 0.0 {
+                r
+            } else {
+                f64::INFINITY
+            }
+        }));
+    }
+
+    /// Number of beams.
+    pub fn len(&self) -> usize {
+        self.ranges.len()
+    }
+
+    /// True without beams.
+    pub fn is_empty(&self) -> bool {
+        self.ranges.is_empty()
+    }
+
+    /// (blocked, total) beams of the window `bearing ± half_width` whose return is shorter than
+    /// `limit`; the window holds at least the beam nearest to `bearing` when that lies in the
+    /// scan. (0, 0) when the window misses the scan.
+    pub fn blocked(&self, bearing: f64, half_width: f64, limit: f64) -> (usize, usize) {
+        let n = self.ranges.len();
+        if n == 0 {
+            return (0, 0);
+        }
+        let inc = if self.angle_increment == 0.0 {
+            1.0
+        } else {
+            self.angle_increment
+        };
+        let a = (bearing - half_width - self.angle_min) / inc;
+        let b = (bearing + half_width - self.angle_min) / inc;
+        let (lo, hi) = if a <= b { (a, b) } else { (b, a) };
+        let (mut first, mut last) = (lo.ceil(), hi.floor());
+        if first > last {
+            let c = ((bearing - self.angle_min) / inc).round();
+            first = c;
+            last = c;
+        }
+        let first = first.max(0.0);
+        let last = last.min((n - 1) as f64);
+        if first > last {
+            return (0, 0);
+        }
+        let window = &self.ranges[first as usize..=last as usize];
+        let blocked = window.iter().filter(|&&r| r < limit).count();
+        (blocked, window.len())
+    }
+}
+
+/// p_D from the field of view and the occlusion by nearer returns of the current scan (see the
+/// module documentation). Clones share the view: keep one clone, call
+/// [`OcclusionDetection::set_view`] before each step, give the other to the filter.
+#[derive(Clone, Debug)]
+pub struct OcclusionDetection {
+    fov: FieldOfViewDetection,
+    object_radius: f64,
+    margin: f64,
+    min_returns: u32,
+    view: Arc<RwLock<BeamView>>,
+}
+
+/// atan2(y, x) to within 2e-5 rad by an odd polynomial on [0, 1] and octant symmetry: the
+/// beam lookup needs a small fraction of a beam spacing, and the library function dominates
+/// the cost of p_D otherwise.
+#[inline]
+pub(crate) fn fast_atan2(y: f64, x: f64) -> f64 {
+    use std::f64::consts::{FRAC_PI_2, PI};
+    let (ax, ay) = (x.abs(), y.abs());
+    let (num, den, swapped) = if ay > ax {
+        (ax, ay, true)
+    } else {
+        (ay, ax, false)
+    };
+    if den == 0.0 {
+        return 0.0;
+    }
+    let z = num / den;
+    let z2 = z * z;
+    let mut a = z
+        * (0.999_977_26
+            + z2 * (-0.332_623_47
+                + z2 * (0.193_543_46
+                    + z2 * (-0.116_432_87 + z2 * (0.052_653_32 - 0.011_721_20 * z2)))));
+    if swapped {
+        a = FRAC_PI_2 - a;
+    }
+    if x < 0.0 {
+        a = PI - a;
+    }
+    if y < 0.0 {
+        -a
+    } else {
+        a
+    }
+}
+
+/// P(N ≥ m) for N ~ Poisson(μ).
+pub fn poisson_at_least(m: u32, mu: f64) -> f64 {
+    if m == 0 {
+        return 1.0;
+    }
+    if mu.is_nan() || mu <= 0.0 {
+        return 0.0;
+    }
+    let mut term = (-mu).exp();
+    let mut below = term;
+    for j in 1..m {
+        term *= mu / j as f64;
+        below += term;
+    }
+    (1.0 - below).clamp(0.0, 1.0)
+}
+
+impl OcclusionDetection {
+    /// Occlusion on top of the sector `fov`, for objects of radius `object_radius` > 0 (m),
+    /// with returns counting as blockers when nearer than the object's surface by more than
+    /// `margin` ≥ 0 (m).
+    pub fn new(fov: FieldOfViewDetection, object_radius: f64, margin: f64) -> Result<Self> {
+        ensure_positive("occlusion object radius", object_radius)?;
+        if !(margin.is_finite() && margin >= 0.0) {
+            return Err(Error::invalid(
+                "occlusion margin",
+                format!("{margin} must be finite and ≥ 0"),
+            ));
+        }
+        Ok(OcclusionDetection {
+            fov,
+            object_radius,
+            margin,
+            min_returns: 0,
+            view: Arc::new(RwLock::new(BeamView::default())),
+        })
+    }
+
+    /// The same model for a detector that needs `m` returns on an object (0: off).
+    pub fn with_min_returns(mut self, m: u32) -> Self {
+        self.min_returns = m;
+        self
+    }
+
+    /// Sets the scan that the next steps' p_D is computed against (shared by all clones).
+    pub fn set_view(&self, view: BeamView) {
+        *self.view.write().unwrap_or_else(|e| e.into_inner()) = view;
+    }
+
+    /// Replaces the shared view's header and ranges in place (no allocation once the buffer
+    /// is large enough).
+    pub fn update_view(
+        &self,
+        angle_min: f64,
+        angle_increment: f64,
+        ranges: impl IntoIterator<Item = f64>,
+    ) {
+        let mut v = self.view.write().unwrap_or_else(|e| e.into_inner());
+        v.angle_min = angle_min;
+        v.angle_increment = angle_increment;
+        v.set_ranges(ranges);
+    }
+
+    /// The field-of-view part.
+    pub fn field_of_view(&self) -> &FieldOfViewDetection {
+        &self.fov
+    }
+
+    /// p_D of one world point at this step.
+    pub fn at(&self, x: f64, y: f64, ctx: &StepContext) -> f64 {
+        let set = ParticleSet::from_rows(&[vec![x, 0.0, y, 0.0]], &[1.0]).expect("one particle");
+        let mut out = [0.0];
+        self.detection_probability(&set, ctx, &mut out);
+        out[0]
+    }
+}
+
+impl DetectionModel for OcclusionDetection {
+    fn detection_probability(&self, particles: &ParticleSet, ctx: &StepContext, out: &mut [f64]) {
+        if particles.dim() < 3 {
+            out.fill(0.0);
+            return;
+        }
+        let view = self.view.read().unwrap_or_else(|e| e.into_inner());
+        let (sx, sy, c, s) = self.fov.sensor(ctx);
+        let (p_in, p_out) = (self.fov.p_inside(), self.fov.p_outside());
+        let xs = particles.component(0);
+        let ys = particles.component(2);
+        for ((o, &x), &y) in out.iter_mut().zip(xs).zip(ys) {
+            if !self.fov.contains_from(x, y, sx, sy, c, s) {
+                *o = p_out;
+                continue;
+            }
+            let (dx, dy) = (x - sx, y - sy);
+            let (lx, ly) = (c * dx + s * dy, -s * dx + c * dy);
+            let d = (lx * lx + ly * ly).sqrt();
+            let half = if d > self.object_radius {
+                let q = self.object_radius / d;
+                if q < 0.3 {
+                    // asin series to q⁷: error below 1e-5 rad for q < 0.3
+                    let q2 = q * q;
+                    q * (1.0 + q2 * (1.0 / 6.0 + q2 * (3.0 / 40.0 + q2 * 5.0 / 112.0)))
+                } else {
+                    q.asin()
+                }
+            } else {
+                std::f64::consts::FRAC_PI_2
+            };
+            let (blocked, total) = view.blocked(
+                fast_atan2(ly, lx),
+                half,
+                d - self.object_radius - self.margin,
+            );
+            let free = if total == 0 {
+                1.0
+            } else {
+                1.0 - blocked as f64 / total as f64
+            };
+            *o = if self.min_returns == 0 {
+                p_in * free
+            } else {
+                let spacing = view.angle_increment.abs();
+                if spacing > 0.0 {
+                    p_in * poisson_at_least(self.min_returns, free * 2.0 * half / spacing)
+                } else {
+                    p_in * free
+                }
+            };
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Isometry3, Vector3};
+    use std::f64::consts::{FRAC_PI_2, PI};
+
+    /// 181 beams over ±90°, 1° apart, all at 20 m except a wall piece at 3 m over beams
+    /// 85..=95 (bearings −5°..=5°).
+    fn view() -> BeamView {
+        let ranges: Vec<f64> = (0..181)
+            .map(|i| if (85..=95).contains(&i) { 3.0 } else { 20.0 })
+            .collect();
+        BeamView::new(-FRAC_PI_2, PI / 180.0, &ranges).unwrap()
+    }
+
+    fn model() -> OcclusionDetection {
+        let fov = FieldOfViewDetection::new(0.9, 0.0, 30.0, FRAC_PI_2).unwrap();
+        let m = OcclusionDetection::new(fov, 0.2, 0.3).unwrap();
+        m.set_view(view());
+        m
+    }
+
+    #[test]
+    fn window_counts_blocked_beams() {
+        let v = view();
+        // straight ahead, ±2°: beams 88..=92, all at 3 m < 5 m
+        assert_eq!(v.blocked(0.0, 2f64.to_radians(), 5.0), (5, 5));
+        // 10° left, ±2°: beams 98..=102 at 20 m
+        assert_eq!(
+            v.blocked(10f64.to_radians(), 2f64.to_radians(), 5.0),
+            (0, 5)
+        );
+        // straddling the wall's edge at 5°: beams 93..=97 → 93, 94, 95 blocked
+        assert_eq!(v.blocked(5f64.to_radians(), 2f64.to_radians(), 5.0), (3, 5));
+        // a window narrower than a beam takes the nearest beam
+        assert_eq!(v.blocked(0.2f64.to_radians(), 1e-4, 5.0), (1, 1));
+        // behind the scanner: nothing
+        assert_eq!(v.blocked(PI, 0.01, 5.0), (0, 0));
+    }
+
+    #[test]
+    fn occluded_visible_and_outside_particles() {
+        let m = model();
+        let ctx = StepContext::new(0, 0.0, 0.1);
+        // 10 m straight ahead, behind the 3 m wall: every beam of its ±1.15° window blocked
+        assert_eq!(m.at(10.0, 0.0, &ctx), 0.0);
+        // 2.5 m ahead, in front of the wall: the wall (3 m) is not nearer → fully visible
+        assert_eq!(m.at(2.5, 0.0, &ctx), 0.9);
+        // a particle right at the wall's surface: wall returns are not "clearly nearer"
+        assert_eq!(m.at(3.2, 0.0, &ctx), 0.9);
+        // 10 m at bearing 30°: free
+        let (s, c) = 30f64.to_radians().sin_cos();
+        assert_eq!(m.at(10.0 * c, 10.0 * s, &ctx), 0.9);
+        // behind the scanner or beyond 30 m: outside the field of view
+        assert_eq!(m.at(-5.0, 0.0, &ctx), 0.0);
+        assert_eq!(m.at(0.0, 35.0, &ctx), 0.0);
+    }
+
+    #[test]
+    fn partial_occlusion_scales_the_probability() {
+        // the wall ends at bearing 5.5°; an object at 10 m, bearing 5° covers ±1.146°,
+        // beams at 4°, 5° (blocked) and 6° (free) → p = 0.9 · 1/3
+        let m = model();
+        let (s, c) = 5f64.to_radians().sin_cos();
+        let p = m.at(10.0 * c, 10.0 * s, &StepContext::new(0, 0.0, 0.1));
+        assert!((p - 0.3).abs() < 1e-12, "{p}");
+    }
+
+    #[test]
+    fn the_view_follows_the_platform() {
+        // platform at (100, 50) facing +y; the wall piece is now 3 m north of it
+        let m = model();
+        let mut ctx = StepContext::new(3, 1.0, 0.1);
+        ctx.platform = Some(Isometry3::new(
+            Vector3::new(100.0, 50.0, 0.0),
+            Vector3::new(0.0, 0.0, FRAC_PI_2),
+        ));
+        assert_eq!(m.at(100.0, 60.0, &ctx), 0.0);
+        assert_eq!(m.at(105.0, 55.0, &ctx), 0.9);
+        // a clone shares the view: clearing it through the clone unblocks the point
+        let other = m.clone();
+        other.update_view(-FRAC_PI_2, PI / 180.0, vec![f64::NAN; 181]);
+        assert_eq!(m.at(100.0, 60.0, &ctx), 0.9);
+    }
+
+    #[test]
+    fn fast_atan2_is_close_to_the_library() {
+        let mut worst: f64 = 0.0;
+        for i in 0..3600 {
+            let a = -PI + (i as f64 + 0.5) * (2.0 * PI / 3600.0);
+            for r in [0.1, 1.0, 37.0] {
+                let (y, x) = (r * a.sin(), r * a.cos());
+                worst = worst.max((fast_atan2(y, x) - y.atan2(x)).abs());
+            }
+        }
+        assert!(worst < 2e-5, "{worst}");
+        assert_eq!(fast_atan2(0.0, 0.0), 0.0);
+        assert!((fast_atan2(1.0, 0.0) - FRAC_PI_2).abs() < 1e-12);
+    }
+
+    #[test]
+    fn poisson_tail_matches_hand_values() {
+        // P(N ≥ 2 | μ = 2) = 1 − e^(−2)(1 + 2) = 0.593994…
+        assert!((poisson_at_least(2, 2.0) - 0.593_994_150_290_161_9).abs() < 1e-12);
+        assert!((poisson_at_least(1, 1.0) - (1.0 - (-1.0f64).exp())).abs() < 1e-15);
+        assert_eq!(poisson_at_least(0, 0.0), 1.0);
+        assert_eq!(poisson_at_least(3, 0.0), 0.0);
+    }
+
+    #[test]
+    fn far_objects_catch_too_few_beams() {
+        // 1° beams, object radius 0.2 m, needs 2 returns. At 10 m: μ = 2 asin(0.02) / 1° =
+        // 2.2920…; at 25 m: μ = 0.9167…
+        let m = model().with_min_returns(2);
+        m.update_view(-FRAC_PI_2, PI / 180.0, vec![30.0; 181]);
+        let ctx = StepContext::new(0, 0.0, 0.1);
+        let mu = |d: f64| 2.0 * (0.2f64 / d).asin() / (PI / 180.0);
+        let (s, c) = 20f64.to_radians().sin_cos();
+        let near = m.at(10.0 * c, 10.0 * s, &ctx);
+        let far = m.at(25.0 * c, 25.0 * s, &ctx);
+        let expect = |mu: f64| 0.9 * (1.0 - (-mu).exp() * (1.0 + mu));
+        assert!((near - expect(mu(10.0))).abs() < 1e-12, "{near}");
+        assert!((far - expect(mu(25.0))).abs() < 1e-12, "{far}");
+        assert!(far < 0.25 && near > 0.6);
+    }
+
+    #[test]
+    fn invalid_parameters_are_rejected() {
+        let fov = FieldOfViewDetection::new(0.9, 0.0, 30.0, FRAC_PI_2).unwrap();
+        assert!(OcclusionDetection::new(fov, 0.0, 0.3).is_err());
+        assert!(OcclusionDetection::new(fov, 0.2, -1.0).is_err());
+        assert!(BeamView::new(0.0, 0.0, &[1.0, 2.0]).is_err());
+        assert!(BeamView::new(f64::NAN, 0.1, &[1.0]).is_err());
+    }
+}
