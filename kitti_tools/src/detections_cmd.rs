@@ -42,6 +42,11 @@ pub struct Args {
 
 /// Reads a TOML or JSON run configuration, naming the file and line of any problem.
 pub fn read_config(path: &Path) -> Result<RunConfig> {
+    read_config_file(path)
+}
+
+/// Reads any TOML or JSON configuration type, naming the file and line of any problem.
+pub fn read_config_file<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let ext = path

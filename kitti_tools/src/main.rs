@@ -5,6 +5,7 @@ mod convert_cmd;
 mod detections_cmd;
 mod info_cmd;
 mod planes_cmd;
+mod track_cmd;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
@@ -32,6 +33,9 @@ enum Command {
     /// Segment building walls in consecutive Velodyne frames of a drive or odometry
     /// sequence, predict them one frame ahead and print area, vertex and normal errors.
     Planes(planes_cmd::Args),
+    /// Track building walls and point clusters of a KITTI raw drive with one labelled
+    /// multi-Bernoulli filter; write per-frame tracks (JSON), labelled clouds and a plot.
+    Track(track_cmd::Args),
 }
 
 fn main() -> Result<()> {
@@ -40,5 +44,6 @@ fn main() -> Result<()> {
         Command::Convert(args) => convert_cmd::run(args),
         Command::Info(args) => info_cmd::run(args),
         Command::Planes(args) => planes_cmd::run(args),
+        Command::Track(args) => track_cmd::run(args),
     }
 }

@@ -207,7 +207,8 @@ impl Default for ClusterDetectionConfig {
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct TrackingConfig {
-    /// Filter tuning (particles per track, resampling, pruning).
+    /// Filter tuning (particles per track, resampling, pruning). Default: the filter's
+    /// defaults with room for 200 tracks.
     pub filter: LmbConfig,
     /// How walls follow the ego motion. Default: measured poses.
     pub ego: EgoModel,
@@ -229,7 +230,10 @@ pub struct TrackingConfig {
 impl Default for TrackingConfig {
     fn default() -> Self {
         TrackingConfig {
-            filter: LmbConfig::default(),
+            filter: LmbConfig {
+                max_tracks: 200,
+                ..LmbConfig::default()
+            },
             ego: EgoModel::Measured,
             plane: PlaneTuning::default(),
             cluster: ClusterTuning::default(),

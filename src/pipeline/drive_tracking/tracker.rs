@@ -87,12 +87,14 @@ impl DriveTracker {
             cluster_sigma_vertical: c.birth_vertical,
         };
         sampler.validate()?;
-        let birth = AdaptiveBirth::new(
+        let mut birth = AdaptiveBirth::new(
             sampler,
             config.birth.expected_births,
             config.birth.max_existence,
             config.filter.particles,
         )?;
+        // A proposal below the pruning threshold would be pruned right after its first update.
+        birth.min_existence = config.filter.prune_threshold.max(birth.min_existence);
         let filter = LmbFilter::builder()
             .transition(transition)
             .measurement(MixedMeasurement::new(plane_meas, c.sigma, c.gate)?)
