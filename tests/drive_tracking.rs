@@ -315,3 +315,35 @@ fn full_real_frames_when_present() {
     eprintln!("{s:#?}");
     assert!(s.mean_planes + s.mean_clusters > 1.0, "{s:?}");
 }
+
+#[test]
+fn ect_ego_model_keeps_wall_labels_and_needs_oxts() {
+    use smc_lmb::pipeline::drive_tracking::EgoModel;
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = synthetic_drive(tmp.path());
+    let mut c = config();
+    c.filter.particles = 300;
+    c.ego = EgoModel::Ect {
+        sigma_accel: 0.5,
+        sigma_turn_accel: 0.1,
+    };
+    let drive = RawDrive::open(&dir).unwrap();
+    let tracks = track_drive(&drive, Some(0..6), &c, 9, |_| Ok(())).unwrap();
+    assert_eq!(tracks.ego, "oxts+ect");
+    let wall_labels: BTreeSet<Label> = tracks.frames[2..]
+        .iter()
+        .flat_map(|f| f.planes.iter().map(|p| p.label))
+        .collect();
+    assert_eq!(wall_labels.len(), 2, "{wall_labels:?}");
+    for f in &tracks.frames[2..] {
+        assert_eq!(f.planes.len(), 2, "frame {}: {:?}", f.frame, f.planes);
+        for p in &f.planes {
+            assert!((p.offset - 10.0).abs() < 0.5, "{p:?}");
+        }
+    }
+    let no_oxts = static_real_drive(tmp.path(), 2);
+    let err = track_drive(&RawDrive::open(&no_oxts).unwrap(), None, &c, 1, |_| Ok(()))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("OXTS"), "{err}");
+}
