@@ -100,7 +100,7 @@ pub fn detect_objects(
     let c = &config.clusters;
     let (xs, ys, zs) = (cloud.xs(), cloud.ys(), cloud.zs());
     // Height above the ground plane (or above a flat road at the nominal mounting height).
-    let ground = seg.ground.as_ref().map(|g| g.patch.plane.clone());
+    let ground = seg.ground.as_ref().map(|g| g.patch.plane);
     let above = |i: usize| -> f64 {
         let p = nalgebra::Point3::new(xs[i] as f64, ys[i] as f64, zs[i] as f64);
         match &ground {
