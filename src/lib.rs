@@ -14,6 +14,7 @@ pub mod laser2d;
 pub mod metrics;
 pub mod models;
 pub mod pipeline;
+pub mod plot;
 pub mod rng;
 pub mod sim;
 pub mod trackers;

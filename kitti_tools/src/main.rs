@@ -7,6 +7,7 @@ mod detections_cmd;
 mod info_cmd;
 mod planes_cmd;
 mod synth_cmd;
+mod track_cmd;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
@@ -37,6 +38,9 @@ enum Command {
     /// Simulate a street drive (lidar, OXTS, walls, cars, pedestrians) in the KITTI raw
     /// layout, with a ground-truth JSON.
     Synth(synth_cmd::Args),
+    /// Track building walls and point clusters of a KITTI raw drive with one labelled
+    /// multi-Bernoulli filter; write per-frame tracks (JSON), labelled clouds and a plot.
+    Track(track_cmd::Args),
 }
 
 fn main() -> Result<()> {
@@ -46,5 +50,6 @@ fn main() -> Result<()> {
         Command::Info(args) => info_cmd::run(args),
         Command::Planes(args) => planes_cmd::run(args),
         Command::Synth(args) => synth_cmd::run(args),
+        Command::Track(args) => track_cmd::run(args),
     }
 }

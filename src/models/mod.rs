@@ -222,3 +222,7 @@ pub mod ect;
 pub use ect::ExtendedConstantTurn;
 pub mod plane;
 pub use plane::{EgoSource, PlaneMeasurement, PlaneTransition};
+pub mod mixed;
+pub use mixed::{
+    MixedBirthSampler, MixedClutter, MixedDetection, MixedMeasurement, MixedTransition, ObjectKind,
+};

@@ -10,3 +10,6 @@ pub use plane_prediction::{
     predict_drive_pairs, predict_odometry_pairs, predict_planes_between, predict_walls,
     segment_walls, EgoMotion, PairPrediction, PlanePredictionConfig,
 };
+
+pub mod drive_tracking;
+pub use drive_tracking::{track_drive, DriveTracker, DriveTracks, TrackingConfig};

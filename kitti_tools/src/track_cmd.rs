@@ -1,0 +1,166 @@
+//! `kitti-tools track`: one LMB run over a KITTI raw drive in which building walls and point
+//! clusters are labelled objects; writes the per-frame tracks as JSON and, on request,
+//! labelled LAS/PLY clouds of chosen frames and a bird's-eye plot; prints a summary.
+
+use crate::config_file::read_config;
+use anyhow::{bail, Context, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+use smc_lmb::cloud::{write_las_labelled, write_ply_labelled};
+use smc_lmb::kitti::RawDrive;
+use smc_lmb::pipeline::drive_tracking::{
+    drive_plot, point_labels, track_drive, EgoModel, TrackingConfig,
+};
+use std::ops::Range;
+use std::path::PathBuf;
+
+/// Flags of `track`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// A KITTI raw drive folder (`.../2011_09_26/2011_09_26_drive_0001_sync`).
+    #[arg(long)]
+    drive: PathBuf,
+    /// Frames to track, `A..B` (B excluded); default all.
+    #[arg(long)]
+    frames: Option<String>,
+    /// Particles per track (overrides the config).
+    #[arg(long)]
+    particles: Option<usize>,
+    /// Random seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Output JSON file.
+    #[arg(long)]
+    out: PathBuf,
+    /// Write a labelled LAS cloud of every tracked frame (or of `--export-frames`) here.
+    #[arg(long)]
+    las: Option<PathBuf>,
+    /// Write a labelled PLY cloud of every tracked frame (or of `--export-frames`) here.
+    #[arg(long)]
+    ply: Option<PathBuf>,
+    /// Frames to export as LAS/PLY, comma-separated (default: all tracked frames).
+    #[arg(long, value_delimiter = ',')]
+    export_frames: Vec<usize>,
+    /// Bird's-eye plot of the drive (.svg or .png).
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    /// Models and tuning (.toml or .json); see `TrackingConfig`.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Move walls by a per-particle draw of the vehicle model instead of the measured poses.
+    #[arg(long)]
+    ect: bool,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
+
+fn parse_range(text: &str) -> Result<Range<usize>> {
+    let Some((a, b)) = text.split_once("..") else {
+        bail!("--frames `{text}`: expected A..B");
+    };
+    let a: usize = a
+        .trim()
+        .parse()
+        .with_context(|| format!("--frames `{text}`: start"))?;
+    let b: usize = b
+        .trim()
+        .parse()
+        .with_context(|| format!("--frames `{text}`: end"))?;
+    if b <= a {
+        bail!("--frames `{text}`: the end must be after the start");
+    }
+    Ok(a..b)
+}
+
+/// Runs the command.
+pub fn run(args: Args) -> Result<()> {
+    let mut config: TrackingConfig = match &args.config {
+        Some(p) => read_config(p)?,
+        None => TrackingConfig::default(),
+    };
+    if let Some(n) = args.particles {
+        config.filter.particles = n;
+    }
+    if args.ect {
+        config.ego = EgoModel::Ect {
+            sigma_accel: 0.5,
+            sigma_turn_accel: 0.1,
+        };
+    }
+    let frames = args.frames.as_deref().map(parse_range).transpose()?;
+    let drive = RawDrive::open(&args.drive)
+        .with_context(|| format!("opening drive {}", args.drive.display()))?;
+    for dir in [&args.las, &args.ply].into_iter().flatten() {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    let bar = if args.quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(0)
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} frames {elapsed} {msg}")
+            .expect("valid template"),
+    );
+    let tracks = track_drive(&drive, frames, &config, args.seed, |view| {
+        let (done, total) = view.progress;
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+        bar.set_message(format!(
+            "{} walls, {} clusters",
+            view.tracked.planes.len(),
+            view.tracked.clusters.len()
+        ));
+        let k = view.tracked.frame;
+        if args.export_frames.is_empty() || args.export_frames.contains(&k) {
+            let labels = point_labels(view.cloud.len(), view.detections, view.tracked);
+            let name = format!("{k:010}");
+            if let Some(dir) = &args.las {
+                write_las_labelled(dir.join(format!("{name}.las")), view.cloud, &labels)?;
+            }
+            if let Some(dir) = &args.ply {
+                write_ply_labelled(dir.join(format!("{name}.ply")), view.cloud, &labels)?;
+            }
+        }
+        Ok(())
+    })
+    .with_context(|| format!("tracking drive {}", args.drive.display()))?;
+    bar.finish_and_clear();
+    tracks.write_json(&args.out)?;
+    if let Some(p) = &args.plot {
+        drive_plot(&tracks).write(p, 1000)?;
+    }
+    let s = &tracks.summary;
+    let t = &s.mean_times;
+    println!(
+        "{}: {} frames (ego {}, {} particles/track, seed {})",
+        tracks.drive, s.frames, tracks.ego, tracks.particles, tracks.seed
+    );
+    println!(
+        "confirmed per frame: {:.2} walls, {:.2} clusters; labels: {} walls, {} clusters",
+        s.mean_planes, s.mean_clusters, s.plane_labels, s.cluster_labels
+    );
+    println!(
+        "ms/frame: read {:.1}, planes {:.1}, clusters {:.1}, filter {:.1}, total {:.1}",
+        t.read_ms,
+        t.planes_ms,
+        t.clusters_ms,
+        t.filter_ms,
+        t.read_ms + t.planes_ms + t.clusters_ms + t.filter_ms
+    );
+    println!("wrote {}", args.out.display());
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_ranges() {
+        assert_eq!(parse_range("2..5").unwrap(), 2..5);
+        assert!(parse_range("5..2").is_err());
+        assert!(parse_range("5").is_err());
+        assert!(parse_range("a..3").is_err());
+    }
+}

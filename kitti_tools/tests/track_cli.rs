@@ -1,0 +1,136 @@
+//! `kitti-tools track` end to end on a drive made of copies of the vendored real Velodyne
+//! frame (a static sensor without OXTS), and on broken inputs.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn run(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_kitti-tools"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
+}
+
+fn static_drive(root: &Path, copies: usize) -> PathBuf {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join(
+        "../tests/data/kitti/2011_09_26/2011_09_26_drive_UNKNOWN_sync/velodyne_points/data/0000000000.bin",
+    );
+    let drive = root.join("2011_09_26/2011_09_26_drive_0000_sync");
+    let data = drive.join("velodyne_points/data");
+    std::fs::create_dir_all(&data).unwrap();
+    for k in 0..copies {
+        std::fs::copy(&src, data.join(format!("{k:010}.bin"))).unwrap();
+    }
+    drive
+}
+
+#[test]
+fn tracks_a_drive_and_writes_every_output() {
+    let tmp = tempfile::tempdir().unwrap();
+    let drive = static_drive(tmp.path(), 3);
+    let out = tmp.path().join("tracks.json");
+    let (las, ply, plot) = (
+        tmp.path().join("las"),
+        tmp.path().join("ply"),
+        tmp.path().join("drive.png"),
+    );
+    let (ok, stdout, stderr) = run(&[
+        "track",
+        "--drive",
+        drive.to_str().unwrap(),
+        "--frames",
+        "0..3",
+        "--particles",
+        "200",
+        "--seed",
+        "4",
+        "--out",
+        out.to_str().unwrap(),
+        "--las",
+        las.to_str().unwrap(),
+        "--ply",
+        ply.to_str().unwrap(),
+        "--export-frames",
+        "2",
+        "--plot",
+        plot.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(ok, "{stdout}\n{stderr}");
+    assert!(
+        stdout.contains("3 frames") && stdout.contains("ms/frame"),
+        "{stdout}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    assert_eq!(json["frames"].as_array().unwrap().len(), 3);
+    assert_eq!(json["particles"], 200);
+    assert_eq!(json["ego"], "none");
+    assert!(las.join("0000000002.las").is_file());
+    assert!(!las.join("0000000001.las").exists());
+    assert!(ply.join("0000000002.ply").is_file());
+    assert_eq!(&std::fs::read(&plot).unwrap()[1..4], b"PNG");
+}
+
+#[test]
+fn bad_inputs_fail_with_clear_messages() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("t.json");
+    let missing = tmp.path().join("no_such_drive");
+    let (ok, _, stderr) = run(&[
+        "track",
+        "--drive",
+        missing.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!ok && stderr.contains("no_such_drive"), "{stderr}");
+
+    let drive = static_drive(tmp.path(), 2);
+    let (ok, _, stderr) = run(&[
+        "track",
+        "--drive",
+        drive.to_str().unwrap(),
+        "--frames",
+        "3..1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!ok && stderr.contains("--frames"), "{stderr}");
+
+    let config = tmp.path().join("bad.toml");
+    std::fs::write(&config, "[plane]\nsigma_angel = 0.1\n").unwrap();
+    let (ok, _, stderr) = run(&[
+        "track",
+        "--drive",
+        drive.to_str().unwrap(),
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && stderr.contains("bad.toml") && stderr.contains("sigma_angel"),
+        "{stderr}"
+    );
+
+    let bin = drive.join("velodyne_points/data/0000000001.bin");
+    let bytes = std::fs::read(&bin).unwrap();
+    std::fs::write(&bin, &bytes[..bytes.len() - 3]).unwrap();
+    let (ok, _, stderr) = run(&[
+        "track",
+        "--drive",
+        drive.to_str().unwrap(),
+        "--particles",
+        "50",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!ok && stderr.contains("0000000001.bin"), "{stderr}");
+    assert!(!out.exists());
+}

@@ -1,0 +1,620 @@
+//! Two kinds of object in one filter: building-wall planes and Euclidean point clusters
+//! (cars, pedestrians, poles), each a labelled track of the same [`LmbFilter`].
+//!
+//! # State (7 components)
+//!
+//! | kind | components 0–5 | component 6 |
+//! |---|---|---|
+//! | plane | `[n_x, n_y, n_z, d, 0, 0]` in the **sensor frame of the current step** | 0 |
+//! | cluster | `[x, ẋ, y, ẏ, z, ż]` in the **world frame** | 1 |
+//!
+//! The kind is one state component ([`KIND`]) so that a track is an ordinary particle set;
+//! every particle of a track carries the same kind (births set it, no transition changes it,
+//! and the resampling kernel adds nothing to a component without spread). Models read the kind
+//! of a set from its first particle ([`kind_of_set`]) and dispatch once per set, so the hot
+//! loops stay the plain structure-of-arrays loops of the single-kind models.
+//!
+//! # Measurement (5 components)
+//!
+//! | kind | components 0–3 | component 4 |
+//! |---|---|---|
+//! | plane | segmented wall `[n_x, n_y, n_z, d]` (sensor frame, canonical) | 0 |
+//! | cluster | centroid `[x, y, z, 0]` in the sensor frame | 1 |
+//!
+//! A measurement of one kind has likelihood 0 (log −∞) for a track of the other kind and the
+//! gate rejects the pair, so planes and clusters are never associated with each other.
+//!
+//! # Models
+//!
+//! - [`MixedTransition`]: planes move by the ego motion with [`PlaneTransition`] (measured
+//!   poses, or a per-particle ECT draw through a [`VehicleStateHandle`] updated every step);
+//!   clusters move by 3-D [`ConstantVelocity`].
+//! - [`MixedMeasurement`]: planes are scored by [`PlaneMeasurement`]; a cluster particle's
+//!   world position p is taken into the sensor frame, s = T⁻¹ p with T = `ctx.platform`, and
+//!   scored by an axis-aligned Gaussian of standard deviation σ per axis around the centroid.
+//! - [`MixedDetection`], [`MixedClutter`]: a constant detection probability and a uniform
+//!   clutter intensity per kind (the plane clutter density is in the (angle, offset) units
+//!   of [`PlaneMeasurement`]; the cluster one per m³).
+//! - [`MixedBirthSampler`]: the inverse measurement model for measurement-driven birth.
+//!
+//! The ECT option moves planes by the vehicle (IMU) motion without the IMU → Velodyne
+//! conjugation; for KITTI (a 1 m lever arm) the difference per 0.1 s step is below 1 cm.
+//!
+//! Not for: segmenting planes or clusters out of point clouds (see
+//! [`crate::pipeline::drive_tracking`]).
+//!
+//! [`LmbFilter`]: crate::filter::LmbFilter
+
+use super::{
+    ClutterModel, ConstantVelocity, DetectionModel, ExtendedConstantTurn, MeasurementModel,
+    PlaneMeasurement, PlaneTransition, StepContext, TrackSummary, TransitionModel,
+};
+use crate::error::{ensure_positive, ensure_probability, Error, Result};
+use crate::filter::{BirthSampler, ParticleSet};
+use crate::models::plane::{canonical_plane, EgoSource};
+use crate::rng::FilterRng;
+use rand_distr::{Distribution, StandardNormal};
+use std::sync::{Arc, RwLock};
+
+/// Dimension of the mixed state.
+pub const STATE_DIM: usize = 7;
+/// Index of the kind component in the state.
+pub const KIND: usize = 6;
+/// Dimension of a mixed measurement.
+pub const MEASUREMENT_DIM: usize = 5;
+/// Index of the kind component in a measurement.
+pub const MEASUREMENT_KIND: usize = 4;
+
+/// What a track or a measurement is.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ObjectKind {
+    /// A building wall (plane).
+    Plane,
+    /// A Euclidean point cluster.
+    Cluster,
+}
+
+impl ObjectKind {
+    /// The value stored in the kind component.
+    pub fn code(self) -> f64 {
+        match self {
+            ObjectKind::Plane => 0.0,
+            ObjectKind::Cluster => 1.0,
+        }
+    }
+
+    /// The kind of a stored code (rounded, so tiny rounding drift does not matter); `None`
+    /// for anything else.
+    pub fn from_code(v: f64) -> Option<Self> {
+        if (v - 0.0).abs() < 0.25 {
+            Some(ObjectKind::Plane)
+        } else if (v - 1.0).abs() < 0.25 {
+            Some(ObjectKind::Cluster)
+        } else {
+            None
+        }
+    }
+}
+
+/// The kind of a particle set, read from its first particle (`None` when empty, too short or
+/// not a known code).
+pub fn kind_of_set(particles: &ParticleSet) -> Option<ObjectKind> {
+    if particles.dim() <= KIND || particles.is_empty() {
+        return None;
+    }
+    ObjectKind::from_code(particles.component(KIND)[0])
+}
+
+/// The kind of a measurement or of a mean state.
+pub fn kind_of_measurement(z: &[f64]) -> Option<ObjectKind> {
+    z.get(MEASUREMENT_KIND)
+        .copied()
+        .and_then(ObjectKind::from_code)
+}
+
+/// A plane measurement row `[n, d, 0]` (canonical sign).
+pub fn plane_measurement(beta: [f64; 4]) -> [f64; MEASUREMENT_DIM] {
+    let b = canonical_plane(&beta);
+    [b[0], b[1], b[2], b[3], ObjectKind::Plane.code()]
+}
+
+/// A cluster measurement row `[x, y, z, 0, 1]` from a sensor-frame centroid.
+pub fn cluster_measurement(centroid: [f64; 3]) -> [f64; MEASUREMENT_DIM] {
+    [
+        centroid[0],
+        centroid[1],
+        centroid[2],
+        0.0,
+        ObjectKind::Cluster.code(),
+    ]
+}
+
+/// A shared, updatable vehicle state `[X, Ẋ, Y, Ẏ, φ, φ̇]` for the ECT plane option: the
+/// caller writes the state of the previous step before each filter step.
+#[derive(Clone, Debug, Default)]
+pub struct VehicleStateHandle(Arc<RwLock<[f64; 6]>>);
+
+impl VehicleStateHandle {
+    /// Replaces the vehicle state.
+    pub fn set(&self, state: [f64; 6]) {
+        let mut guard = self.0.write().unwrap_or_else(|e| e.into_inner());
+        *guard = state;
+    }
+
+    /// The current vehicle state.
+    pub fn get(&self) -> [f64; 6] {
+        *self.0.read().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+/// Plane transition or constant velocity, chosen by the kind of the set.
+#[derive(Clone, Debug)]
+pub struct MixedTransition {
+    plane: PlaneTransition,
+    vehicle: Option<VehicleStateHandle>,
+    cluster: ConstantVelocity,
+}
+
+impl MixedTransition {
+    /// Planes moved by the measured poses with normal-tilt noise `plane_sigma_angle` (rad) and
+    /// offset noise `plane_sigma_offset` (m); clusters by 3-D constant velocity with
+    /// acceleration noise `cluster_sigma_accel` (m/s²).
+    pub fn measured(
+        plane_sigma_angle: f64,
+        plane_sigma_offset: f64,
+        cluster_sigma_accel: f64,
+    ) -> Result<Self> {
+        Ok(MixedTransition {
+            plane: PlaneTransition::new(
+                EgoSource::Measured,
+                plane_sigma_angle,
+                plane_sigma_offset,
+            )?,
+            vehicle: None,
+            cluster: ConstantVelocity::spatial(cluster_sigma_accel)?,
+        })
+    }
+
+    /// As [`MixedTransition::measured`], but planes are moved by a per-particle ECT draw of
+    /// the vehicle motion from the state in the returned handle (seed 001, Algorithm 1).
+    pub fn predicted(
+        ect: ExtendedConstantTurn,
+        plane_sigma_angle: f64,
+        plane_sigma_offset: f64,
+        cluster_sigma_accel: f64,
+    ) -> Result<(Self, VehicleStateHandle)> {
+        let handle = VehicleStateHandle::default();
+        let plane = PlaneTransition::new(
+            EgoSource::Predicted {
+                ect,
+                vehicle_state: [0.0; 6],
+            },
+            plane_sigma_angle,
+            plane_sigma_offset,
+        )?;
+        Ok((
+            MixedTransition {
+                plane,
+                vehicle: Some(handle.clone()),
+                cluster: ConstantVelocity::spatial(cluster_sigma_accel)?,
+            },
+            handle,
+        ))
+    }
+}
+
+impl TransitionModel for MixedTransition {
+    fn state_dim(&self) -> usize {
+        STATE_DIM
+    }
+
+    fn predict(&self, particles: &mut ParticleSet, ctx: &StepContext, rng: &mut FilterRng) {
+        match kind_of_set(particles) {
+            Some(ObjectKind::Plane) => match &self.vehicle {
+                None => self.plane.predict(particles, ctx, rng),
+                Some(h) => {
+                    let mut p = self.plane;
+                    p.set_vehicle_state(h.get());
+                    p.predict(particles, ctx, rng)
+                }
+            },
+            Some(ObjectKind::Cluster) => self.cluster.predict(particles, ctx, rng),
+            None => {}
+        }
+    }
+}
+
+/// Plane likelihood or sensor-frame position likelihood, chosen by the kind of the set; −∞
+/// for a measurement of the other kind.
+#[derive(Clone, Debug)]
+pub struct MixedMeasurement {
+    plane: PlaneMeasurement,
+    cluster_sigma: f64,
+    cluster_gate: f64,
+}
+
+impl MixedMeasurement {
+    /// Planes scored by `plane`; cluster centroids by an isotropic Gaussian of standard
+    /// deviation `cluster_sigma` (m), gated at `cluster_gate`·(σ + spread) per axis.
+    pub fn new(plane: PlaneMeasurement, cluster_sigma: f64, cluster_gate: f64) -> Result<Self> {
+        ensure_positive("cluster measurement sigma", cluster_sigma)?;
+        ensure_positive("cluster measurement gate", cluster_gate)?;
+        Ok(MixedMeasurement {
+            plane,
+            cluster_sigma,
+            cluster_gate,
+        })
+    }
+
+    /// World → sensor transform of the step (identity without a platform pose).
+    fn world_to_sensor(ctx: &StepContext) -> nalgebra::Isometry3<f64> {
+        ctx.platform
+            .map(|p| p.inverse())
+            .unwrap_or_else(nalgebra::Isometry3::identity)
+    }
+}
+
+impl MeasurementModel for MixedMeasurement {
+    fn measurement_dim(&self) -> usize {
+        MEASUREMENT_DIM
+    }
+
+    fn log_likelihood(
+        &self,
+        z: &[f64],
+        particles: &ParticleSet,
+        ctx: &StepContext,
+        out: &mut [f64],
+    ) {
+        let n = particles.len();
+        let kind = kind_of_set(particles);
+        if kind.is_none() || kind != kind_of_measurement(z) {
+            out[..n].fill(f64::NEG_INFINITY);
+            return;
+        }
+        if kind == Some(ObjectKind::Plane) {
+            self.plane.log_likelihood(&z[..4], particles, ctx, out);
+            return;
+        }
+        // Cluster: s = R p + t, Gaussian around z per axis.
+        let inv = Self::world_to_sensor(ctx);
+        let r = inv.rotation.to_rotation_matrix().into_inner();
+        let t = inv.translation.vector;
+        let s2 = self.cluster_sigma * self.cluster_sigma;
+        let norm = -1.5 * (2.0 * std::f64::consts::PI * s2).ln();
+        let half_inv = 0.5 / s2;
+        let (x, y, zc) = (
+            particles.component(0),
+            particles.component(2),
+            particles.component(4),
+        );
+        let (z0, z1, z2) = (z[0], z[1], z[2]);
+        for i in 0..n {
+            let sx = r[(0, 0)] * x[i] + r[(0, 1)] * y[i] + r[(0, 2)] * zc[i] + t.x - z0;
+            let sy = r[(1, 0)] * x[i] + r[(1, 1)] * y[i] + r[(1, 2)] * zc[i] + t.y - z1;
+            let sz = r[(2, 0)] * x[i] + r[(2, 1)] * y[i] + r[(2, 2)] * zc[i] + t.z - z2;
+            let l = norm - half_inv * (sx * sx + sy * sy + sz * sz);
+            out[i] = if l.is_nan() { f64::NEG_INFINITY } else { l };
+        }
+    }
+
+    fn gate(&self, z: &[f64], track: &TrackSummary, ctx: &StepContext) -> bool {
+        let track_kind = track
+            .mean
+            .get(KIND)
+            .copied()
+            .and_then(ObjectKind::from_code);
+        let z_kind = kind_of_measurement(z);
+        if track_kind.is_none() || track_kind != z_kind {
+            return false;
+        }
+        if track_kind == Some(ObjectKind::Plane) {
+            let summary = TrackSummary {
+                mean: track.mean[..4].to_vec(),
+                std: track.std[..4].to_vec(),
+            };
+            return self.plane.gate(&z[..4], &summary, ctx);
+        }
+        // Cluster: compare in the world frame, per axis.
+        let pose = ctx.platform.unwrap_or_else(nalgebra::Isometry3::identity);
+        let w = pose * nalgebra::Point3::new(z[0], z[1], z[2]);
+        [(w.x, 0), (w.y, 2), (w.z, 4)].iter().all(|&(v, c)| {
+            (v - track.mean[c]).abs() <= self.cluster_gate * (self.cluster_sigma + track.std[c])
+        })
+    }
+}
+
+/// A constant detection probability per kind.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct MixedDetection {
+    plane: f64,
+    cluster: f64,
+}
+
+impl MixedDetection {
+    /// p_D of planes and of clusters, each in [0, 1].
+    pub fn new(plane: f64, cluster: f64) -> Result<Self> {
+        ensure_probability("plane detection probability", plane)?;
+        ensure_probability("cluster detection probability", cluster)?;
+        Ok(MixedDetection { plane, cluster })
+    }
+}
+
+impl DetectionModel for MixedDetection {
+    fn detection_probability(&self, particles: &ParticleSet, _: &StepContext, out: &mut [f64]) {
+        let p = match kind_of_set(particles) {
+            Some(ObjectKind::Plane) => self.plane,
+            Some(ObjectKind::Cluster) => self.cluster,
+            None => 0.0,
+        };
+        out[..particles.len()].fill(p);
+    }
+}
+
+/// A uniform clutter intensity per kind: κ = rate / volume.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct MixedClutter {
+    log_plane: f64,
+    log_cluster: f64,
+}
+
+impl MixedClutter {
+    /// Expected false planes per frame spread over `plane_volume` (rad·m) and expected false
+    /// clusters per frame spread over `cluster_volume` (m³); all positive.
+    pub fn new(
+        plane_rate: f64,
+        plane_volume: f64,
+        cluster_rate: f64,
+        cluster_volume: f64,
+    ) -> Result<Self> {
+        for (name, v) in [
+            ("plane clutter rate", plane_rate),
+            ("plane clutter volume", plane_volume),
+            ("cluster clutter rate", cluster_rate),
+            ("cluster clutter volume", cluster_volume),
+        ] {
+            ensure_positive(name, v)?;
+        }
+        Ok(MixedClutter {
+            log_plane: (plane_rate / plane_volume).ln(),
+            log_cluster: (cluster_rate / cluster_volume).ln(),
+        })
+    }
+}
+
+impl ClutterModel for MixedClutter {
+    fn log_intensity(&self, z: &[f64], _: &StepContext) -> f64 {
+        match kind_of_measurement(z) {
+            Some(ObjectKind::Cluster) => self.log_cluster,
+            _ => self.log_plane,
+        }
+    }
+}
+
+/// Draws the particles of a new track from one mixed measurement of the step in `ctx`.
+///
+/// Planes: each normal component gets N(0, σ_angle²) and the normal is renormalised (a tilt
+/// of about σ_angle per tangent axis), the offset gets N(0, σ_offset²). Clusters: the
+/// centroid is taken into the world with `ctx.platform`, position ~ N(world centroid,
+/// σ_position²) per axis, horizontal velocity ~ N(0, σ_velocity²), vertical velocity ~
+/// N(0, σ_vertical²).
+#[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MixedBirthSampler {
+    /// Normal spread of a plane birth (rad).
+    pub plane_sigma_angle: f64,
+    /// Offset spread of a plane birth (m).
+    pub plane_sigma_offset: f64,
+    /// Position spread of a cluster birth (m).
+    pub cluster_sigma_position: f64,
+    /// Horizontal velocity spread of a cluster birth (m/s).
+    pub cluster_sigma_velocity: f64,
+    /// Vertical velocity spread of a cluster birth (m/s).
+    pub cluster_sigma_vertical: f64,
+}
+
+impl MixedBirthSampler {
+    /// Checks that every spread is finite and non-negative.
+    pub fn validate(&self) -> Result<()> {
+        for (name, v) in [
+            ("plane_sigma_angle", self.plane_sigma_angle),
+            ("plane_sigma_offset", self.plane_sigma_offset),
+            ("cluster_sigma_position", self.cluster_sigma_position),
+            ("cluster_sigma_velocity", self.cluster_sigma_velocity),
+            ("cluster_sigma_vertical", self.cluster_sigma_vertical),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(Error::invalid(
+                    format!("birth sampler {name}"),
+                    format!("{v} (must be finite and non-negative)"),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl BirthSampler for MixedBirthSampler {
+    fn sample(&self, z: &[f64], ctx: &StepContext, n: usize, rng: &mut FilterRng) -> ParticleSet {
+        let mut set = ParticleSet::zeros(STATE_DIM, n);
+        let Some(kind) = kind_of_measurement(z) else {
+            return ParticleSet::zeros(STATE_DIM, 0);
+        };
+        let mut comps = set.components_mut();
+        let [c0, c1, c2, c3, c4, c5, kind_col] = comps.as_mut_slice() else {
+            unreachable!("a mixed set has {STATE_DIM} components");
+        };
+        kind_col.fill(kind.code());
+        let mut g = || -> f64 { StandardNormal.sample(rng) };
+        match kind {
+            ObjectKind::Plane => {
+                let b = canonical_plane(&[z[0], z[1], z[2], z[3]]);
+                for i in 0..n {
+                    let nx = b[0] + self.plane_sigma_angle * g();
+                    let ny = b[1] + self.plane_sigma_angle * g();
+                    let nz = b[2] + self.plane_sigma_angle * g();
+                    let inv = 1.0 / (nx * nx + ny * ny + nz * nz).sqrt();
+                    c0[i] = nx * inv;
+                    c1[i] = ny * inv;
+                    c2[i] = nz * inv;
+                    c3[i] = b[3] + self.plane_sigma_offset * g();
+                }
+            }
+            ObjectKind::Cluster => {
+                let pose = ctx.platform.unwrap_or_else(nalgebra::Isometry3::identity);
+                let w = pose * nalgebra::Point3::new(z[0], z[1], z[2]);
+                let (sp, sv, sz) = (
+                    self.cluster_sigma_position,
+                    self.cluster_sigma_velocity,
+                    self.cluster_sigma_vertical,
+                );
+                for i in 0..n {
+                    c0[i] = w.x + sp * g();
+                    c1[i] = sv * g();
+                    c2[i] = w.y + sp * g();
+                    c3[i] = sv * g();
+                    c4[i] = w.z + sp * g();
+                    c5[i] = sz * g();
+                }
+            }
+        }
+        drop(comps);
+        set
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::seeded;
+    use nalgebra::{Isometry3, Vector3};
+
+    fn ctx(platform: Isometry3<f64>) -> StepContext {
+        StepContext {
+            platform: Some(platform),
+            previous_platform: Some(Isometry3::identity()),
+            ..StepContext::new(1, 0.1, 0.1)
+        }
+    }
+
+    fn sampler() -> MixedBirthSampler {
+        MixedBirthSampler {
+            plane_sigma_angle: 0.0,
+            plane_sigma_offset: 0.0,
+            cluster_sigma_position: 0.0,
+            cluster_sigma_velocity: 0.0,
+            cluster_sigma_vertical: 0.0,
+        }
+    }
+
+    #[test]
+    fn kinds_never_score_each_other() {
+        let c = ctx(Isometry3::identity());
+        let m = MixedMeasurement::new(PlaneMeasurement::new(0.05, 0.2).unwrap(), 0.3, 4.0).unwrap();
+        let plane_z = plane_measurement([-1.0, 0.0, 0.0, 10.0]);
+        let cluster_z = cluster_measurement([5.0, 1.0, 0.0]);
+        let planes = sampler().sample(&plane_z, &c, 3, &mut seeded(1));
+        let clusters = sampler().sample(&cluster_z, &c, 3, &mut seeded(1));
+        let mut out = [0.0; 3];
+        m.log_likelihood(&cluster_z, &planes, &c, &mut out);
+        assert!(out.iter().all(|v| *v == f64::NEG_INFINITY));
+        m.log_likelihood(&plane_z, &clusters, &c, &mut out);
+        assert!(out.iter().all(|v| *v == f64::NEG_INFINITY));
+        m.log_likelihood(&plane_z, &planes, &c, &mut out);
+        assert!(out.iter().all(|v| v.is_finite()));
+        let summary = |s: &ParticleSet| TrackSummary {
+            mean: s.mean(),
+            std: s.std_dev(),
+        };
+        assert!(!m.gate(&cluster_z, &summary(&planes), &c));
+        assert!(!m.gate(&plane_z, &summary(&clusters), &c));
+        assert!(m.gate(&plane_z, &summary(&planes), &c));
+        assert!(m.gate(&cluster_z, &summary(&clusters), &c));
+    }
+
+    #[test]
+    fn cluster_likelihood_uses_the_platform_pose() {
+        // Sensor 10 m east of the origin, turned 90° left: world (10, 5, 0) is 5 m ahead.
+        let pose = Isometry3::new(
+            Vector3::new(10.0, 0.0, 0.0),
+            Vector3::new(0.0, 0.0, std::f64::consts::FRAC_PI_2),
+        );
+        let c = ctx(pose);
+        let set =
+            ParticleSet::from_rows(&[vec![10.0, 0.0, 5.0, 0.0, 0.0, 0.0, 1.0]], &[1.0]).unwrap();
+        let m = MixedMeasurement::new(PlaneMeasurement::new(0.05, 0.2).unwrap(), 0.5, 4.0).unwrap();
+        let mut out = [0.0];
+        m.log_likelihood(&cluster_measurement([5.0, 0.0, 0.0]), &set, &c, &mut out);
+        let peak = -1.5 * (2.0 * std::f64::consts::PI * 0.25).ln();
+        assert!((out[0] - peak).abs() < 1e-9, "{out:?} vs {peak}");
+        // one σ off along the sensor's y axis costs ½
+        m.log_likelihood(&cluster_measurement([5.0, 0.5, 0.0]), &set, &c, &mut out);
+        assert!((out[0] - (peak - 0.5)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn births_carry_the_kind_and_land_in_the_world() {
+        let pose = Isometry3::new(Vector3::new(3.0, 4.0, 0.0), Vector3::zeros());
+        let c = ctx(pose);
+        let s = MixedBirthSampler {
+            cluster_sigma_velocity: 2.0,
+            ..sampler()
+        };
+        let set = s.sample(
+            &cluster_measurement([1.0, 2.0, 0.5]),
+            &c,
+            500,
+            &mut seeded(3),
+        );
+        assert_eq!(kind_of_set(&set), Some(ObjectKind::Cluster));
+        let mean = set.mean();
+        for (got, want) in [(mean[0], 4.0), (mean[2], 6.0), (mean[4], 0.5)] {
+            assert!((got - want).abs() < 1e-9, "{mean:?}");
+        }
+        assert!(set.std_dev()[1] > 1.5);
+        let planes = s.sample(
+            &plane_measurement([1.0, 0.0, 0.0, -7.0]),
+            &c,
+            10,
+            &mut seeded(3),
+        );
+        assert_eq!(kind_of_set(&planes), Some(ObjectKind::Plane));
+        assert_eq!(&planes.state(0)[..4], &[-1.0, 0.0, 0.0, 7.0]);
+    }
+
+    #[test]
+    fn transition_dispatches_by_kind() {
+        let mv = Isometry3::new(Vector3::new(1.0, 0.0, 0.0), Vector3::zeros());
+        let c = ctx(mv);
+        let t = MixedTransition::measured(0.0, 0.0, 0.0).unwrap();
+        let mut plane =
+            ParticleSet::from_rows(&[vec![-1.0, 0.0, 0.0, 10.0, 0.0, 0.0, 0.0]], &[1.0]).unwrap();
+        t.predict(&mut plane, &c, &mut seeded(1));
+        assert_eq!(plane.state(0), vec![-1.0, 0.0, 0.0, 9.0, 0.0, 0.0, 0.0]);
+        let mut cluster =
+            ParticleSet::from_rows(&[vec![0.0, 2.0, 0.0, -1.0, 0.0, 0.0, 1.0]], &[1.0]).unwrap();
+        t.predict(&mut cluster, &c, &mut seeded(1));
+        let s = cluster.state(0);
+        assert!((s[0] - 0.2).abs() < 1e-12 && (s[2] + 0.1).abs() < 1e-12 && s[6] == 1.0);
+    }
+
+    #[test]
+    fn clutter_and_detection_follow_the_kind() {
+        let cl = MixedClutter::new(1.0, 10.0, 2.0, 1000.0).unwrap();
+        let c = StepContext::new(0, 0.0, 0.0);
+        assert!(
+            (cl.log_intensity(&plane_measurement([1.0, 0.0, 0.0, 1.0]), &c) - 0.1f64.ln()).abs()
+                < 1e-12
+        );
+        assert!(
+            (cl.log_intensity(&cluster_measurement([0.0; 3]), &c) - 0.002f64.ln()).abs() < 1e-12
+        );
+        let d = MixedDetection::new(0.9, 0.7).unwrap();
+        let set =
+            ParticleSet::from_rows(&[vec![0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]], &[1.0]).unwrap();
+        let mut out = [0.0];
+        d.detection_probability(&set, &c, &mut out);
+        assert_eq!(out, [0.7]);
+        assert!(MixedDetection::new(1.2, 0.5).is_err());
+    }
+}

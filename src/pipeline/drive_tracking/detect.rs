@@ -1,0 +1,167 @@
+//! One LiDAR frame → the detections the tracker sees: building-wall planes (from
+//! [`extract_planes`]) and Euclidean clusters of the points on neither the ground nor a wall,
+//! turned into mixed measurements ([`crate::models::mixed`]).
+//!
+//! The ground is not tracked: it is always under the vehicle, so tracking it adds nothing a
+//! per-frame fit does not give; its plane is used to drop the points near the road surface
+//! before clustering. Clusters are kept when they lie within `max_range` of the sensor and
+//! their axis-aligned box is object-sized (`max_footprint`, `max_height`); of those, at most
+//! `max_clusters`, the nearest first.
+//!
+//! Not for: the filter (see [`super::tracker`]).
+
+use super::TrackingConfig;
+use crate::cloud::cluster::{euclidean_clusters_of, ClusterParams};
+use crate::cloud::planes::extract_planes;
+use crate::cloud::PointCloud;
+use crate::error::Result;
+use crate::filter::Measurements;
+use crate::geometry::PlanePatch;
+use crate::models::mixed::{cluster_measurement, plane_measurement, MEASUREMENT_DIM};
+use crate::rng::FilterRng;
+use std::time::Instant;
+
+/// One cluster detection in the sensor frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClusterDetection {
+    /// Centroid (m, sensor frame).
+    pub centroid: [f64; 3],
+    /// Smallest corner of the axis-aligned box (m, sensor frame).
+    pub min: [f64; 3],
+    /// Largest corner of the axis-aligned box (m, sensor frame).
+    pub max: [f64; 3],
+    /// Indices of the member points in the frame's cloud (empty for detections built by hand).
+    pub indices: Vec<u32>,
+}
+
+impl ClusterDetection {
+    /// A detection with a box of `size` around `centroid` and no points (for benchmarks and
+    /// tests that bypass the point cloud).
+    pub fn around(centroid: [f64; 3], size: [f64; 3]) -> Self {
+        ClusterDetection {
+            centroid,
+            min: std::array::from_fn(|i| centroid[i] - 0.5 * size[i]),
+            max: std::array::from_fn(|i| centroid[i] + 0.5 * size[i]),
+            indices: Vec::new(),
+        }
+    }
+}
+
+/// One wall detection: its patch (sensor frame) and inlier indices.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WallDetection {
+    /// Bounding rectangle of the inliers (sensor frame).
+    pub patch: PlanePatch,
+    /// Indices of the inliers in the frame's cloud (empty for detections built by hand).
+    pub indices: Vec<u32>,
+}
+
+/// The detections of one frame and the time each stage took.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FrameDetections {
+    /// Building walls.
+    pub walls: Vec<WallDetection>,
+    /// Object clusters.
+    pub clusters: Vec<ClusterDetection>,
+    /// Ground inliers (not tracked; for labelled exports).
+    pub ground: Vec<u32>,
+    /// Milliseconds spent on plane segmentation.
+    pub planes_ms: f64,
+    /// Milliseconds spent on clustering.
+    pub clusters_ms: f64,
+}
+
+impl FrameDetections {
+    /// The mixed measurements: walls first (index `i`), then clusters (index
+    /// `walls.len() + j`).
+    pub fn measurements(&self) -> Result<Measurements> {
+        let mut m = Measurements::empty(MEASUREMENT_DIM);
+        for w in &self.walls {
+            m.push(&plane_measurement(w.patch.plane.as_vector()))?;
+        }
+        for c in &self.clusters {
+            m.push(&cluster_measurement(c.centroid))?;
+        }
+        Ok(m)
+    }
+}
+
+/// Segments walls and clusters in `cloud` (sensor frame).
+pub fn detect_objects(
+    cloud: &PointCloud,
+    config: &TrackingConfig,
+    rng: &mut FilterRng,
+) -> Result<FrameDetections> {
+    let start = Instant::now();
+    let seg = extract_planes(cloud, &config.planes, rng)?;
+    let planes_ms = start.elapsed().as_secs_f64() * 1e3;
+
+    let start = Instant::now();
+    let c = &config.clusters;
+    let (xs, ys, zs) = (cloud.xs(), cloud.ys(), cloud.zs());
+    // Height above the ground plane (or above a flat road at the nominal mounting height).
+    let ground = seg.ground.as_ref().map(|g| g.patch.plane);
+    let above = |i: usize| -> f64 {
+        let p = nalgebra::Point3::new(xs[i] as f64, ys[i] as f64, zs[i] as f64);
+        match &ground {
+            Some(plane) => {
+                let h = plane.signed_distance(&p);
+                // The canonical normal points towards the sensor, i.e. up.
+                if plane.normal.z < 0.0 {
+                    -h
+                } else {
+                    h
+                }
+            }
+            None => p.z + c.sensor_height,
+        }
+    };
+    let max_r2 = c.max_range * c.max_range;
+    let candidates: Vec<u32> = seg
+        .remaining
+        .iter()
+        .copied()
+        .filter(|&i| {
+            let i = i as usize;
+            let r2 = (xs[i] * xs[i] + ys[i] * ys[i]) as f64;
+            r2 <= max_r2 && above(i) > c.ground_clearance
+        })
+        .collect();
+    let params = ClusterParams {
+        tolerance: c.tolerance as f32,
+        min_points: c.min_points,
+        max_points: c.max_points,
+    };
+    let mut clusters: Vec<ClusterDetection> = euclidean_clusters_of(cloud, &candidates, &params)?
+        .into_iter()
+        .filter(|k| {
+            let size: [f64; 3] = std::array::from_fn(|a| (k.max[a] - k.min[a]) as f64);
+            size[0].max(size[1]) <= c.max_footprint && size[2] <= c.max_height
+        })
+        .map(|k| ClusterDetection {
+            centroid: k.centroid,
+            min: k.min.map(f64::from),
+            max: k.max.map(f64::from),
+            indices: k.indices,
+        })
+        .collect();
+    let range = |d: &ClusterDetection| d.centroid[0].hypot(d.centroid[1]);
+    clusters.sort_by(|a, b| range(a).total_cmp(&range(b)));
+    clusters.truncate(c.max_clusters);
+    let clusters_ms = start.elapsed().as_secs_f64() * 1e3;
+
+    Ok(FrameDetections {
+        walls: seg
+            .walls
+            .into_iter()
+            .map(|w| WallDetection {
+                patch: w.patch,
+                indices: w.inliers,
+            })
+            .collect(),
+        clusters,
+        ground: seg.ground.map(|g| g.inliers).unwrap_or_default(),
+        planes_ms,
+        clusters_ms,
+    })
+}

@@ -1,0 +1,390 @@
+//! Tracking a whole KITTI raw drive with one LMB filter in which building walls and object
+//! clusters are both labelled objects (the mixed state of [`crate::models::mixed`]).
+//!
+//! Per frame: read the Velodyne `.bin`, segment the ground and walls, cluster the points on
+//! neither ([`detect`]), turn walls and cluster centroids into mixed measurements and step the
+//! filter with the frame's OXTS pose ([`tracker`]); the MAP estimate becomes a
+//! [`TrackedFrame`] of labelled planes and clusters ([`output`]). Walls are tracked in the
+//! Velodyne frame and moved by the ego motion (the measured poses, or per particle by the
+//! extended constant-turn vehicle model, [`EgoModel`]); clusters are tracked in the world
+//! frame with constant velocity. The ground is not tracked (see [`detect`]).
+//!
+//! [`DriveTracker::step`] is the per-frame step on ready-made detections (for benchmarks);
+//! [`track_drive`] runs a whole drive and hands every frame (cloud, detections, report) to a
+//! callback, which is where a caller draws progress or writes labelled point clouds
+//! ([`export`]).
+//!
+//! Not for: plane prediction scoring (see [`super::plane_prediction`]) or evaluation against
+//! ground truth.
+
+pub mod detect;
+pub mod export;
+pub mod output;
+pub mod tracker;
+
+pub use detect::{detect_objects, ClusterDetection, FrameDetections, WallDetection};
+pub use export::{drive_plot, point_labels};
+pub use output::{
+    DriveTracks, StageTimes, TrackedCluster, TrackedFrame, TrackedPlane, TrackingSummary,
+};
+pub use tracker::DriveTracker;
+
+use crate::cloud::planes::PlaneConfig;
+use crate::cloud::PointCloud;
+use crate::error::{ensure_positive, ensure_probability, Error, Result};
+use crate::filter::LmbConfig;
+use crate::kitti::RawDrive;
+use crate::rng::stream;
+use nalgebra::Isometry3;
+use std::ops::Range;
+use std::time::Instant;
+
+/// How walls are moved between frames.
+#[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum EgoModel {
+    /// By the measured OXTS poses (every particle alike).
+    Measured,
+    /// By a per-particle draw of the extended constant-turn vehicle model from the OXTS
+    /// vehicle state of the previous frame (seed 001, Algorithm 1).
+    Ect {
+        /// Longitudinal acceleration noise (m/s²).
+        sigma_accel: f64,
+        /// Yaw acceleration noise (rad/s²).
+        sigma_turn_accel: f64,
+    },
+}
+
+/// Wall models: process noise, measurement noise, detection, clutter and birth spread.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PlaneTuning {
+    /// Normal-tilt process noise per step (rad). Default 0.5°.
+    pub process_angle: f64,
+    /// Offset process noise per step (m). Default 0.05.
+    pub process_offset: f64,
+    /// Measurement noise of the normal angle (rad). Default 2°.
+    pub sigma_angle: f64,
+    /// Measurement noise of the offset (m). Default 0.15.
+    pub sigma_offset: f64,
+    /// Gate width in multiples of (σ + spread). Default 4.
+    pub gate: f64,
+    /// Detection probability. Default 0.9.
+    pub detection: f64,
+    /// Expected false walls per frame. Default 0.5.
+    pub clutter_rate: f64,
+    /// Volume of the (angle, offset) space the false walls spread over (rad·m). Default
+    /// π/2 · 50.
+    pub clutter_volume: f64,
+    /// Normal spread of a new wall (rad). Default 2°.
+    pub birth_angle: f64,
+    /// Offset spread of a new wall (m). Default 0.15.
+    pub birth_offset: f64,
+}
+
+impl Default for PlaneTuning {
+    fn default() -> Self {
+        PlaneTuning {
+            process_angle: 0.5f64.to_radians(),
+            process_offset: 0.05,
+            sigma_angle: 2f64.to_radians(),
+            sigma_offset: 0.15,
+            gate: 4.0,
+            detection: 0.9,
+            clutter_rate: 0.5,
+            clutter_volume: std::f64::consts::FRAC_PI_2 * 50.0,
+            birth_angle: 2f64.to_radians(),
+            birth_offset: 0.15,
+        }
+    }
+}
+
+/// Cluster models: motion, measurement noise, detection, clutter and birth spread.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ClusterTuning {
+    /// Acceleration noise of the constant-velocity model (m/s²). Default 2.
+    pub sigma_accel: f64,
+    /// Centroid measurement noise per axis (m). Default 0.3.
+    pub sigma: f64,
+    /// Gate width in multiples of (σ + spread). Default 4.
+    pub gate: f64,
+    /// Detection probability. Default 0.8.
+    pub detection: f64,
+    /// Expected false clusters per frame. Default 2.
+    pub clutter_rate: f64,
+    /// Volume they spread over (m³). Default 80 × 80 × 4.
+    pub clutter_volume: f64,
+    /// Position spread of a new cluster (m). Default 0.3.
+    pub birth_position: f64,
+    /// Horizontal velocity spread of a new cluster (m/s). Default 4.
+    pub birth_velocity: f64,
+    /// Vertical velocity spread of a new cluster (m/s). Default 0.3.
+    pub birth_vertical: f64,
+}
+
+impl Default for ClusterTuning {
+    fn default() -> Self {
+        ClusterTuning {
+            sigma_accel: 2.0,
+            sigma: 0.3,
+            gate: 4.0,
+            detection: 0.8,
+            clutter_rate: 2.0,
+            clutter_volume: 80.0 * 80.0 * 4.0,
+            birth_position: 0.3,
+            birth_velocity: 4.0,
+            birth_vertical: 0.3,
+        }
+    }
+}
+
+/// Birth and survival.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BirthTuning {
+    /// Expected new objects per frame, λ_B of the adaptive birth. Default 4.
+    pub expected_births: f64,
+    /// Largest existence of a birth. Default 0.1.
+    pub max_existence: f64,
+    /// Survival probability per step. Default 0.95.
+    pub survival: f64,
+}
+
+impl Default for BirthTuning {
+    fn default() -> Self {
+        BirthTuning {
+            expected_births: 4.0,
+            max_existence: 0.1,
+            survival: 0.95,
+        }
+    }
+}
+
+/// Which point clusters become detections.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ClusterDetectionConfig {
+    /// Neighbour distance of the Euclidean clustering (m). Default 0.5.
+    pub tolerance: f64,
+    /// Fewest points of a cluster. Default 15.
+    pub min_points: usize,
+    /// Most points of a cluster. Default 20 000.
+    pub max_points: usize,
+    /// Points at most this high above the ground are not clustered (m). Default 0.3.
+    pub ground_clearance: f64,
+    /// Sensor height over the road, used when no ground plane was found (m). Default 1.73.
+    pub sensor_height: f64,
+    /// Horizontal range limit (m). Default 40.
+    pub max_range: f64,
+    /// Largest horizontal box side (m). Default 8.
+    pub max_footprint: f64,
+    /// Largest box height (m). Default 4.
+    pub max_height: f64,
+    /// At most this many clusters per frame, the nearest first. Default 40.
+    pub max_clusters: usize,
+}
+
+impl Default for ClusterDetectionConfig {
+    fn default() -> Self {
+        ClusterDetectionConfig {
+            tolerance: 0.5,
+            min_points: 15,
+            max_points: 20_000,
+            ground_clearance: 0.3,
+            sensor_height: 1.73,
+            max_range: 40.0,
+            max_footprint: 8.0,
+            max_height: 4.0,
+            max_clusters: 40,
+        }
+    }
+}
+
+/// Everything [`track_drive`] needs besides the drive and the seed. Every field has a default;
+/// a JSON or TOML file may set any subset. The plane segmentation uses
+/// [`PlaneConfig::default`] (not part of the file).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TrackingConfig {
+    /// Filter tuning (particles per track, resampling, pruning). Default: the filter's
+    /// defaults with room for 200 tracks.
+    pub filter: LmbConfig,
+    /// How walls follow the ego motion. Default: measured poses.
+    pub ego: EgoModel,
+    /// Wall models.
+    pub plane: PlaneTuning,
+    /// Cluster models.
+    pub cluster: ClusterTuning,
+    /// Birth and survival.
+    pub birth: BirthTuning,
+    /// Cluster detection.
+    pub clusters: ClusterDetectionConfig,
+    /// Frame interval when the drive has no Velodyne timestamps (s). Default 0.1.
+    pub dt: f64,
+    /// Plane segmentation.
+    #[serde(skip)]
+    pub planes: PlaneConfig,
+}
+
+impl Default for TrackingConfig {
+    fn default() -> Self {
+        TrackingConfig {
+            filter: LmbConfig {
+                max_tracks: 200,
+                ..LmbConfig::default()
+            },
+            ego: EgoModel::Measured,
+            plane: PlaneTuning::default(),
+            cluster: ClusterTuning::default(),
+            birth: BirthTuning::default(),
+            clusters: ClusterDetectionConfig::default(),
+            dt: 0.1,
+            planes: PlaneConfig::default(),
+        }
+    }
+}
+
+impl TrackingConfig {
+    /// Checks the fields the models do not check themselves.
+    pub fn validate(&self) -> Result<()> {
+        self.filter.validate()?;
+        self.planes.validate()?;
+        ensure_positive("tracking config field dt", self.dt)?;
+        ensure_probability("tracking config field birth.survival", self.birth.survival)?;
+        let c = &self.clusters;
+        for (name, v) in [
+            ("clusters.tolerance", c.tolerance),
+            ("clusters.max_range", c.max_range),
+            ("clusters.max_footprint", c.max_footprint),
+            ("clusters.max_height", c.max_height),
+        ] {
+            ensure_positive(&format!("tracking config field {name}"), v)?;
+        }
+        if !(c.ground_clearance.is_finite() && c.sensor_height.is_finite()) {
+            return Err(Error::invalid(
+                "tracking config field clusters.ground_clearance / sensor_height",
+                "must be finite",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// What [`track_drive`] hands its callback for every frame.
+#[derive(Debug)]
+pub struct FrameView<'a> {
+    /// The frame's cloud (sensor frame).
+    pub cloud: &'a PointCloud,
+    /// The frame's detections.
+    pub detections: &'a FrameDetections,
+    /// The frame's report.
+    pub tracked: &'a TrackedFrame,
+    /// Frames done so far (including this one) and frames in the run.
+    pub progress: (usize, usize),
+}
+
+/// Stream key of the plane segmentation random stream of a frame.
+const KEY_SEGMENT: u64 = 0x5E6 << 48;
+
+/// Tracks walls and clusters over `frames` (default: all) of `drive`.
+///
+/// Poses come from OXTS when the drive has it; otherwise every frame is taken at the world
+/// origin (`ego = "none"`: only a static sensor is then tracked correctly). The ECT ego model
+/// needs OXTS. Time stamps come from `velodyne_points/timestamps.txt` when present, else frame
+/// k is at k·`config.dt`. `on_frame` sees every frame as it is done; its error stops the run.
+pub fn track_drive(
+    drive: &RawDrive,
+    frames: Option<Range<usize>>,
+    config: &TrackingConfig,
+    seed: u64,
+    mut on_frame: impl FnMut(&FrameView<'_>) -> Result<()>,
+) -> Result<DriveTracks> {
+    config.validate()?;
+    let name = drive.dir().display().to_string();
+    if !drive.has_velodyne() {
+        return Err(Error::invalid(
+            format!("drive {name}"),
+            "has no velodyne_points/data folder",
+        ));
+    }
+    let n = drive.velodyne_count();
+    let range = frames.unwrap_or(0..n);
+    if range.start >= range.end || range.end > n {
+        return Err(Error::invalid(
+            format!("frame range of drive {name}"),
+            format!(
+                "{}..{} is empty or beyond its {n} frames",
+                range.start, range.end
+            ),
+        ));
+    }
+    let (poses, ego) = if drive.has_oxts() {
+        let ego = match config.ego {
+            EgoModel::Measured => "oxts",
+            EgoModel::Ect { .. } => "oxts+ect",
+        };
+        (drive.poses()?, ego)
+    } else {
+        if let EgoModel::Ect { .. } = config.ego {
+            return Err(Error::invalid(
+                format!("drive {name}"),
+                "the ECT ego model needs OXTS packets (oxts/data)",
+            ));
+        }
+        (vec![Isometry3::identity(); n], "none")
+    };
+    let vehicle: Option<Vec<[f64; 6]>> = match config.ego {
+        EgoModel::Measured => None,
+        EgoModel::Ect { .. } => Some(
+            drive
+                .vehicle_states()?
+                .iter()
+                .map(|s| s.to_array())
+                .collect(),
+        ),
+    };
+    let times: Vec<f64> = if drive.velodyne_timestamps_path().is_file() {
+        let t = drive.timestamps()?;
+        if t.len() != n {
+            return Err(Error::invalid(
+                format!("{}", drive.velodyne_timestamps_path().display()),
+                format!("has {} stamps for {n} Velodyne frames", t.len()),
+            ));
+        }
+        t.seconds
+    } else {
+        (0..n).map(|k| k as f64 * config.dt).collect()
+    };
+
+    let mut tracker = DriveTracker::new(config, seed)?;
+    let mut out = Vec::with_capacity(range.len());
+    let total = range.len();
+    for k in range.clone() {
+        let start = Instant::now();
+        let cloud = drive.velodyne(k)?;
+        let read_ms = start.elapsed().as_secs_f64() * 1e3;
+        let detections = detect_objects(&cloud, config, &mut stream(seed, KEY_SEGMENT ^ k as u64))?;
+        let previous_state = vehicle
+            .as_ref()
+            .map(|v| v[if k > range.start { k - 1 } else { k }]);
+        let mut tracked = tracker.step(k, times[k], poses[k], previous_state, &detections)?;
+        tracked.times.read_ms = read_ms;
+        on_frame(&FrameView {
+            cloud: &cloud,
+            detections: &detections,
+            tracked: &tracked,
+            progress: (out.len() + 1, total),
+        })?;
+        out.push(tracked);
+    }
+    let summary = TrackingSummary::of(&out);
+    Ok(DriveTracks {
+        drive: drive.name(),
+        seed,
+        particles: config.filter.particles,
+        ego: ego.to_string(),
+        frames: out,
+        summary,
+    })
+}

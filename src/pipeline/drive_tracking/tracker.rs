@@ -1,0 +1,308 @@
+//! [`DriveTracker`]: one [`LmbFilter`] over the mixed plane/cluster state, stepped frame by
+//! frame with a frame's detections and the sensor pose, and the per-frame report built from
+//! its MAP estimate.
+//!
+//! The filter's estimates carry no shape, so the report borrows it from the detections: each
+//! confirmed track is matched (greedy, nearest first, within a fixed gate) to one detection of
+//! its kind in the frame; a wall takes that detection's rectangle projected onto the track's
+//! plane and remembers it in the world frame for the frames where it is missed, a cluster
+//! takes the detection's box size. The matches also give every detection (and so every
+//! point) a track number for the labelled exports.
+//!
+//! Not for: reading drives or segmenting clouds (see [`super::detect`], [`super::track_drive`]).
+
+use super::detect::FrameDetections;
+use super::output::{StageTimes, TrackedCluster, TrackedFrame, TrackedPlane};
+use super::{EgoModel, TrackingConfig};
+use crate::error::Result;
+use crate::filter::{AdaptiveBirth, Estimate, Frame, Label, LmbFilter};
+use crate::geometry::Plane;
+use crate::models::mixed::{
+    MixedBirthSampler, MixedClutter, MixedDetection, MixedMeasurement, MixedTransition, ObjectKind,
+    VehicleStateHandle, KIND,
+};
+use crate::models::plane::{canonical_plane, plane_residual};
+use crate::models::{ExtendedConstantTurn, PlaneMeasurement};
+use crate::rng::{seeded, FilterRng};
+use nalgebra::{Isometry3, Point3, Vector3};
+use std::collections::HashMap;
+use std::time::Instant;
+
+/// Largest normal angle between a wall track and the detection it is matched to (rad).
+const MATCH_ANGLE: f64 = 0.15;
+/// Largest offset difference between a wall track and its matched detection (m).
+const MATCH_OFFSET: f64 = 1.0;
+/// Largest sensor-frame distance between a cluster track and its matched detection (m).
+const MATCH_DISTANCE: f64 = 1.5;
+
+/// The tracker of one drive: the filter, its random state and what the report remembers.
+pub struct DriveTracker {
+    filter: LmbFilter,
+    vehicle: Option<VehicleStateHandle>,
+    rng: FilterRng,
+    ids: HashMap<Label, u32>,
+    wall_corners: HashMap<Label, [Point3<f64>; 4]>,
+    cluster_extent: HashMap<Label, [f64; 3]>,
+}
+
+impl std::fmt::Debug for DriveTracker {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("DriveTracker")
+            .field("filter", &self.filter)
+            .field("labels", &self.ids.len())
+            .finish_non_exhaustive()
+    }
+}
+
+impl DriveTracker {
+    /// A tracker with the models and tuning of `config`; `seed` drives the filter's randomness.
+    pub fn new(config: &TrackingConfig, seed: u64) -> Result<Self> {
+        config.validate()?;
+        let p = &config.plane;
+        let c = &config.cluster;
+        let (transition, vehicle) = match config.ego {
+            EgoModel::Measured => (
+                MixedTransition::measured(p.process_angle, p.process_offset, c.sigma_accel)?,
+                None,
+            ),
+            EgoModel::Ect {
+                sigma_accel,
+                sigma_turn_accel,
+            } => {
+                let (t, h) = MixedTransition::predicted(
+                    ExtendedConstantTurn::new(sigma_accel, sigma_turn_accel)?,
+                    p.process_angle,
+                    p.process_offset,
+                    c.sigma_accel,
+                )?;
+                (t, Some(h))
+            }
+        };
+        let plane_meas = PlaneMeasurement::new(p.sigma_angle, p.sigma_offset)?.with_gate(p.gate)?;
+        let sampler = MixedBirthSampler {
+            plane_sigma_angle: p.birth_angle,
+            plane_sigma_offset: p.birth_offset,
+            cluster_sigma_position: c.birth_position,
+            cluster_sigma_velocity: c.birth_velocity,
+            cluster_sigma_vertical: c.birth_vertical,
+        };
+        sampler.validate()?;
+        let mut birth = AdaptiveBirth::new(
+            sampler,
+            config.birth.expected_births,
+            config.birth.max_existence,
+            config.filter.particles,
+        )?;
+        // A proposal below the pruning threshold would be pruned right after its first update.
+        birth.min_existence = config.filter.prune_threshold.max(birth.min_existence);
+        let filter = LmbFilter::builder()
+            .transition(transition)
+            .measurement(MixedMeasurement::new(plane_meas, c.sigma, c.gate)?)
+            .detection(MixedDetection::new(p.detection, c.detection)?)
+            .clutter(MixedClutter::new(
+                p.clutter_rate,
+                p.clutter_volume,
+                c.clutter_rate,
+                c.clutter_volume,
+            )?)
+            .survival(crate::models::ConstantSurvival(config.birth.survival))
+            .birth(birth)
+            .config(config.filter.clone())
+            .build()?;
+        Ok(DriveTracker {
+            filter,
+            vehicle,
+            rng: seeded(seed),
+            ids: HashMap::new(),
+            wall_corners: HashMap::new(),
+            cluster_extent: HashMap::new(),
+        })
+    }
+
+    /// The filter (tracks, configuration).
+    pub fn filter(&self) -> &LmbFilter {
+        &self.filter
+    }
+
+    /// Runs one frame: `pose` is the sensor pose (sensor → world) at `time` (s);
+    /// `vehicle_state` the planar vehicle state `[X, Ẋ, Y, Ẏ, φ, φ̇]` of the *previous* frame,
+    /// needed only by the ECT ego model (the first frame may pass any). Returns the frame's
+    /// report; `times.read_ms` is left 0 for the caller, `planes_ms` and `clusters_ms` are
+    /// copied from `detections`.
+    pub fn step(
+        &mut self,
+        frame: usize,
+        time: f64,
+        pose: Isometry3<f64>,
+        vehicle_state: Option<[f64; 6]>,
+        detections: &FrameDetections,
+    ) -> Result<TrackedFrame> {
+        let start = Instant::now();
+        if let (Some(h), Some(s)) = (&self.vehicle, vehicle_state) {
+            h.set(s);
+        }
+        let measurements = detections.measurements()?;
+        let estimates = self.filter.step(
+            &Frame {
+                time,
+                measurements,
+                platform: Some(pose),
+            },
+            &mut self.rng,
+        )?;
+        let (planes, clusters) = self.report(&estimates, &pose, detections);
+        let filter_ms = start.elapsed().as_secs_f64() * 1e3;
+        let (_, _, yaw) = pose.rotation.euler_angles();
+        let t = pose.translation.vector;
+        Ok(TrackedFrame {
+            frame,
+            time,
+            ego_position: [t.x, t.y, t.z],
+            ego_yaw: yaw,
+            detected_planes: detections.walls.len(),
+            detected_clusters: detections.clusters.len(),
+            planes,
+            clusters,
+            times: StageTimes {
+                read_ms: 0.0,
+                planes_ms: detections.planes_ms,
+                clusters_ms: detections.clusters_ms,
+                filter_ms,
+            },
+        })
+    }
+
+    fn id_of(&mut self, label: Label) -> u32 {
+        let next = self.ids.len() as u32 + 1;
+        *self.ids.entry(label).or_insert(next)
+    }
+
+    fn report(
+        &mut self,
+        estimates: &[Estimate],
+        pose: &Isometry3<f64>,
+        det: &FrameDetections,
+    ) -> (Vec<TrackedPlane>, Vec<TrackedCluster>) {
+        let inv = pose.inverse();
+        let mut planes: Vec<(&Estimate, [f64; 4])> = Vec::new();
+        let mut clusters: Vec<(&Estimate, Point3<f64>)> = Vec::new();
+        for e in estimates {
+            match e.state.get(KIND).copied().and_then(ObjectKind::from_code) {
+                Some(ObjectKind::Plane) => {
+                    let s = &e.state;
+                    planes.push((e, canonical_plane(&[s[0], s[1], s[2], s[3]])));
+                }
+                Some(ObjectKind::Cluster) => {
+                    let w = Point3::new(e.state[0], e.state[2], e.state[4]);
+                    clusters.push((e, w));
+                }
+                None => {}
+            }
+        }
+        // Greedy matching, cheapest pair first.
+        let mut plane_pairs: Vec<(f64, usize, usize)> = Vec::new();
+        for (i, (_, beta)) in planes.iter().enumerate() {
+            for (j, w) in det.walls.iter().enumerate() {
+                let (angle, dd) = plane_residual(beta, &w.patch.plane.as_vector());
+                if angle <= MATCH_ANGLE && dd.abs() <= MATCH_OFFSET {
+                    plane_pairs.push((angle / MATCH_ANGLE + dd.abs() / MATCH_OFFSET, i, j));
+                }
+            }
+        }
+        let plane_match = greedy(plane_pairs, planes.len(), det.walls.len());
+        let mut cluster_pairs: Vec<(f64, usize, usize)> = Vec::new();
+        for (i, (_, w)) in clusters.iter().enumerate() {
+            let s = inv * w;
+            for (j, c) in det.clusters.iter().enumerate() {
+                let d = (s - Point3::from(c.centroid)).norm();
+                if d <= MATCH_DISTANCE {
+                    cluster_pairs.push((d, i, j));
+                }
+            }
+        }
+        let cluster_match = greedy(cluster_pairs, clusters.len(), det.clusters.len());
+
+        let mut out_planes = Vec::with_capacity(planes.len());
+        for ((e, beta), m) in planes.iter().zip(plane_match) {
+            let plane = Plane::new(Vector3::new(beta[0], beta[1], beta[2]), beta[3]).ok();
+            if let (Some(j), Some(_)) = (m, &plane) {
+                let corners = det.walls[j].patch.vertices.map(|v| pose * v);
+                self.wall_corners.insert(e.label, corners);
+            }
+            let sensor = match (&plane, self.wall_corners.get(&e.label)) {
+                (Some(pl), Some(world)) => Some(world.map(|v| pl.project(&(inv * v)))),
+                _ => None,
+            };
+            let area = sensor.map_or(0.0, |v| rectangle_area(&v));
+            let id = self.id_of(e.label);
+            out_planes.push(TrackedPlane {
+                id,
+                label: e.label,
+                normal: [beta[0], beta[1], beta[2]],
+                offset: beta[3],
+                vertices: sensor.map(|v| v.map(|p| [p.x, p.y, p.z])),
+                vertices_world: sensor.map(|v| {
+                    v.map(|p| {
+                        let w = pose * p;
+                        [w.x, w.y, w.z]
+                    })
+                }),
+                area,
+                existence: e.existence,
+                detection: m,
+            });
+        }
+        let mut out_clusters = Vec::with_capacity(clusters.len());
+        for ((e, w), m) in clusters.iter().zip(cluster_match) {
+            if let Some(j) = m {
+                let c = &det.clusters[j];
+                self.cluster_extent
+                    .insert(e.label, std::array::from_fn(|a| c.max[a] - c.min[a]));
+            }
+            let s = inv * w;
+            let id = self.id_of(e.label);
+            out_clusters.push(TrackedCluster {
+                id,
+                label: e.label,
+                position_world: [w.x, w.y, w.z],
+                position_sensor: [s.x, s.y, s.z],
+                velocity: [e.state[1], e.state[3], e.state[5]],
+                extent: self.cluster_extent.get(&e.label).copied(),
+                existence: e.existence,
+                detection: m,
+            });
+        }
+        (out_planes, out_clusters)
+    }
+}
+
+/// Assigns each row at most one column and each column at most one row, taking pairs in
+/// ascending cost (ties: lower row, then lower column).
+fn greedy(mut pairs: Vec<(f64, usize, usize)>, rows: usize, cols: usize) -> Vec<Option<usize>> {
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
+    let mut row = vec![None; rows];
+    let mut used = vec![false; cols];
+    for (_, i, j) in pairs {
+        if row[i].is_none() && !used[j] {
+            row[i] = Some(j);
+            used[j] = true;
+        }
+    }
+    row
+}
+
+/// Area of the rectangle v0 v1 v2 v3.
+fn rectangle_area(v: &[Point3<f64>; 4]) -> f64 {
+    (v[1] - v[0]).norm() * (v[3] - v[0]).norm()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn greedy_takes_cheapest_pairs_first() {
+        let m = greedy(vec![(1.0, 0, 0), (0.5, 1, 0), (2.0, 0, 1)], 3, 2);
+        assert_eq!(m, vec![Some(1), Some(0), None]);
+    }
+}
