@@ -1,6 +1,7 @@
 //! End-to-end processing chains that combine readers, detectors, models and metrics, e.g.
 //! segmenting walls in consecutive LiDAR frames, predicting them forward and scoring the
-//! prediction ([`plane_prediction`]).
+//! prediction ([`plane_prediction`]); tracking walls and clusters through a whole drive
+//! ([`drive_tracking`]) and scoring the tracks against ground truth ([`drive_evaluation`]).
 //!
 //! Not for: the filter itself (see [`crate::filter`]) or command-line parsing.
 
@@ -13,3 +14,6 @@ pub use plane_prediction::{
 
 pub mod drive_tracking;
 pub use drive_tracking::{track_drive, DriveTracker, DriveTracks, TrackingConfig};
+
+pub mod drive_evaluation;
+pub use drive_evaluation::{evaluate_clusters, evaluate_walls, ClusterEvaluation, WallEvaluation};

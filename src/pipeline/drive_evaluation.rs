@@ -1,0 +1,273 @@
+//! Scores the output of a drive's tracking run ([`DriveTracks`]) against ground truth: the
+//! cluster tracks by OSPA and GOSPA (per frame and averaged) and label switches, against the
+//! objects of a simulated street ([`StreetTruth`]) or the tracklets of a KITTI raw drive
+//! ([`Tracklets`]); the wall tracks of a simulated street by the angle between their normals
+//! and the truth wall's and the distance of their centres from its plane.
+//!
+//! Distances are horizontal (x, y of the world frame): a cluster's centroid is the mean of the
+//! points the lidar sees, which lie on the object's near faces, while the truth gives the box
+//! centre; the two differ by up to half the object's length whatever the tracker does, and
+//! mostly in the horizontal plane. Vertical offsets would add the sensor-height bias of
+//! partially seen objects, which says nothing about tracking.
+//!
+//! Not for: producing the tracks (see [`super::drive_tracking`]) or the plane prediction
+//! between frames (see [`super::plane_prediction`]).
+
+use super::drive_tracking::DriveTracks;
+use crate::error::{Error, Result};
+use crate::kitti::Tracklets;
+use crate::metrics::{gospa, ospa, percentile, LabelConsistency, LabelStats};
+use crate::sim::street::StreetTruth;
+use nalgebra::{Isometry3, Point3, Vector3};
+
+/// One truth object in one frame: an identity and its horizontal position (world frame of the
+/// tracking output, metres).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct TruthObject {
+    /// Stable identity across frames.
+    pub id: u64,
+    /// x, y (m).
+    pub position: [f64; 2],
+}
+
+/// Truth objects per frame, indexed by the drive's frame number.
+pub type TruthFrames = Vec<Vec<TruthObject>>;
+
+/// The cars and pedestrians of a simulated street, per frame, in the world frame of the
+/// tracking output (the first Velodyne frame of the drive). An object counts in a frame only
+/// when at least `min_points` lidar points hit it there: what the sensor cannot see, no
+/// tracker can report.
+pub fn street_object_truth(truth: &StreetTruth, min_points: usize) -> TruthFrames {
+    let drive_from_world = truth.world_from_drive.to_isometry().inverse();
+    let mut frames: TruthFrames = vec![Vec::new(); truth.frames.len()];
+    for object in &truth.objects {
+        for state in &object.states {
+            if state.points < min_points || state.frame >= frames.len() {
+                continue;
+            }
+            let [x, y, z] = state.position;
+            let centre = drive_from_world * Point3::new(x, y, z + object.size[2] / 2.0);
+            frames[state.frame].push(TruthObject {
+                id: object.id as u64,
+                position: [centre.x, centre.y],
+            });
+        }
+    }
+    frames
+}
+
+/// The tracklet boxes of a KITTI raw drive, per frame, moved into the world frame of the
+/// tracking output with the drive's Velodyne poses (`RawDrive::poses`, one per frame).
+/// Frames beyond the poses are left empty.
+pub fn tracklet_truth(tracklets: &Tracklets, poses: &[Isometry3<f64>]) -> TruthFrames {
+    (0..poses.len())
+        .map(|k| {
+            tracklets
+                .objects_at(k)
+                .iter()
+                .map(|o| {
+                    let c = poses[k] * o.center();
+                    TruthObject {
+                        id: o.id as u64,
+                        position: [c.x, c.y],
+                    }
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// OSPA / GOSPA settings.
+#[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ClusterEvaluationConfig {
+    /// Cut-off c (m).
+    pub cutoff: f64,
+    /// Order p.
+    pub order: f64,
+}
+
+impl Default for ClusterEvaluationConfig {
+    /// c = 3 m (larger than the half-length of a car, the largest bias between a visible-surface
+    /// centroid and the box centre), p = 1.
+    fn default() -> Self {
+        ClusterEvaluationConfig {
+            cutoff: 3.0,
+            order: 1.0,
+        }
+    }
+}
+
+/// Scores of one frame.
+#[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FrameScore {
+    /// Frame number.
+    pub frame: usize,
+    /// Truth objects counted.
+    pub truth: usize,
+    /// Confirmed cluster tracks.
+    pub estimates: usize,
+    /// OSPA distance (m).
+    pub ospa: f64,
+    /// GOSPA distance (m, α = 2).
+    pub gospa: f64,
+    /// Truth objects left unpaired by GOSPA.
+    pub missed: usize,
+    /// Tracks left unpaired by GOSPA.
+    pub false_tracks: usize,
+}
+
+/// Scores of a whole drive.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ClusterEvaluation {
+    /// Settings used.
+    pub config: ClusterEvaluationConfig,
+    /// Per frame.
+    pub frames: Vec<FrameScore>,
+    /// Mean OSPA over the frames (m).
+    pub mean_ospa: f64,
+    /// Mean GOSPA over the frames (m).
+    pub mean_gospa: f64,
+    /// Label statistics (a switch is a truth object paired, within c, with another label than
+    /// the last time).
+    pub labels: LabelStats,
+}
+
+/// Scores the confirmed cluster tracks of `tracks` against `truth` (indexed by frame number;
+/// frames of `tracks` beyond `truth` are an error: the truth does not describe them).
+pub fn evaluate_clusters(
+    tracks: &DriveTracks,
+    truth: &[Vec<TruthObject>],
+    config: &ClusterEvaluationConfig,
+) -> Result<ClusterEvaluation> {
+    if tracks.frames.is_empty() {
+        return Err(Error::invalid(
+            "tracking output",
+            "has no frames to evaluate",
+        ));
+    }
+    let mut labels = LabelConsistency::new(config.cutoff)?;
+    let mut frames = Vec::with_capacity(tracks.frames.len());
+    for f in &tracks.frames {
+        let Some(objects) = truth.get(f.frame) else {
+            return Err(Error::invalid(
+                format!("tracking output frame {}", f.frame),
+                format!("the truth has only {} frames", truth.len()),
+            ));
+        };
+        let x: Vec<[f64; 2]> = objects.iter().map(|o| o.position).collect();
+        let y: Vec<[f64; 2]> = f
+            .clusters
+            .iter()
+            .map(|c| [c.position_world[0], c.position_world[1]])
+            .collect();
+        let o = ospa(&x, &y, config.cutoff, config.order)?;
+        let g = gospa(&x, &y, config.cutoff, config.order)?;
+        let truth_ids: Vec<(u64, [f64; 2])> = objects.iter().map(|o| (o.id, o.position)).collect();
+        let estimates: Vec<_> = f
+            .clusters
+            .iter()
+            .zip(&y)
+            .map(|(c, p)| (c.label, *p))
+            .collect();
+        labels.add_step(&truth_ids, &estimates)?;
+        frames.push(FrameScore {
+            frame: f.frame,
+            truth: x.len(),
+            estimates: y.len(),
+            ospa: o.distance,
+            gospa: g.distance,
+            missed: g.n_missed,
+            false_tracks: g.n_false,
+        });
+    }
+    let n = frames.len() as f64;
+    Ok(ClusterEvaluation {
+        config: *config,
+        mean_ospa: frames.iter().map(|f| f.ospa).sum::<f64>() / n,
+        mean_gospa: frames.iter().map(|f| f.gospa).sum::<f64>() / n,
+        frames,
+        labels: labels.finish(),
+    })
+}
+
+/// Accuracy of the wall tracks against the walls of a simulated street.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct WallEvaluation {
+    /// Confirmed wall reports with a rectangle (over all frames).
+    pub reports: usize,
+    /// Reports within 2° and 0.5 m of a truth wall.
+    pub matched: usize,
+    /// Median angle between a report's normal and its closest truth wall's (degrees).
+    pub median_normal_angle_deg: f64,
+    /// 90th percentile of that angle (degrees).
+    pub p90_normal_angle_deg: f64,
+    /// Median distance of a report's rectangle centre from its truth wall's plane (m).
+    pub median_offset_m: f64,
+    /// 90th percentile of that distance (m).
+    pub p90_offset_m: f64,
+    /// Distinct truth walls matched at least once.
+    pub walls_matched: usize,
+}
+
+/// Compares every confirmed wall report that has a rectangle with the truth wall closest to
+/// it (smallest angle, then centre-to-plane distance, among walls within 10°).
+pub fn evaluate_walls(tracks: &DriveTracks, truth: &StreetTruth) -> Result<WallEvaluation> {
+    let world_from_drive = truth.world_from_drive.to_isometry();
+    let (mut angles, mut offsets) = (Vec::new(), Vec::new());
+    let (mut reports, mut matched) = (0, 0);
+    let mut walls = std::collections::BTreeSet::new();
+    for f in &tracks.frames {
+        for plane in &f.planes {
+            let Some(v) = plane.vertices_world else {
+                continue;
+            };
+            reports += 1;
+            let p: Vec<Point3<f64>> = v
+                .iter()
+                .map(|q| world_from_drive * Point3::from(*q))
+                .collect();
+            let centre =
+                Point3::from((p[0].coords + p[1].coords + p[2].coords + p[3].coords) / 4.0);
+            let normal = (p[1] - p[0]).cross(&(p[3] - p[0]));
+            if normal.norm() == 0.0 {
+                continue;
+            }
+            let normal = normal.normalize();
+            let best = truth
+                .walls
+                .iter()
+                .map(|w| {
+                    let n = Vector3::from(w.normal);
+                    let angle = normal.dot(&n).abs().min(1.0).acos();
+                    let offset = (n.dot(&centre.coords) + w.offset).abs();
+                    (w.id, angle, offset)
+                })
+                .filter(|(_, a, _)| *a < 10f64.to_radians())
+                .min_by(|a, b| (a.2 + 10.0 * a.1).total_cmp(&(b.2 + 10.0 * b.1)));
+            if let Some((id, angle, offset)) = best {
+                angles.push(angle.to_degrees());
+                offsets.push(offset);
+                if angle < 2f64.to_radians() && offset < 0.5 {
+                    matched += 1;
+                    walls.insert(id);
+                }
+            }
+        }
+    }
+    let stat = |v: &[f64], q: f64| {
+        if v.is_empty() {
+            f64::NAN
+        } else {
+            percentile(v, q)
+        }
+    };
+    Ok(WallEvaluation {
+        reports,
+        matched,
+        median_normal_angle_deg: stat(&angles, 50.0),
+        p90_normal_angle_deg: stat(&angles, 90.0),
+        median_offset_m: stat(&offsets, 50.0),
+        p90_offset_m: stat(&offsets, 90.0),
+        walls_matched: walls.len(),
+    })
+}
