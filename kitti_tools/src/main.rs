@@ -3,7 +3,9 @@
 
 mod config_file;
 mod convert_cmd;
+mod demo_cmd;
 mod detections_cmd;
+mod eval_cmd;
 mod info_cmd;
 mod planes_cmd;
 mod synth_cmd;
@@ -25,6 +27,9 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// The whole 3-D pipeline on a simulated street (nothing to download): simulate a KITTI
+    /// drive, predict its walls frame to frame, track walls and clusters, score the tracks.
+    Demo(demo_cmd::Args),
     /// Run the filter on your own per-frame detections (JSON or CSV) with a model config
     /// (TOML or JSON); write per-frame estimates and, given truth, print OSPA/GOSPA.
     Detections(detections_cmd::Args),
@@ -41,15 +46,21 @@ enum Command {
     /// Track building walls and point clusters of a KITTI raw drive with one labelled
     /// multi-Bernoulli filter; write per-frame tracks (JSON), labelled clouds and a plot.
     Track(track_cmd::Args),
+    /// Score the output of `track` against ground truth (a simulated street's truth.json or
+    /// KITTI tracklets): OSPA, GOSPA and label switches of the clusters, wall accuracy, and
+    /// optionally the drive's plane-prediction statistics.
+    Eval(eval_cmd::Args),
 }
 
 fn main() -> Result<()> {
     match Cli::parse().command {
+        Command::Demo(args) => demo_cmd::run(args),
         Command::Detections(args) => detections_cmd::run(args),
         Command::Convert(args) => convert_cmd::run(args),
         Command::Info(args) => info_cmd::run(args),
         Command::Planes(args) => planes_cmd::run(args),
         Command::Synth(args) => synth_cmd::run(args),
         Command::Track(args) => track_cmd::run(args),
+        Command::Eval(args) => eval_cmd::run(args),
     }
 }

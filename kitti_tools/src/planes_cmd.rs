@@ -103,6 +103,15 @@ pub fn run(args: Args) -> Result<()> {
         println!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
     }
+    print_pairs(&results);
+    if args.all {
+        print_summary(&summary, results.len());
+    }
+    Ok(())
+}
+
+/// Prints one row per associated wall pair, like seed 001's Tables 1–6.
+pub fn print_pairs(results: &[PairPrediction]) {
     println!(
         "{:>6} {:>10} {:>10} {:>8} {:>8} {:>8} {:>8} {:>9} {:>8} {:>9}",
         "frame",
@@ -116,7 +125,7 @@ pub fn run(args: Args) -> Result<()> {
         "angle °",
         "pred ms"
     );
-    for r in &results {
+    for r in results {
         if r.pairs.is_empty() {
             println!(
                 "{:>6} (no associated walls: {} predicted, {} segmented)",
@@ -140,17 +149,18 @@ pub fn run(args: Args) -> Result<()> {
             );
         }
     }
-    if args.all {
-        println!(
-            "{} pairs over {} frame pairs: normal angle median {:.3}° p90 {:.3}°, vertex distance median {:.3} m p90 {:.3} m, prediction {:.4} ms",
-            summary.pairs,
-            results.len(),
-            summary.median_normal_angle_deg,
-            summary.p90_normal_angle_deg,
-            summary.median_vertex_distance_m,
-            summary.p90_vertex_distance_m,
-            summary.mean_prediction_ms
-        );
-    }
-    Ok(())
+}
+
+/// Prints the distribution over all pairs.
+pub fn print_summary(summary: &PlanePredictionSummary, frame_pairs: usize) {
+    println!(
+        "{} pairs over {frame_pairs} frame pairs: normal angle median {:.3}° p90 {:.3}°, vertex \
+         distance median {:.3} m p90 {:.3} m, prediction {:.4} ms",
+        summary.pairs,
+        summary.median_normal_angle_deg,
+        summary.p90_normal_angle_deg,
+        summary.median_vertex_distance_m,
+        summary.p90_vertex_distance_m,
+        summary.mean_prediction_ms
+    );
 }

@@ -8,7 +8,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use smc_lmb::cloud::{write_las_labelled, write_ply_labelled};
 use smc_lmb::kitti::RawDrive;
 use smc_lmb::pipeline::drive_tracking::{
-    drive_plot, point_labels, track_drive, EgoModel, TrackingConfig,
+    drive_plot, point_labels, track_drive, DriveTracks, EgoModel, TrackingConfig,
 };
 use std::ops::Range;
 use std::path::PathBuf;
@@ -130,6 +130,13 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(p) = &args.plot {
         drive_plot(&tracks).write(p, 1000)?;
     }
+    print_summary(&tracks);
+    println!("wrote {}", args.out.display());
+    Ok(())
+}
+
+/// Prints what a tracking run confirmed and how long its stages took.
+pub fn print_summary(tracks: &DriveTracks) {
     let s = &tracks.summary;
     let t = &s.mean_times;
     println!(
@@ -148,8 +155,6 @@ pub fn run(args: Args) -> Result<()> {
         t.filter_ms,
         t.read_ms + t.planes_ms + t.clusters_ms + t.filter_ms
     );
-    println!("wrote {}", args.out.display());
-    Ok(())
 }
 
 #[cfg(test)]

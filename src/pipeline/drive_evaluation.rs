@@ -35,9 +35,10 @@ pub type TruthFrames = Vec<Vec<TruthObject>>;
 
 /// The cars and pedestrians of a simulated street, per frame, in the world frame of the
 /// tracking output (the first Velodyne frame of the drive). An object counts in a frame only
-/// when at least `min_points` lidar points hit it there: what the sensor cannot see, no
-/// tracker can report.
-pub fn street_object_truth(truth: &StreetTruth, min_points: usize) -> TruthFrames {
+/// when at least `min_points` lidar points hit it there and its centre is within `max_range`
+/// (horizontally) of the sensor: what the sensor cannot see, or the tracker is set not to
+/// look at, no tracker can report.
+pub fn street_object_truth(truth: &StreetTruth, min_points: usize, max_range: f64) -> TruthFrames {
     let drive_from_world = truth.world_from_drive.to_isometry().inverse();
     let mut frames: TruthFrames = vec![Vec::new(); truth.frames.len()];
     for object in &truth.objects {
@@ -46,6 +47,10 @@ pub fn street_object_truth(truth: &StreetTruth, min_points: usize) -> TruthFrame
                 continue;
             }
             let [x, y, z] = state.position;
+            let sensor = truth.frames[state.frame].velodyne_pose.translation;
+            if (x - sensor[0]).hypot(y - sensor[1]) > max_range {
+                continue;
+            }
             let centre = drive_from_world * Point3::new(x, y, z + object.size[2] / 2.0);
             frames[state.frame].push(TruthObject {
                 id: object.id as u64,
@@ -108,6 +113,10 @@ pub struct FrameScore {
     pub estimates: usize,
     /// OSPA distance (m).
     pub ospa: f64,
+    /// Its localisation part (m).
+    pub ospa_localisation: f64,
+    /// Its cardinality part (m).
+    pub ospa_cardinality: f64,
     /// GOSPA distance (m, α = 2).
     pub gospa: f64,
     /// Truth objects left unpaired by GOSPA.
@@ -175,6 +184,8 @@ pub fn evaluate_clusters(
             truth: x.len(),
             estimates: y.len(),
             ospa: o.distance,
+            ospa_localisation: o.localisation,
+            ospa_cardinality: o.cardinality,
             gospa: g.distance,
             missed: g.n_missed,
             false_tracks: g.n_false,

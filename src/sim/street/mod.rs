@@ -32,7 +32,7 @@ pub use ego::{EgoState, EgoTrajectory, LegSpec};
 pub use lidar::{LidarConfig, LidarScan, Surface};
 pub use truth::{FrameTruth, ObjectState, ObjectTruth, PoseTruth, StreetTruth, WallTruth};
 pub use world::{ObjectKind, Street};
-pub use writer::{write_drive, WrittenDrive};
+pub use writer::{write_drive, WrittenDrive, TRUTH_FILE};
 
 use crate::error::{ensure_non_negative, ensure_positive, Error, Result};
 use crate::kitti::calib::{rigid_calib_from, CalibFile};

@@ -1,0 +1,219 @@
+//! `kitti-tools eval`: scores the output of `track` against ground truth — OSPA and GOSPA of
+//! the cluster tracks and their label switches against a simulated street's `truth.json` or a
+//! KITTI drive's `tracklet_labels.xml`, the wall tracks against the street's walls — and, on
+//! request, the drive's plane-prediction statistics.
+
+use anyhow::{bail, Context, Result};
+use smc_lmb::kitti::{read_tracklets, RawDrive};
+use smc_lmb::metrics::{PlanePairError, PlanePredictionSummary};
+use smc_lmb::pipeline::drive_evaluation::{
+    evaluate_clusters, evaluate_walls, street_object_truth, tracklet_truth, ClusterEvaluation,
+    ClusterEvaluationConfig, FrameScore, TruthFrames, WallEvaluation,
+};
+use smc_lmb::pipeline::{predict_drive_pairs, DriveTracks, PlanePredictionConfig};
+use smc_lmb::sim::street::StreetTruth;
+use std::path::{Path, PathBuf};
+
+/// Flags of `eval`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Output of `kitti-tools track`.
+    #[arg(long)]
+    tracks: PathBuf,
+    /// The drive folder; its `truth.json` (simulated) or `tracklet_labels.xml` (KITTI) is the
+    /// truth unless `--truth` or `--tracklets` names one.
+    #[arg(long)]
+    drive: Option<PathBuf>,
+    /// A simulated street's `truth.json`.
+    #[arg(long)]
+    truth: Option<PathBuf>,
+    /// A KITTI `tracklet_labels.xml` (needs `--drive` for the poses).
+    #[arg(long)]
+    tracklets: Option<PathBuf>,
+    /// Simulated objects count in a frame only with at least this many lidar points.
+    #[arg(long, default_value_t = 15)]
+    min_points: usize,
+    /// Simulated objects count only within this horizontal range of the sensor (m); the
+    /// default is the tracker's default cluster range.
+    #[arg(long, default_value_t = 40.0)]
+    max_range: f64,
+    /// OSPA/GOSPA cut-off c (m).
+    #[arg(long, default_value_t = 3.0)]
+    cutoff: f64,
+    /// OSPA/GOSPA order p.
+    #[arg(long, default_value_t = 1.0)]
+    order: f64,
+    /// Also predict every frame's walls to the next frame (ECT Monte Carlo, `--runs` runs) and
+    /// report the plane-prediction statistics (needs `--drive`).
+    #[arg(long)]
+    planes: bool,
+    /// Monte-Carlo runs of `--planes`.
+    #[arg(long, default_value_t = 10)]
+    runs: usize,
+    /// Print one JSON object.
+    #[arg(long)]
+    json: bool,
+}
+
+enum Truth {
+    Street(StreetTruth),
+    Tracklets(TruthFrames),
+}
+
+fn load_truth(args: &Args) -> Result<Truth> {
+    let street = |p: &Path| -> Result<Truth> {
+        Ok(Truth::Street(StreetTruth::read(p).with_context(|| {
+            format!("reading street truth {}", p.display())
+        })?))
+    };
+    let tracklets = |p: &Path| -> Result<Truth> {
+        let Some(dir) = &args.drive else {
+            bail!("--tracklets needs --drive for the poses of the frames");
+        };
+        let drive =
+            RawDrive::open(dir).with_context(|| format!("opening drive {}", dir.display()))?;
+        let poses = drive
+            .poses()
+            .with_context(|| format!("poses of drive {}", dir.display()))?;
+        let t = read_tracklets(p).with_context(|| format!("reading tracklets {}", p.display()))?;
+        Ok(Truth::Tracklets(tracklet_truth(&t, &poses)))
+    };
+    match (&args.truth, &args.tracklets, &args.drive) {
+        (Some(_), Some(_), _) => bail!("give --truth or --tracklets, not both"),
+        (Some(p), None, _) => street(p),
+        (None, Some(p), _) => tracklets(p),
+        (None, None, Some(dir)) => {
+            let (t, x) = (dir.join("truth.json"), dir.join("tracklet_labels.xml"));
+            if t.is_file() {
+                street(&t)
+            } else if x.is_file() {
+                tracklets(&x)
+            } else {
+                bail!(
+                    "{} holds neither truth.json nor tracklet_labels.xml; name the truth with \
+                     --truth or --tracklets",
+                    dir.display()
+                )
+            }
+        }
+        (None, None, None) => bail!("give --drive, --truth or --tracklets"),
+    }
+}
+
+fn plane_statistics(args: &Args) -> Result<Option<PlanePredictionSummary>> {
+    if !args.planes {
+        return Ok(None);
+    }
+    let Some(dir) = &args.drive else {
+        bail!("--planes needs --drive");
+    };
+    let drive = RawDrive::open(dir).with_context(|| format!("opening drive {}", dir.display()))?;
+    let mut rng = smc_lmb::rng::seeded(1);
+    let results = predict_drive_pairs(
+        &drive,
+        None,
+        &PlanePredictionConfig::default(),
+        args.runs,
+        &mut rng,
+    )
+    .with_context(|| format!("predicting planes of drive {}", dir.display()))?;
+    let pairs: Vec<PlanePairError> = results.iter().flat_map(|r| r.pairs.clone()).collect();
+    let timings: Vec<f64> = results
+        .iter()
+        .flat_map(|r| r.prediction_ms.iter().copied())
+        .collect();
+    Ok(Some(PlanePredictionSummary::from_pairs(&pairs, &timings)))
+}
+
+/// Runs the command.
+pub fn run(args: Args) -> Result<()> {
+    let tracks = DriveTracks::read_json(&args.tracks)
+        .with_context(|| format!("reading tracks {}", args.tracks.display()))?;
+    let truth = load_truth(&args)?;
+    let config = ClusterEvaluationConfig {
+        cutoff: args.cutoff,
+        order: args.order,
+    };
+    let (frames, walls): (TruthFrames, Option<WallEvaluation>) = match &truth {
+        Truth::Street(t) => (
+            street_object_truth(t, args.min_points, args.max_range),
+            Some(evaluate_walls(&tracks, t)?),
+        ),
+        Truth::Tracklets(f) => (f.clone(), None),
+    };
+    let clusters = evaluate_clusters(&tracks, &frames, &config)
+        .with_context(|| format!("scoring {}", args.tracks.display()))?;
+    let planes = plane_statistics(&args)?;
+    if args.json {
+        let out = serde_json::json!({
+            "tracks": args.tracks,
+            "clusters": clusters,
+            "walls": walls,
+            "plane_prediction": planes,
+        });
+        println!("{}", serde_json::to_string_pretty(&out)?);
+        return Ok(());
+    }
+    print_evaluation(&tracks, &clusters, walls.as_ref());
+    if let Some(s) = &planes {
+        println!(
+            "plane prediction ({} runs): {} pairs, normal angle median {:.3}° p90 {:.3}°, vertex \
+             distance median {:.3} m p90 {:.3} m, prediction {:.4} ms",
+            args.runs,
+            s.pairs,
+            s.median_normal_angle_deg,
+            s.p90_normal_angle_deg,
+            s.median_vertex_distance_m,
+            s.p90_vertex_distance_m,
+            s.mean_prediction_ms
+        );
+    }
+    Ok(())
+}
+
+/// Prints the cluster and wall scores.
+pub fn print_evaluation(
+    tracks: &DriveTracks,
+    clusters: &ClusterEvaluation,
+    walls: Option<&WallEvaluation>,
+) {
+    println!(
+        "cluster tracks of {} ({} frames), c = {} m, p = {}:",
+        tracks.drive,
+        clusters.frames.len(),
+        clusters.config.cutoff,
+        clusters.config.order
+    );
+    let mean = |f: &dyn Fn(&FrameScore) -> f64| {
+        clusters.frames.iter().map(f).sum::<f64>() / clusters.frames.len() as f64
+    };
+    println!(
+        "  mean OSPA {:.3} m, mean GOSPA {:.3} m; per frame {:.1} truth objects, {:.1} tracks, \
+         {:.1} missed, {:.1} false",
+        clusters.mean_ospa,
+        clusters.mean_gospa,
+        mean(&|f| f.truth as f64),
+        mean(&|f| f.estimates as f64),
+        mean(&|f| f.missed as f64),
+        mean(&|f| f.false_tracks as f64)
+    );
+    println!(
+        "  label switches {} over {} truth objects; every object kept one label: {}",
+        clusters.labels.switches,
+        clusters.labels.per_truth.len(),
+        clusters.labels.all_kept
+    );
+    if let Some(w) = walls {
+        println!(
+            "wall tracks: {} reports, {} within 2° and 0.5 m of a truth wall ({} walls); normal \
+             angle median {:.3}° p90 {:.3}°, offset median {:.3} m p90 {:.3} m",
+            w.reports,
+            w.matched,
+            w.walls_matched,
+            w.median_normal_angle_deg,
+            w.p90_normal_angle_deg,
+            w.median_offset_m,
+            w.p90_offset_m
+        );
+    }
+}
