@@ -46,10 +46,10 @@ fn score(tracker: &mut dyn PointTracker) -> RunMetrics {
     evaluate_run(tracker, &run, &detector, &eval).unwrap()
 }
 
-/// Bounds a little above what seed 1 gave when these trackers were written (true pose):
-/// mean OSPA / OSPA(2) / label switches of GNN 0.905 / 1.221 / 14, ML-RANSAC 0.752 / 0.935 / 8,
-/// JPDA-IMM 0.743 / 0.927 / 2, LMB 0.898 / 1.931 / 41. A tracker that loses people sits near
-/// the cut-off c = 2 m.
+/// Bounds a little above what seed 1 gives with the polar grouping of person returns (true
+/// pose): mean OSPA / OSPA(2) / label switches of GNN 0.854 / 1.382 / 5, ML-RANSAC
+/// 0.846 / 1.343 / 10, JPDA-IMM 0.828 / 1.288 / 6, LMB 0.907 / 1.727 / 16. A tracker that
+/// loses people sits near the cut-off c = 2 m.
 fn check(name: &str, m: &RunMetrics, max_ospa: f64, max_ospa2: f64, max_switches: usize) {
     eprintln!("{name}: {m:?}");
     assert_eq!(m.scans, 240);
@@ -66,7 +66,7 @@ fn check(name: &str, m: &RunMetrics, max_ospa: f64, max_ospa2: f64, max_switches
 fn gnn_tracks_scenario_one() {
     let (_, _, _, sensor) = setup();
     let m = score(&mut GnnTracker::new(GnnConfig::new(sensor)).unwrap());
-    check("gnn", &m, 1.0, 1.35, 25);
+    check("gnn", &m, 1.0, 1.5, 12);
     // a Gaussian tracker reports its innovations: RMS prediction error of a person at
     // σ_ρ = 0.2 m, σ_θ = 2° within a few metres
     let rms = m.rms_prediction_error().unwrap();
@@ -80,7 +80,7 @@ fn ml_ransac_tracks_scenario_one_and_repeats_itself() {
     cfg.seed = 7;
     let a = score(&mut MlRansacTracker::new(cfg.clone()).unwrap());
     let b = score(&mut MlRansacTracker::new(cfg).unwrap());
-    check("ml_ransac", &a, 0.85, 1.05, 15);
+    check("ml_ransac", &a, 0.95, 1.45, 18);
     assert_eq!(a.mean_ospa, b.mean_ospa);
     assert_eq!(a.nis, b.nis);
 }
@@ -89,7 +89,7 @@ fn ml_ransac_tracks_scenario_one_and_repeats_itself() {
 fn jpda_imm_tracks_scenario_one() {
     let (_, _, _, sensor) = setup();
     let m = score(&mut JpdaImmTracker::new(JpdaImmConfig::new(sensor)).unwrap());
-    check("jpda_imm", &m, 0.85, 1.05, 6);
+    check("jpda_imm", &m, 0.95, 1.4, 12);
     assert!(!m.nis.is_empty());
 }
 
@@ -99,7 +99,7 @@ fn lmb_behind_the_same_interface() {
     let mut cfg = detector.filter.clone();
     cfg.seed = 1;
     let m = score(&mut LmbTracker::new(cfg.build().unwrap(), seeded(1)));
-    check("lmb", &m, 1.0, 2.0, 60);
+    check("lmb", &m, 1.0, 1.85, 30);
     // the particle filter keeps no Gaussian innovations
     assert_eq!(m.innovations, 0);
 }
