@@ -1,0 +1,108 @@
+//! `kitti-tools demo` (simulate, predict planes, track, score) and `kitti-tools eval` on its
+//! output, end to end, and `eval` on broken inputs.
+
+use std::process::Command;
+
+fn run(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_kitti-tools"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
+}
+
+#[test]
+fn demo_runs_the_whole_pipeline_and_eval_scores_its_tracks() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().to_str().unwrap();
+    let (ok, out, err) = run(&[
+        "demo", "--dir", dir, "--frames", "8", "--runs", "2", "--quiet",
+    ]);
+    assert!(ok, "{err}");
+    for needle in [
+        "simulated street written",
+        "all frame pairs",
+        "confirmed per frame",
+        "mean OSPA",
+        "wall tracks",
+    ] {
+        assert!(out.contains(needle), "missing `{needle}` in\n{out}");
+    }
+    // A second run reuses the drive.
+    let (ok, out, err) = run(&[
+        "demo", "--dir", dir, "--frames", "8", "--runs", "2", "--quiet",
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("reusing the simulated street"), "{out}");
+
+    let root = tmp.path().join("seed1-frames8");
+    let drive = root.join("2020_01_01/2020_01_01_drive_0001_sync");
+    let tracks = root.join("tracks.json");
+    assert!(root.join("tracks.svg").is_file());
+    let (ok, out, err) = run(&[
+        "eval",
+        "--tracks",
+        tracks.to_str().unwrap(),
+        "--drive",
+        drive.to_str().unwrap(),
+        "--planes",
+        "--runs",
+        "2",
+        "--json",
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let ospa = v["clusters"]["mean_ospa"].as_f64().unwrap();
+    assert!((0.0..=3.0).contains(&ospa), "{ospa}");
+    assert_eq!(v["clusters"]["frames"].as_array().unwrap().len(), 8);
+    assert!(v["walls"]["matched"].as_u64().unwrap() > 0);
+    let angle = v["plane_prediction"]["median_normal_angle_deg"]
+        .as_f64()
+        .unwrap();
+    assert!(angle < 0.5, "{angle}");
+}
+
+#[test]
+fn eval_names_what_is_wrong() {
+    let tmp = tempfile::tempdir().unwrap();
+    let missing = tmp.path().join("nope.json");
+    let (ok, _, err) = run(&[
+        "eval",
+        "--tracks",
+        missing.to_str().unwrap(),
+        "--truth",
+        "x.json",
+    ]);
+    assert!(!ok);
+    assert!(err.contains("nope.json"), "{err}");
+
+    let bad = tmp.path().join("bad.json");
+    std::fs::write(&bad, "{\"drive\": 3}").unwrap();
+    let (ok, _, err) = run(&[
+        "eval",
+        "--tracks",
+        bad.to_str().unwrap(),
+        "--truth",
+        "x.json",
+    ]);
+    assert!(!ok);
+    assert!(err.contains("bad.json"), "{err}");
+
+    let (ok, _, err) = run(&["eval", "--tracks", bad.to_str().unwrap()]);
+    assert!(!ok);
+    assert!(err.contains("bad.json") || err.contains("--drive"), "{err}");
+
+    let (ok, _, err) = run(&[
+        "demo",
+        "--frames",
+        "1",
+        "--dir",
+        tmp.path().to_str().unwrap(),
+    ]);
+    assert!(!ok);
+    assert!(err.contains("--frames"), "{err}");
+}
