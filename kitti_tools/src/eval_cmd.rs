@@ -56,15 +56,15 @@ pub struct Args {
 }
 
 enum Truth {
-    Street(StreetTruth),
+    Street(Box<StreetTruth>),
     Tracklets(TruthFrames),
 }
 
 fn load_truth(args: &Args) -> Result<Truth> {
     let street = |p: &Path| -> Result<Truth> {
-        Ok(Truth::Street(StreetTruth::read(p).with_context(|| {
-            format!("reading street truth {}", p.display())
-        })?))
+        Ok(Truth::Street(Box::new(StreetTruth::read(p).with_context(
+            || format!("reading street truth {}", p.display()),
+        )?)))
     };
     let tracklets = |p: &Path| -> Result<Truth> {
         let Some(dir) = &args.drive else {
