@@ -24,13 +24,12 @@ use clap::Parser;
 use smc_lmb::laser2d::evaluate::{
     evaluate_run, summarise, EvalConfig, PoseSource, RunMetrics, Summary,
 };
-use smc_lmb::laser2d::PeopleTrackerConfig;
+use smc_lmb::laser2d::{PeopleTracker, PeopleTrackerConfig};
 use smc_lmb::models::RangeBearing;
-use smc_lmb::rng::seeded;
 use smc_lmb::sim::PeopleScenario;
 use smc_lmb::trackers::{
-    GnnConfig, GnnTracker, JpdaImmConfig, JpdaImmTracker, LmbTracker, MlRansacConfig,
-    MlRansacTracker, PointTracker,
+    GnnConfig, GnnTracker, JpdaImmConfig, JpdaImmTracker, MlRansacConfig, MlRansacTracker,
+    PointTracker,
 };
 
 #[derive(Parser, Debug)]
@@ -169,10 +168,7 @@ fn build_tracker(
 ) -> Result<Box<dyn PointTracker>> {
     let sensor = sensor_model(scenario)?;
     Ok(match name {
-        "lmb" => {
-            let cfg = detector_config(scenario, seed);
-            Box::new(LmbTracker::new(cfg.filter.build()?, seeded(seed)))
-        }
+        "lmb" => Box::new(PeopleTracker::new(detector_config(scenario, seed))?),
         "gnn" => Box::new(GnnTracker::new(GnnConfig::new(sensor))?),
         "ml_ransac" => {
             let mut cfg = MlRansacConfig::new(sensor);

@@ -116,6 +116,7 @@ pub fn evaluate_run(
         let ctx = clock.tick(scan.time, pose)?;
         let t0 = Instant::now();
         let z = person_measurements(detector, scan)?;
+        tracker.observe_scan(scan);
         let est = tracker.step(&z, &ctx)?;
         seconds += t0.elapsed().as_secs_f64();
         for inn in tracker.innovations() {

@@ -280,8 +280,13 @@ impl PeopleTracker {
     /// none).
     pub fn step(&mut self, scan: &Scan) -> Result<Vec<Estimate>> {
         let people = self.step_people(scan)?;
+        Ok(self.visible(people))
+    }
+
+    /// The people whose visibility reaches `min_visibility`, as filter estimates.
+    fn visible(&self, people: Vec<PersonEstimate>) -> Vec<Estimate> {
         let min = self.config.min_visibility;
-        Ok(people
+        people
             .into_iter()
             .filter(|p| p.visibility >= min)
             .map(|p| Estimate {
@@ -290,7 +295,7 @@ impl PeopleTracker {
                 state: vec![p.position[0], p.velocity[0], p.position[1], p.velocity[1]],
                 age: p.age,
             })
-            .collect())
+            .collect()
     }
 
     /// One scan, with every person of the filter's MAP estimate (visible or not), their
@@ -300,11 +305,27 @@ impl PeopleTracker {
         let platform = scan
             .odometry
             .map(|p| Isometry3::new(Vector3::new(p.x, p.y, 0.0), Vector3::new(0.0, 0.0, p.theta)));
+        self.observe(scan);
+        self.step_measured(measurements, scan.time, platform)
+    }
+
+    /// Hands the scan's ranges to the occlusion-aware detection model for the next step.
+    pub fn observe(&mut self, scan: &Scan) {
         self.detection.update_view(
             scan.angle_min,
             scan.angle_increment,
             (0..scan.len()).map(|i| scan.range(i).unwrap_or(f64::INFINITY)),
         );
+    }
+
+    /// One step on measurements made elsewhere (range-bearing rows of the people's centres),
+    /// after [`PeopleTracker::observe`] has seen the scan they come from.
+    pub fn step_measured(
+        &mut self,
+        measurements: Measurements,
+        time: f64,
+        platform: Option<Isometry3<f64>>,
+    ) -> Result<Vec<PersonEstimate>> {
         self.birth
             .set_confirmed(self.filter.tracks().iter().map(|t| {
                 let p = &t.particles;
@@ -318,13 +339,13 @@ impl PeopleTracker {
             }));
         let estimates = self.filter.step(
             &Frame {
-                time: scan.time,
+                time,
                 measurements,
                 platform,
             },
             &mut self.rng,
         )?;
-        let mut ctx = StepContext::new(self.filter.steps(), scan.time, 0.0);
+        let mut ctx = StepContext::new(self.filter.steps(), time, 0.0);
         ctx.platform = platform;
         let p_max = self.detection.field_of_view().p_inside();
         let tracks = self.filter.tracks();
@@ -361,6 +382,23 @@ impl PeopleTracker {
     /// The underlying filter.
     pub fn filter(&self) -> &LmbFilter {
         &self.filter
+    }
+}
+
+/// The people tracker behind the common tracker interface, so that it runs on exactly the
+/// measurements the baselines get ([`crate::laser2d::evaluate`]).
+impl crate::trackers::PointTracker for PeopleTracker {
+    fn name(&self) -> &str {
+        "lmb"
+    }
+
+    fn observe_scan(&mut self, scan: &Scan) {
+        self.observe(scan);
+    }
+
+    fn step(&mut self, z: &Measurements, ctx: &StepContext) -> Result<Vec<Estimate>> {
+        let people = self.step_measured(z.clone(), ctx.time, ctx.platform)?;
+        Ok(self.visible(people))
     }
 }
 

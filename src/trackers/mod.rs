@@ -63,6 +63,13 @@ pub trait PointTracker {
     /// and the platform pose. Returns the confirmed tracks.
     fn step(&mut self, z: &Measurements, ctx: &StepContext) -> Result<Vec<Estimate>>;
 
+    /// Sees the scan the next step's measurements come from, before [`PointTracker::step`]
+    /// (trackers whose detection model looks at the scan, e.g. for occlusions, keep what they
+    /// need; the default ignores it).
+    fn observe_scan(&mut self, scan: &crate::laser2d::Scan) {
+        let _ = scan;
+    }
+
     /// Innovations of the tracks updated in the last step (empty when the tracker does not
     /// keep Gaussian track densities).
     fn innovations(&self) -> &[Innovation] {
