@@ -7,7 +7,6 @@
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use smc_lmb::kitti::RawDrive;
-use smc_lmb::metrics::{PlanePairError, PlanePredictionSummary};
 use smc_lmb::pipeline::drive_evaluation::{
     evaluate_clusters, evaluate_walls, street_object_truth, ClusterEvaluationConfig,
 };
@@ -92,14 +91,9 @@ pub fn run(args: Args) -> Result<()> {
         &mut rng,
     )?;
     crate::planes_cmd::print_pairs(&results[..1]);
-    let pairs: Vec<PlanePairError> = results.iter().flat_map(|r| r.pairs.clone()).collect();
-    let timings: Vec<f64> = results
-        .iter()
-        .flat_map(|r| r.prediction_ms.iter().copied())
-        .collect();
     print!("all frame pairs: ");
     crate::planes_cmd::print_summary(
-        &PlanePredictionSummary::from_pairs(&pairs, &timings),
+        &crate::planes_cmd::pairs_and_summary(&results).1,
         results.len(),
     );
 

@@ -5,7 +5,7 @@
 
 use anyhow::{bail, Context, Result};
 use smc_lmb::kitti::{read_tracklets, RawDrive};
-use smc_lmb::metrics::{PlanePairError, PlanePredictionSummary};
+use smc_lmb::metrics::PlanePredictionSummary;
 use smc_lmb::pipeline::drive_evaluation::{
     evaluate_clusters, evaluate_walls, street_object_truth, tracklet_truth, ClusterEvaluation,
     ClusterEvaluationConfig, FrameScore, TruthFrames, WallEvaluation,
@@ -117,12 +117,7 @@ fn plane_statistics(args: &Args) -> Result<Option<PlanePredictionSummary>> {
         &mut rng,
     )
     .with_context(|| format!("predicting planes of drive {}", dir.display()))?;
-    let pairs: Vec<PlanePairError> = results.iter().flat_map(|r| r.pairs.clone()).collect();
-    let timings: Vec<f64> = results
-        .iter()
-        .flat_map(|r| r.prediction_ms.iter().copied())
-        .collect();
-    Ok(Some(PlanePredictionSummary::from_pairs(&pairs, &timings)))
+    Ok(Some(crate::planes_cmd::pairs_and_summary(&results).1))
 }
 
 /// Runs the command.

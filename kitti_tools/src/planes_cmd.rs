@@ -82,12 +82,7 @@ pub fn run(args: Args) -> Result<()> {
         }
         (None, None) => bail!("give --drive DIR or --odometry ROOT --sequence NN"),
     };
-    let pairs: Vec<PlanePairError> = results.iter().flat_map(|r| r.pairs.clone()).collect();
-    let timings: Vec<f64> = results
-        .iter()
-        .flat_map(|r| r.prediction_ms.iter().copied())
-        .collect();
-    let summary = PlanePredictionSummary::from_pairs(&pairs, &timings);
+    let (pairs, summary) = pairs_and_summary(&results);
     if args.json {
         let out = serde_json::json!({
             "pairs": pairs,
@@ -163,4 +158,17 @@ pub fn print_summary(summary: &PlanePredictionSummary, frame_pairs: usize) {
         summary.p90_vertex_distance_m,
         summary.mean_prediction_ms
     );
+}
+
+/// Every associated wall pair of `results` and their distribution.
+pub fn pairs_and_summary(
+    results: &[PairPrediction],
+) -> (Vec<PlanePairError>, PlanePredictionSummary) {
+    let pairs: Vec<PlanePairError> = results.iter().flat_map(|r| r.pairs.clone()).collect();
+    let timings: Vec<f64> = results
+        .iter()
+        .flat_map(|r| r.prediction_ms.iter().copied())
+        .collect();
+    let summary = PlanePredictionSummary::from_pairs(&pairs, &timings);
+    (pairs, summary)
 }

@@ -1,19 +1,8 @@
 //! `kitti-tools demo` (simulate, predict planes, track, score) and `kitti-tools eval` on its
 //! output, end to end, and `eval` on broken inputs.
 
-use std::process::Command;
-
-fn run(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_kitti-tools"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
-}
+mod common;
+use common::run;
 
 #[test]
 fn demo_runs_the_whole_pipeline_and_eval_scores_its_tracks() {

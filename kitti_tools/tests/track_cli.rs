@@ -2,19 +2,8 @@
 //! frame (a static sensor without OXTS), and on broken inputs.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn run(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_kitti-tools"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
-}
+mod common;
+use common::run;
 
 fn static_drive(root: &Path, copies: usize) -> PathBuf {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join(
