@@ -1,14 +1,13 @@
 //! Plane prediction on a synthetic street: a ground plane and two building walls seen from a
 //! vehicle before and after it drives 1 m forward while turning by 2°.
 
+mod common;
+
 use nalgebra::{Isometry3, Point3};
-use rand::RngExt;
-use rand_distr::{Distribution, Normal};
-use smc_lmb::cloud::PointCloud;
 use smc_lmb::metrics::{PlanePairError, PlanePredictionSummary};
 use smc_lmb::models::ExtendedConstantTurn;
 use smc_lmb::pipeline::{predict_planes_between, PairPrediction, PlanePredictionConfig};
-use smc_lmb::rng::{seeded, FilterRng};
+use smc_lmb::rng::seeded;
 
 const SPACING: f64 = 0.1;
 const DT: f64 = 0.1;
@@ -48,24 +47,6 @@ fn street() -> Vec<Point3<f64>> {
     pts
 }
 
-/// The street seen from a sensor at `pose` (sensor → world), with 1 cm Gaussian noise.
-fn scan(world: &[Point3<f64>], pose: &Isometry3<f64>, rng: &mut FilterRng) -> PointCloud {
-    let noise = Normal::new(0.0, 0.01).unwrap();
-    let inv = pose.inverse();
-    let mut cloud = PointCloud::with_capacity(world.len());
-    for p in world {
-        let q = inv * p;
-        let i: f32 = rng.random_range(0.0..1.0);
-        cloud.push(
-            (q.x + noise.sample(rng)) as f32,
-            (q.y + noise.sample(rng)) as f32,
-            (q.z + noise.sample(rng)) as f32,
-            i,
-        );
-    }
-    cloud
-}
-
 /// Vehicle state at k (10 m/s along x, turning 2° per 0.1 s) and the two sensor poses.
 fn scene() -> ([f64; 6], Isometry3<f64>, Isometry3<f64>) {
     let omega = 2f64.to_radians() / DT;
@@ -103,8 +84,8 @@ fn measured_motion_predicts_both_walls() {
     let world = street();
     let (_, pose_k, pose_k1) = scene();
     let mut rng = seeded(11);
-    let cloud_k = scan(&world, &pose_k, &mut rng);
-    let cloud_k1 = scan(&world, &pose_k1, &mut rng);
+    let cloud_k = common::scan(&world, &pose_k, 0.01, &mut rng);
+    let cloud_k1 = common::scan(&world, &pose_k1, 0.01, &mut rng);
     let config = PlanePredictionConfig::default();
     let result = predict_planes_between(
         0, &cloud_k, &cloud_k1, &pose_k, &pose_k1, None, &config, 5, &mut rng,
@@ -119,8 +100,8 @@ fn monte_carlo_vehicle_model_predicts_both_walls() {
     let world = street();
     let (state, pose_k, pose_k1) = scene();
     let mut rng = seeded(12);
-    let cloud_k = scan(&world, &pose_k, &mut rng);
-    let cloud_k1 = scan(&world, &pose_k1, &mut rng);
+    let cloud_k = common::scan(&world, &pose_k, 0.01, &mut rng);
+    let cloud_k1 = common::scan(&world, &pose_k1, 0.01, &mut rng);
     let config = PlanePredictionConfig {
         dt: DT,
         ..PlanePredictionConfig::default()
@@ -180,63 +161,9 @@ fn pair_errors_serialise_with_the_reported_keys() {
 /// Writes the two-frame street as a KITTI raw drive (OXTS from the vehicle states of
 /// [`scene`], Velodyne clouds seen from the resulting Velodyne poses) and returns its folder.
 fn write_drive(root: &std::path::Path) -> std::path::PathBuf {
-    use smc_lmb::cloud::write_kitti_bin;
-    use smc_lmb::kitti::poses::Mercator;
-    use smc_lmb::kitti::{
-        frame_file_name, write_oxts_dir, write_timestamps, OxtsPacket, RawDrive, Timestamp,
-    };
-    let day = root.join("2011_09_26");
-    let dir = day.join("2011_09_26_drive_0042_sync");
-    std::fs::create_dir_all(dir.join("oxts/data")).unwrap();
-    let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/kitti/2011_09_26");
-    for name in [
-        "calib_imu_to_velo.txt",
-        "calib_velo_to_cam.txt",
-        "calib_cam_to_cam.txt",
-    ] {
-        std::fs::copy(src.join(name), day.join(name)).unwrap();
-    }
     let (state, _, _) = scene();
     let states = [state, ExtendedConstantTurn::step_noiseless(&state, DT)];
-    let merc = Mercator::from_reference_latitude(49.0).unwrap();
-    let (x0, y0) = merc.project(49.0, 8.4);
-    let packets: Vec<OxtsPacket> = states
-        .iter()
-        .map(|s| {
-            let (lat, lon) = merc.unproject(x0 + s[0], y0 + s[2]);
-            OxtsPacket {
-                lat,
-                lon,
-                alt: 110.0,
-                yaw: s[4],
-                ve: s[1],
-                vn: s[3],
-                vf: 10.0,
-                wu: s[5],
-                wz: s[5],
-                ..Default::default()
-            }
-        })
-        .collect();
-    write_oxts_dir(dir.join("oxts/data"), &packets).unwrap();
-    let t0 = Timestamp::parse("2011-09-26 13:02:25.964389445").unwrap();
-    let stamps = [t0, t0.plus_seconds(DT).unwrap()];
-    write_timestamps(dir.join("oxts/timestamps.txt"), &stamps).unwrap();
-    // Velodyne poses from the OXTS just written (no Velodyne folder yet).
-    let poses = RawDrive::open(&dir).unwrap().poses().unwrap();
-    std::fs::create_dir_all(dir.join("velodyne_points/data")).unwrap();
-    write_timestamps(dir.join("velodyne_points/timestamps.txt"), &stamps).unwrap();
-    let world = street();
-    let mut rng = seeded(21);
-    for (k, pose) in poses.iter().enumerate() {
-        write_kitti_bin(
-            dir.join("velodyne_points/data")
-                .join(frame_file_name(k as u64, "bin")),
-            &scan(&world, pose, &mut rng),
-        )
-        .unwrap();
-    }
-    dir
+    common::write_drive(root, 42, &states, DT, |_| street())
 }
 
 #[test]
