@@ -10,24 +10,20 @@
 //! * `frame/planes`: ground and wall segmentation (`extract_planes`, default configuration);
 //! * `frame/clusters`: Euclidean clustering of the points left after plane removal;
 //! * `frame/read_planes_clusters`: the three in a row, as a frame is processed;
-//! * `frame/filter_update`: reserved for the tracking filter's update on the frame's planes
-//!   and clusters, once that pipeline exists (see `filter_update` below);
-//! * `frame/standin_lmb_step_40x1000`: a STAND-IN for that update — one `LmbFilter` step
-//!   with 40 tracks × 1000 particles of the 3-D constant-velocity model and a 3-D position
-//!   measurement, one detection per track; it is not the plane/cluster tracking filter.
+//! * `frame/filter_update`: one step of the drive tracker (walls and clusters as labelled
+//!   objects of one LMB filter, 1000 particles per track) on this frame's detections, after a
+//!   warm-up on the same detections that confirms them (a static sensor);
+//! * `frame/whole`: read, detect (planes and clusters as the drive tracker selects them) and
+//!   the filter update in a row.
 
-use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use nalgebra::Isometry3;
 use smc_lmb::cloud::planes::{extract_planes, PlaneConfig};
-use smc_lmb::cloud::{euclidean_clusters_of, read_kitti_bin, ClusterParams};
-use smc_lmb::filter::birth::BirthEvidence;
-use smc_lmb::filter::{
-    BirthModel, BirthTerm, BirthTrack, Frame, LmbConfig, LmbFilter, Measurements, StaticBirth,
-};
-use smc_lmb::models::{
-    ConstantDetection, ConstantVelocity, PositionMeasurement, StepContext, UniformClutter,
+use smc_lmb::cloud::{euclidean_clusters_of, read_kitti_bin, ClusterParams, PointCloud};
+use smc_lmb::pipeline::drive_tracking::{
+    detect_objects, DriveTracker, FrameDetections, TrackingConfig,
 };
 use smc_lmb::rng::seeded;
-use smc_lmb::FilterRng;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -79,79 +75,43 @@ fn frame(c: &mut Criterion) {
             euclidean_clusters_of(&cloud, &seg.remaining, &clusters).unwrap()
         })
     });
-    filter_update(&mut g);
-    standin_lmb_step(&mut g);
+    filter_update(&mut g, &path, &cloud);
     g.finish();
 }
 
-/// Place for the tracking filter's update on one frame (~10 plane and ~30 cluster tracks at
-/// 1000 particles each) once the tracking pipeline exists; add it to the group here and to
-/// `read_planes_clusters` so the whole frame is timed together.
-fn filter_update(_g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>) {}
-
-/// Births only at the first step: the tracks under test, and nothing new afterwards.
-struct FirstStepOnly(StaticBirth);
-
-impl BirthModel for FirstStepOnly {
-    fn birth(
-        &self,
-        ctx: &StepContext,
-        ev: Option<&BirthEvidence<'_>>,
-        rng: &mut FilterRng,
-    ) -> Vec<BirthTrack> {
-        if ctx.step == 0 {
-            self.0.birth(ctx, ev, rng)
-        } else {
-            Vec::new()
-        }
-    }
-}
-
-/// Stand-in for the tracking update: a 3-D CV filter with `targets` tracks of `particles`
-/// particles each (objects 10 m apart), and the frame of the next step.
-fn standin_filter(targets: usize, particles: usize) -> (LmbFilter, Frame) {
-    let positions: Vec<[f64; 3]> = (0..targets)
-        .map(|i| [10.0 * (i % 8) as f64, 10.0 * (i / 8) as f64, 0.5])
-        .collect();
-    let terms = positions
-        .iter()
-        .map(|p| BirthTerm {
-            existence: 0.9,
-            mean: vec![p[0], 1.0, p[1], 0.0, p[2], 0.0],
-            std: vec![0.5, 0.5, 0.5, 0.5, 0.2, 0.1],
-        })
-        .collect();
-    let mut filter = LmbFilter::builder()
-        .transition(ConstantVelocity::new(3, 1.0).unwrap())
-        .measurement(PositionMeasurement::new(3, 0.3).unwrap())
-        .detection(ConstantDetection(0.9))
-        .clutter(UniformClutter::new(5.0, 200.0 * 200.0 * 6.0).unwrap())
-        .birth(FirstStepOnly(StaticBirth::new(terms, particles).unwrap()))
-        .config(LmbConfig {
-            particles,
-            ..LmbConfig::default()
-        })
-        .build()
-        .unwrap();
-    let measure = |k: usize| {
-        let z: Vec<[f64; 3]> = positions
-            .iter()
-            .map(|p| [p[0] + 0.1 * k as f64, p[1], p[2]])
-            .collect();
-        Frame::new(0.1 * k as f64, Measurements::from_rows(3, &z).unwrap())
+/// The drive tracker's filter step on this frame's walls and clusters, and the whole frame.
+fn filter_update(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    path: &Path,
+    cloud: &PointCloud,
+) {
+    let config = TrackingConfig::default();
+    let det = detect_objects(cloud, &config, &mut seeded(1)).expect("detections");
+    println!(
+        "tracked objects: {} walls, {} clusters",
+        det.walls.len(),
+        det.clusters.len()
+    );
+    let mut tracker = DriveTracker::new(&config, 1).expect("default config is valid");
+    let pose = Isometry3::identity();
+    let mut k = 0usize;
+    let mut step = |tracker: &mut DriveTracker, det: &FrameDetections| {
+        let f = tracker
+            .step(k, k as f64 * 0.1, pose, None, det)
+            .expect("step");
+        k += 1;
+        f
     };
-    filter.step(&measure(0), &mut seeded(1)).unwrap();
-    (filter, measure(1))
-}
-
-fn standin_lmb_step(g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>) {
-    g.throughput(Throughput::Elements(40 * 1000));
-    g.bench_function("standin_lmb_step_40x1000", |b| {
-        b.iter_batched(
-            || standin_filter(40, 1000),
-            |(mut f, z)| f.step(&z, &mut seeded(2)).unwrap(),
-            BatchSize::LargeInput,
-        )
+    for _ in 0..5 {
+        step(&mut tracker, &det);
+    }
+    g.bench_function("filter_update", |b| b.iter(|| step(&mut tracker, &det)));
+    g.bench_function("whole", |b| {
+        b.iter(|| {
+            let cloud = read_kitti_bin(path).unwrap();
+            let det = detect_objects(&cloud, &config, &mut seeded(1)).unwrap();
+            step(&mut tracker, &det)
+        })
     });
 }
 
