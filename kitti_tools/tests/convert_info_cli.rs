@@ -3,7 +3,9 @@
 
 use smc_lmb::cloud::{read_kitti_bin, read_ply, write_ply_labelled, PointCloud};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+use common::{ok, output as run};
+use std::process::Output;
 
 fn data(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -15,13 +17,6 @@ fn frame() -> PathBuf {
     data("2011_09_26_drive_UNKNOWN_sync/velodyne_points/data/0000000000.bin")
 }
 
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_kitti-tools"))
-        .args(args)
-        .output()
-        .expect("run kitti-tools")
-}
-
 fn convert(input: &Path, output: &Path) -> Output {
     run(&[
         "convert",
@@ -30,16 +25,6 @@ fn convert(input: &Path, output: &Path) -> Output {
         "--output",
         output.to_str().unwrap(),
     ])
-}
-
-fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "stdout: {}\nstderr: {}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
 fn max_abs_diff(a: &PointCloud, b: &PointCloud) -> f32 {

@@ -1,24 +1,8 @@
 //! `kitti-tools synth` through the built binary: a small drive that `info` then reads without
 //! issues, a configuration file, and refused arguments.
 
-use std::process::{Command, Output};
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_kitti-tools"))
-        .args(args)
-        .output()
-        .expect("run kitti-tools")
-}
-
-fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "stdout: {}\nstderr: {}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
+mod common;
+use common::{ok, output as run};
 
 #[test]
 fn synth_then_info() {
