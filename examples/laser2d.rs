@@ -4,7 +4,7 @@
 //!
 //! ```text
 //! cargo run --release --example laser2d -- --scenario one --runs 10 --seed 1 [--json]
-//!     [--trackers lmb,gnn,ml_ransac,jpda_imm] [--pose odometry|truth]
+//!     [--trackers lmb,gnn,ml_ransac,jpda_imm] [--pose odometry|truth] [--frame robot|world]
 //! cargo run --release --example laser2d -- --carmen intel.clf.bz2 --out people.json --plot tracks.svg
 //! cargo run --release --example laser2d -- --bag demo.bag --topic /scan --out people.json --plot tracks.png
 //! ```
@@ -22,7 +22,7 @@
 use anyhow::{Context, Result};
 use clap::Parser;
 use smc_lmb::laser2d::evaluate::{
-    evaluate_run, summarise, EvalConfig, PoseSource, RunMetrics, Summary,
+    evaluate_run, summarise, EvalConfig, PoseSource, RunMetrics, ScoreFrame, Summary,
 };
 use smc_lmb::laser2d::{PeopleTracker, PeopleTrackerConfig};
 use smc_lmb::models::RangeBearing;
@@ -48,6 +48,10 @@ struct Args {
     /// `truth` (the simulator's pose, to judge the trackers apart from localisation).
     #[arg(long, default_value = "odometry")]
     pose: String,
+    /// Scoring frame: `robot` (truth relative to the robot, placed with the pose the trackers
+    /// got — scores tracking apart from odometry drift) or `world` (drift counts as error).
+    #[arg(long, default_value = "robot")]
+    frame: String,
     /// Comma-separated trackers to run.
     #[arg(long, default_value = "lmb,gnn,ml_ransac,jpda_imm")]
     trackers: String,
@@ -101,6 +105,11 @@ fn run_simulated(args: &Args) -> Result<()> {
             "odometry" => PoseSource::Odometry,
             "truth" => PoseSource::Truth,
             other => anyhow::bail!("--pose {other}: expected odometry or truth"),
+        },
+        frame: match args.frame.as_str() {
+            "robot" => ScoreFrame::Robot,
+            "world" => ScoreFrame::World,
+            other => anyhow::bail!("--frame {other}: expected robot or world"),
         },
         ..EvalConfig::default()
     };
@@ -189,7 +198,7 @@ fn build_tracker(
 
 fn print_json(args: &Args, names: &[&str], summaries: &[Summary]) -> Result<()> {
     let mut out = serde_json::json!({
-        "scenario": args.scenario, "runs": args.runs, "seed": args.seed, "pose": args.pose,
+        "scenario": args.scenario, "runs": args.runs, "seed": args.seed, "pose": args.pose, "frame": args.frame,
     });
     for (name, s) in names.iter().zip(summaries) {
         out[*name] = serde_json::to_value(s)?;
@@ -201,11 +210,12 @@ fn print_json(args: &Args, names: &[&str], summaries: &[Summary]) -> Result<()> 
 fn print_table(args: &Args, names: &[&str], summaries: &[Summary]) {
     let scans = |s: &Summary| s.runs;
     println!(
-        "scenario {}, {} run(s) from seed {}, pose {}; OSPA and OSPA(2) with c = 2 m, p = 1",
+        "scenario {}, {} run(s) from seed {}, pose {}, {} frame; OSPA and OSPA(2) with c = 2 m, p = 1",
         args.scenario,
         summaries.first().map_or(0, scans),
         args.seed,
-        args.pose
+        args.pose,
+        args.frame
     );
     println!(
         "{:<10} {:>8} {:>8} {:>9} {:>10} {:>9} {:>8} {:>22}",
