@@ -552,19 +552,21 @@ impl PeopleScenario {
     /// Chosen here (the paper gives no positions): 30 s; the robot starts at the origin
     /// facing +x and drives 4 s at 0.5 m/s, 6 s at 1 m/s, 5 s at 2 m/s turning left at
     /// 0.1 rad/s, 5 s at 1 m/s turning right at 0.1 rad/s and 10 s at 0.5 m/s. People 1–5
-    /// (radius 0.2 m) start at (12.25, −1.75), (13.625, 8), (24.1, 20.5), (27.75, 22.6) and
-    /// (33.25, 0.5), so that all five pass within about 1.5 m of (22, 8.5) between 14 s and
-    /// 17 s, roughly 6–8 m ahead of the robot, where they hide one another; people 3–5 start
-    /// out of range and walk in, person 5 later leaves the field of view behind the robot.
-    /// Mount offset (0.2, 0) m; default odometry noise.
+    /// (radius 0.2 m) start at (9.9, −4.1), (13.4, 8), (24.15, 20.9), (28.1, 23.8) and
+    /// (31.75, 1.7): seven of the ten pairs pass within 2 m of each other between 13 s and
+    /// 20 s, 2–8 m ahead of the robot where they hide one another, but no two come closer
+    /// than 0.9 m centre to centre (people pass, they do not walk through each other) and
+    /// nobody comes within 1.5 m of the robot; people 3–5 start out of range and walk in,
+    /// person 5 later leaves the field of view. Mount offset (0.2, 0) m; default odometry
+    /// noise.
     pub fn one() -> Self {
         let duration = 30.0;
         let people = vec![
-            walker(1, [12.25, -1.75], [0.625, 0.625], duration),
-            walker(2, [13.625, 8.0], [0.625, 0.0], duration),
-            walker(3, [24.1, 20.5], [-0.1, -0.75], duration),
-            walker(4, [27.75, 22.6], [-0.25, -0.8], duration),
-            walker(5, [33.25, 0.5], [-0.75, 0.6], duration),
+            walker(1, [9.9, -4.1], [0.625, 0.625], duration),
+            walker(2, [13.4, 8.0], [0.625, 0.0], duration),
+            walker(3, [24.15, 20.9], [-0.1, -0.75], duration),
+            walker(4, [28.1, 23.8], [-0.25, -0.8], duration),
+            walker(5, [31.75, 1.7], [-0.75, 0.6], duration),
         ];
         PeopleScenario {
             name: "people2d-one".into(),

@@ -140,6 +140,24 @@ fn scenario_one_truth_follows_the_velocity_table() {
 }
 
 #[test]
+fn scenario_one_people_pass_each_other_closely_but_never_collide() {
+    let run = PeopleScenario::one().generate(0).unwrap();
+    let mut close_pairs = std::collections::BTreeSet::new();
+    for people in &run.people_truth {
+        for (i, (a, pa, _)) in people.iter().enumerate() {
+            for (b, pb, _) in &people[i + 1..] {
+                let d = (pa[0] - pb[0]).hypot(pa[1] - pb[1]);
+                assert!(d > 0.8, "people {a} and {b} are {d:.2} m apart");
+                if d < 2.0 {
+                    close_pairs.insert((*a, *b));
+                }
+            }
+        }
+    }
+    assert!(close_pairs.len() >= 7, "{close_pairs:?}");
+}
+
+#[test]
 fn scenario_one_has_crossings_and_occlusions() {
     let sc = PeopleScenario::one();
     let run = sc.generate(11).unwrap();
