@@ -24,7 +24,7 @@ use clap::Parser;
 use smc_lmb::laser2d::evaluate::{
     evaluate_run, summarise, EvalConfig, PoseSource, RunMetrics, ScoreFrame, Summary,
 };
-use smc_lmb::laser2d::{PeopleTracker, PeopleTrackerConfig};
+use smc_lmb::laser2d::{centre_noise, PeopleTracker, PeopleTrackerConfig};
 use smc_lmb::models::RangeBearing;
 use smc_lmb::sim::PeopleScenario;
 use smc_lmb::trackers::{
@@ -52,6 +52,10 @@ struct Args {
     /// got — scores tracking apart from odometry drift) or `world` (drift counts as error).
     #[arg(long, default_value = "robot")]
     frame: String,
+    /// Score estimates of people who are present but unseen (hidden, too far, out of view) as
+    /// false instead of ignoring them.
+    #[arg(long)]
+    score_unseen: bool,
     /// Comma-separated trackers to run.
     #[arg(long, default_value = "lmb,gnn,ml_ransac,jpda_imm")]
     trackers: String,
@@ -111,6 +115,7 @@ fn run_simulated(args: &Args) -> Result<()> {
             "world" => ScoreFrame::World,
             other => anyhow::bail!("--frame {other}: expected robot or world"),
         },
+        ignore_unseen: !args.score_unseen,
         ..EvalConfig::default()
     };
     let names: Vec<&str> = args.trackers.split(',').map(str::trim).collect();
@@ -160,14 +165,12 @@ fn detector_config(scenario: &PeopleScenario, seed: u64) -> PeopleTrackerConfig 
     cfg
 }
 
-/// The range-bearing sensor every baseline assumes: the scanner's noise (floored as the LMB
-/// floors it) and its mounting offset.
+/// The range-bearing sensor every baseline assumes: the noise of a person's measured centre,
+/// as the LMB assumes it, and the scanner's mounting offset.
 fn sensor_model(scenario: &PeopleScenario) -> Result<RangeBearing> {
     let s = &scenario.scanner;
-    Ok(
-        RangeBearing::new(s.sigma_range.max(0.05), s.sigma_bearing.max(0.005))?
-            .with_offset(scenario.mount[0], scenario.mount[1])?,
-    )
+    let (sr, sb) = centre_noise(s.sigma_range, s.sigma_bearing);
+    Ok(RangeBearing::new(sr, sb)?.with_offset(scenario.mount[0], scenario.mount[1])?)
 }
 
 fn build_tracker(
