@@ -46,10 +46,8 @@ fn score(tracker: &mut dyn PointTracker) -> RunMetrics {
     evaluate_run(tracker, &run, &detector, &eval).unwrap()
 }
 
-/// Bounds a little above what seed 1 gives with the polar grouping of person returns (true
-/// pose): mean OSPA / OSPA(2) / label switches of GNN 0.854 / 1.382 / 5, ML-RANSAC
-/// 0.846 / 1.343 / 10, JPDA-IMM 0.828 / 1.288 / 6, LMB 0.907 / 1.727 / 16. A tracker that
-/// loses people sits near the cut-off c = 2 m.
+/// Upper bounds on mean OSPA, OSPA(2) and label switches for seed 1 (true pose), well above
+/// what the trackers give: a tracker that loses people sits near the cut-off c = 2 m.
 fn check(name: &str, m: &RunMetrics, max_ospa: f64, max_ospa2: f64, max_switches: usize) {
     eprintln!("{name}: {m:?}");
     assert_eq!(m.scans, 240);
@@ -104,21 +102,48 @@ fn lmb_behind_the_same_interface() {
     assert_eq!(m.innovations, 0);
 }
 
-/// The people tracker (occlusion-aware p_D, people birth, view survival) through the same
-/// harness: on seed 1 it scores mean OSPA 0.551, OSPA(2) 1.388 and 5 switches, better than
-/// every baseline on OSPA.
+/// The people tracker (occlusion- and resolution-aware p_D, people birth, view survival)
+/// through the same harness: on seed 1 it beats GNN and ML-RANSAC on OSPA and on OSPA(2),
+/// which also charges label switches.
 #[test]
-fn people_tracker_behind_the_same_interface_beats_the_baselines_on_ospa() {
+fn people_tracker_behind_the_same_interface_beats_the_baselines() {
     let (_, _, detector, sensor) = setup();
     let mut cfg = detector.clone();
     cfg.filter.seed = 1;
     let m = score(&mut smc_lmb::laser2d::PeopleTracker::new(cfg).unwrap());
-    check("people", &m, 0.65, 1.5, 12);
+    check("people", &m, 0.3, 0.6, 3);
     let g = score(&mut GnnTracker::new(GnnConfig::new(sensor)).unwrap());
-    assert!(
-        m.mean_ospa < g.mean_ospa,
-        "{} vs GNN {}",
-        m.mean_ospa,
-        g.mean_ospa
-    );
+    let mut rc = MlRansacConfig::new(sensor);
+    rc.seed = 1;
+    let r = score(&mut MlRansacTracker::new(rc).unwrap());
+    for (name, b) in [("GNN", &g), ("ML-RANSAC", &r)] {
+        assert!(
+            m.mean_ospa < b.mean_ospa && m.ospa2 < b.ospa2,
+            "LMB {} / {} vs {name} {} / {}",
+            m.mean_ospa,
+            m.ospa2,
+            b.mean_ospa,
+            b.ospa2
+        );
+    }
+}
+
+/// Label keeping, the hard part of scenario one (people pass within 0.9–2 m of each other
+/// while hiding one another): over five runs with the robot's drifting odometry, at least four
+/// keep every person on a single label from start to end.
+#[test]
+fn people_tracker_keeps_every_label_in_most_runs() {
+    let (scenario, _, detector, _) = setup();
+    let mut kept = Vec::new();
+    for seed in 2..=6 {
+        let run = scenario.generate(seed).unwrap();
+        let mut cfg = detector.clone();
+        cfg.filter.seed = seed;
+        let mut tracker = smc_lmb::laser2d::PeopleTracker::new(cfg).unwrap();
+        let m = evaluate_run(&mut tracker, &run, &detector, &EvalConfig::default()).unwrap();
+        assert!(m.mean_ospa < 0.3, "seed {seed}: mean OSPA {}", m.mean_ospa);
+        kept.push(m.all_labels_kept);
+    }
+    let n = kept.iter().filter(|&&k| k).count();
+    assert!(n >= 4, "all labels kept in {n} of 5 runs: {kept:?}");
 }
