@@ -5,6 +5,11 @@
 //! Not for: deciding what to draw (the pipelines build a [`BirdsEyePlot`]) or interactive
 //! viewing.
 
+pub mod people;
+pub mod text;
+
+pub use self::people::{write_people_plot, PeoplePlotCounts, PeoplePlotOptions};
+
 use crate::error::{Error, Result};
 use plotters::prelude::*;
 use std::path::Path;
