@@ -3,7 +3,8 @@
 //! dot where they start, static ones thin and dark with a hollow square at their mean — the
 //! sensor's path, a metre grid with tick labels, a title with the counts and a legend. Points
 //! and tracks are drawn in the frame the tracker worked in (the scan's odometry pose, else
-//! the sensor frame). SVG or PNG by extension, written atomically.
+//! the sensor frame). A track's line is cut where it went unseen for a while. SVG or PNG by
+//! extension, written atomically.
 //!
 //! Not for: running the tracker (see [`crate::laser2d::people_run`]) or plots of other
 //! pipelines (see [`super::BirdsEyePlot`]).
@@ -61,7 +62,20 @@ pub struct PeoplePlotCounts {
 struct TrackPath {
     label: Label,
     moving: bool,
-    points: Vec<(f64, f64)>,
+    /// Visible positions, cut where the track went unseen for [`GAP_SCANS`] scans or more:
+    /// a track that coasts unseen and is picked up again elsewhere is drawn as two pieces,
+    /// not as a long straight line.
+    pieces: Vec<Vec<(f64, f64)>>,
+    last_seen: usize,
+}
+
+/// Scans a track may go unseen before its drawn path is cut.
+const GAP_SCANS: usize = 5;
+
+impl TrackPath {
+    fn points(&self) -> impl Iterator<Item = &(f64, f64)> {
+        self.pieces.iter().flatten()
+    }
 }
 
 /// The pose a scan was tracked with: its odometry, else the logged sensor pose, else none.
@@ -112,17 +126,24 @@ pub fn write_people_plot(
         .map(|t| TrackPath {
             label: t.label,
             moving: t.dynamic_fraction >= options.moving_fraction,
-            points: Vec::new(),
+            pieces: Vec::new(),
+            last_seen: 0,
         })
         .collect();
-    for s in &run.scans {
+    for (k, s) in run.scans.iter().enumerate() {
         for p in s
             .people
             .iter()
             .filter(|p| p.visibility >= options.min_visibility)
         {
             if let Ok(i) = tracks.binary_search_by(|t| t.label.cmp(&p.label)) {
-                tracks[i].points.push((p.position[0], p.position[1]));
+                let t = &mut tracks[i];
+                if t.pieces.is_empty() || k >= t.last_seen + GAP_SCANS {
+                    t.pieces.push(Vec::new());
+                }
+                t.last_seen = k;
+                let piece = t.pieces.last_mut().expect("pushed above");
+                piece.push((p.position[0], p.position[1]));
             }
         }
     }
@@ -255,7 +276,7 @@ impl Scene<'_> {
         let others = self
             .tracks
             .iter()
-            .flat_map(|t| t.points.iter())
+            .flat_map(|t| t.points())
             .chain(self.sensor.iter());
         for &(x, y) in others.filter(|p| p.0.is_finite() && p.1.is_finite()) {
             lo = (lo.0.min(x), lo.1.min(y));
@@ -378,21 +399,18 @@ impl Scene<'_> {
                 .draw_series(std::iter::once(TriangleMarker::new(s, 7, INK.filled())))
                 .map_err(err)?;
         }
-        for t in self
-            .tracks
-            .iter()
-            .filter(|t| !t.moving && !t.points.is_empty())
-        {
-            chart
-                .draw_series(std::iter::once(PathElement::new(
-                    t.points.clone(),
-                    STATIC.stroke_width(1),
-                )))
-                .map_err(err)?;
-            let n = t.points.len() as f64;
+        for t in self.tracks.iter().filter(|t| !t.moving) {
+            for piece in &t.pieces {
+                chart
+                    .draw_series(std::iter::once(PathElement::new(
+                        piece.clone(),
+                        STATIC.stroke_width(1),
+                    )))
+                    .map_err(err)?;
+            }
+            let n = t.points().count() as f64;
             let mean = t
-                .points
-                .iter()
+                .points()
                 .fold((0.0, 0.0), |a, p| (a.0 + p.0 / n, a.1 + p.1 / n));
             let (px, py) = chart.backend_coord(&mean);
             root.draw(&Rectangle::new(
@@ -401,25 +419,21 @@ impl Scene<'_> {
             ))
             .map_err(err)?;
         }
-        for t in self
-            .tracks
-            .iter()
-            .filter(|t| t.moving && !t.points.is_empty())
-        {
+        for t in self.tracks.iter().filter(|t| t.moving) {
             let colour = label_colour(t.label);
-            chart
-                .draw_series(std::iter::once(PathElement::new(
-                    t.points.clone(),
-                    colour.stroke_width(2),
-                )))
-                .map_err(err)?;
-            chart
-                .draw_series(std::iter::once(Circle::new(
-                    t.points[0],
-                    3,
-                    colour.filled(),
-                )))
-                .map_err(err)?;
+            for piece in &t.pieces {
+                chart
+                    .draw_series(std::iter::once(PathElement::new(
+                        piece.clone(),
+                        colour.stroke_width(2),
+                    )))
+                    .map_err(err)?;
+            }
+            if let Some(&start) = t.points().next() {
+                chart
+                    .draw_series(std::iter::once(Circle::new(start, 3, colour.filled())))
+                    .map_err(err)?;
+            }
         }
 
         // Title and legend.
