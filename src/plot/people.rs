@@ -502,6 +502,96 @@ impl Scene<'_> {
 mod tests {
     use super::*;
 
+    use crate::laser2d::{PersonEstimate, PersonTrack, Pose2, ScanPeople};
+
+    /// Ten scans of a wall 5 m ahead; a walker (label (0, 0)) crossing at 1 m/s, unseen in
+    /// scans 3–8; a standing person (label (1, 0)) seen throughout.
+    fn story() -> (Vec<Scan>, PeopleRun) {
+        let mut scans = Vec::new();
+        let mut run = PeopleRun::default();
+        let person = |label: Label, x: f64, moving: bool, visibility: f64| PersonEstimate {
+            label,
+            existence: 0.9,
+            position: [x, 1.0],
+            velocity: [if moving { 1.0 } else { 0.0 }, 0.0],
+            p_moving: if moving { 0.9 } else { 0.1 },
+            moving,
+            visibility,
+            age: 0,
+        };
+        for k in 0..10 {
+            let mut s = Scan::new(k as f64, -0.5, 0.01, vec![5.0; 101], 0.0, 30.0).unwrap();
+            s.odometry = Some(Pose2::new(0.0, 0.0, 0.0));
+            scans.push(s);
+            let seen = if (3..9).contains(&k) { 0.0 } else { 1.0 };
+            run.scans.push(ScanPeople {
+                scan: k,
+                time: k as f64,
+                pose: Some([0.0; 3]),
+                people: vec![
+                    person(Label::new(0, 0), k as f64, true, seen),
+                    person(Label::new(1, 0), 2.0, false, 1.0),
+                ],
+            });
+        }
+        let track = |label, scans, dynamic_fraction| PersonTrack {
+            label,
+            scans,
+            first_time: 0.0,
+            last_time: 9.0,
+            mean_speed: 0.0,
+            dynamic_fraction,
+            displacement: 0.0,
+        };
+        run.tracks = vec![
+            track(Label::new(0, 0), 4, 1.0),
+            track(Label::new(1, 0), 10, 0.0),
+        ];
+        (scans, run)
+    }
+
+    #[test]
+    fn writes_moving_and_static_tracks_and_cuts_unseen_stretches() {
+        let (scans, run) = story();
+        let dir = tempfile::tempdir().unwrap();
+        let options = PeoplePlotOptions {
+            min_scans: 4,
+            title: "story".into(),
+            ..PeoplePlotOptions::default()
+        };
+        let png = dir.path().join("p.png");
+        let counts = write_people_plot(&png, &scans, &run, &options).unwrap();
+        assert_eq!((counts.moving, counts.stationary), (1, 1));
+        assert_eq!(counts.points, 10 * 101);
+        assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");
+        let svg = dir.path().join("p.svg");
+        write_people_plot(&svg, &scans, &run, &options).unwrap();
+        let text = std::fs::read_to_string(&svg).unwrap();
+        assert!(text.starts_with("<svg"));
+        // the walker's line is cut at its six unseen scans: two polylines in its colour
+        let [r, g, b] = {
+            let c = label_colour(Label::new(0, 0));
+            [c.0, c.1, c.2]
+        };
+        let colour = format!("#{r:02X}{g:02X}{b:02X}");
+        let lines = text
+            .lines()
+            .filter(|l| l.contains("<polyline") && l.contains(&colour))
+            .count();
+        assert_eq!(lines, 2, "{colour}");
+        // only .svg and .png, only matching scans and runs; the directory holds just the plots
+        assert!(write_people_plot(&dir.path().join("p.gif"), &scans, &run, &options).is_err());
+        assert!(write_people_plot(&png, &scans[..5], &run, &options).is_err());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+        // more scans required: the walker (seen in 4) drops out
+        let strict = PeoplePlotOptions {
+            min_scans: 5,
+            ..options
+        };
+        let counts = write_people_plot(&png, &scans, &run, &strict).unwrap();
+        assert_eq!((counts.moving, counts.stationary), (0, 1));
+    }
+
     #[test]
     fn grid_steps_are_round() {
         assert_eq!(grid_step(100.0, 10.0), 10.0);
