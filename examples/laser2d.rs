@@ -5,7 +5,7 @@
 //! ```text
 //! cargo run --release --example laser2d -- --scenario one --runs 10 --seed 1 [--json]
 //!     [--trackers lmb,gnn,ml_ransac,jpda_imm] [--pose odometry|truth] [--frame robot|world]
-//! cargo run --release --example laser2d -- --carmen intel.clf.bz2 --out people.json --plot tracks.svg
+//! cargo run --release --example laser2d -- --carmen intel.clf.bz2 [--scans 2000..2600] --out people.json --plot tracks.svg
 //! cargo run --release --example laser2d -- --bag demo.bag --topic /scan --out people.json --plot tracks.png
 //! ```
 //!
@@ -71,6 +71,9 @@ struct Args {
     /// Scan topic of `--bag` (default: the only LaserScan topic).
     #[arg(long)]
     topic: Option<String>,
+    /// Track only the scans `A..B` of a recording (0-based, B exclusive; `A..` to the end).
+    #[arg(long)]
+    scans: Option<String>,
     /// Per-scan people of a recording, as JSON.
     #[arg(long)]
     out: Option<std::path::PathBuf>,
@@ -256,17 +259,17 @@ fn print_table(args: &Args, names: &[&str], summaries: &[Summary]) {
 mod recording {
     use super::Args;
     use anyhow::{Context, Result};
-    use plotters::prelude::*;
     use smc_lmb::laser2d::{
         config_for_scans, read_bag, read_carmen, track_scans, write_people_json, BagOptions,
         CarmenOptions, PeopleRun, Scan, TimeOrder,
     };
+    use smc_lmb::plot::{write_people_plot, PeoplePlotOptions};
     use std::path::Path;
     use std::time::Instant;
 
     pub fn run(args: &Args) -> Result<()> {
         let t_read = Instant::now();
-        let scans = load(args)?;
+        let scans = window(args, load(args)?)?;
         let read_s = t_read.elapsed().as_secs_f64();
         anyhow::ensure!(!scans.is_empty(), "the recording holds no scan");
         let mut cfg = config_for_scans(
@@ -284,7 +287,8 @@ mod recording {
             write_people_json(path, &run).with_context(|| format!("writing {}", path.display()))?;
         }
         if let Some(path) = &args.plot {
-            plot(path, &scans, &run).with_context(|| format!("plotting {}", path.display()))?;
+            plot(path, args, &scans, &run)
+                .with_context(|| format!("plotting {}", path.display()))?;
         }
         report(&scans, &run, read_s, secs);
         Ok(())
@@ -363,113 +367,50 @@ mod recording {
         }
     }
 
-    /// World points of a scan: the sensor sits at the laser pose when the log has one, else at
-    /// the odometry pose, else at the origin.
-    fn world_points(s: &Scan) -> Vec<(f64, f64)> {
-        let pose = s.laser_pose.or(s.odometry);
-        let (x0, y0, th) = pose.map_or((0.0, 0.0, 0.0), |p| (p.x, p.y, p.theta));
-        let (sn, cs) = th.sin_cos();
-        s.points()
-            .map(|(_, [x, y])| (x0 + cs * x - sn * y, y0 + sn * x + cs * y))
-            .collect()
+    fn plot(path: &Path, args: &Args, scans: &[Scan], run: &PeopleRun) -> Result<()> {
+        let source = args
+            .carmen
+            .as_ref()
+            .or(args.bag.as_ref())
+            .expect("a recording");
+        let mut title = source
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+        if let Some(range) = &args.scans {
+            title = format!("{title}, scans {range}");
+        }
+        let options = PeoplePlotOptions {
+            title,
+            ..PeoplePlotOptions::default()
+        };
+        write_people_plot(path, scans, run, &options)?;
+        Ok(())
     }
 
-    fn plot(path: &Path, scans: &[Scan], run: &PeopleRun) -> Result<()> {
-        let every = (scans.len() / 200).max(1);
-        let points: Vec<(f64, f64)> = scans.iter().step_by(every).flat_map(world_points).collect();
-        let tracks: Vec<&smc_lmb::laser2d::PersonTrack> = run.tracks_with(8).collect();
-        let mut paths: Vec<Vec<(f64, f64)>> = vec![Vec::new(); tracks.len()];
-        for s in &run.scans {
-            for p in s.people.iter().filter(|p| p.visibility >= 0.5) {
-                if let Some(i) = tracks.iter().position(|t| t.label == p.label) {
-                    paths[i].push((p.position[0], p.position[1]));
-                }
-            }
-        }
-        let all = points.iter().chain(paths.iter().flatten());
-        let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-        for &(x, y) in all {
-            x0 = x0.min(x);
-            x1 = x1.max(x);
-            y0 = y0.min(y);
-            y1 = y1.max(y);
-        }
-        anyhow::ensure!(x0 <= x1, "nothing to plot");
-        let size = (
-            1000,
-            (1000.0 * (y1 - y0 + 1.0) / (x1 - x0 + 1.0)).clamp(300.0, 1600.0) as u32,
-        );
-        let png = path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
-        // Draw into a temporary file next to the target, then rename (atomic output).
-        let tmp = path.with_extension(if png { "tmp.png" } else { "tmp.svg" });
-        let frame = (x0, x1, y0, y1);
-        if png {
-            draw(
-                BitMapBackend::new(&tmp, size).into_drawing_area(),
-                &points,
-                &paths,
-                frame,
-                false, // no font engine in the bitmap backend: no axis text
-            )?;
+    /// The scans `A..B` (0-based, B exclusive) of `--scans`, all without it.
+    fn window(args: &Args, scans: Vec<Scan>) -> Result<Vec<Scan>> {
+        let Some(range) = &args.scans else {
+            return Ok(scans);
+        };
+        let (a, b) = range
+            .split_once("..")
+            .with_context(|| format!("--scans {range}: expected A..B"))?;
+        let a: usize = a
+            .trim()
+            .parse()
+            .with_context(|| format!("--scans {range}"))?;
+        let b: usize = if b.trim().is_empty() {
+            scans.len()
         } else {
-            draw(
-                SVGBackend::new(&tmp, size).into_drawing_area(),
-                &points,
-                &paths,
-                frame,
-                true,
-            )?;
-        }
-        std::fs::rename(&tmp, path)?;
-        Ok(())
-    }
-
-    fn draw<DB: DrawingBackend>(
-        root: DrawingArea<DB, plotters::coord::Shift>,
-        points: &[(f64, f64)],
-        paths: &[Vec<(f64, f64)>],
-        (x0, x1, y0, y1): (f64, f64, f64, f64),
-        labels: bool,
-    ) -> Result<()>
-    where
-        DB::ErrorType: 'static,
-    {
-        root.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        let label_space = if labels { 40 } else { 0 };
-        let mut chart = ChartBuilder::on(&root)
-            .margin(10)
-            .x_label_area_size(label_space)
-            .y_label_area_size(label_space)
-            .build_cartesian_2d(x0 - 0.5..x1 + 0.5, y0 - 0.5..y1 + 0.5)
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        if labels {
-            chart
-                .configure_mesh()
-                .x_desc("x (m)")
-                .y_desc("y (m)")
-                .disable_mesh()
-                .draw()
-                .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        }
-        chart
-            .draw_series(
-                points
-                    .iter()
-                    .map(|&p| Pixel::new(p, RGBColor(150, 150, 150))),
-            )
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        for (i, path) in paths.iter().enumerate() {
-            let colour = Palette99::pick(i).to_rgba();
-            chart
-                .draw_series(LineSeries::new(
-                    path.iter().copied(),
-                    colour.stroke_width(2),
-                ))
-                .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        }
-        root.present().map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        Ok(())
+            b.trim()
+                .parse()
+                .with_context(|| format!("--scans {range}"))?
+        };
+        anyhow::ensure!(
+            a < b && b <= scans.len(),
+            "--scans {range}: the recording has {} scans",
+            scans.len()
+        );
+        Ok(scans[a..b].to_vec())
     }
 }

@@ -86,7 +86,12 @@ pub fn read_scan_csv(path: impl AsRef<Path>) -> Result<Vec<Scan>> {
     let mut saw_magic = false;
     for (k, line) in reader.lines().enumerate() {
         let line_no = k + 1;
-        let line = line.map_err(|e| Error::io(path, e))?;
+        let line = line.map_err(|e| {
+            Error::io(
+                path,
+                std::io::Error::new(e.kind(), format!("line {line_no}: {e}")),
+            )
+        })?;
         let text = line.trim_end_matches('\r');
         if line_no == 1 {
             if text.trim_end() != CSV_MAGIC {

@@ -26,7 +26,9 @@
 //! [`Scan`] treats it as "no return". Odometry poses become planar: `theta` is the yaw of
 //! the quaternion; `linear_velocity` is twist.linear.x, `angular_velocity` twist.angular.z.
 //! Each scan gets the latest odometry pose not after its time ([`attach_odometry`]).
-//! Messages are returned in the bag's storage order.
+//! Messages are returned in the bag's storage order; their stamps are not checked for order
+//! (a scan stamped before the one preceding it is returned as it is, and the people tracker
+//! then stops with an error naming that scan).
 
 use super::scan::{attach_odometry, OdometryRecord, Pose2, Scan};
 use crate::error::{Error, Result};
@@ -554,6 +556,38 @@ mod tests {
         let mut z = m.clone();
         z[4..12].fill(0);
         assert_eq!(laser_scan_to_scan(&z, 3_250_000_000).unwrap().time, 3.25);
+    }
+
+    #[test]
+    fn odd_ranges_are_kept_and_odd_headers_refused() {
+        // NaN, +∞, zero (below range_min), range_max itself: kept in place, none a return.
+        let m = laser_bytes(&[f32::NAN, f32::INFINITY, 0.0, 20.0, 3.0], 0, 1.0);
+        let s = laser_scan_to_scan(&m, 0).unwrap();
+        assert_eq!(s.len(), 5);
+        assert!(s.ranges[0].is_nan());
+        assert_eq!(s.points().map(|(i, _)| i).collect::<Vec<_>>(), vec![4]);
+        // Header floats at byte 21 on: angle_min, angle_max, angle_increment, time_increment,
+        // scan_time, range_min, range_max.
+        let set = |at: usize, v: f32| {
+            let mut b = m.clone();
+            b[21 + 4 * at..25 + 4 * at].copy_from_slice(&v.to_le_bytes());
+            b
+        };
+        assert_eq!(
+            laser_scan_to_scan(&set(2, f32::NAN), 0).unwrap_err().0,
+            "ranges"
+        );
+        assert_eq!(laser_scan_to_scan(&set(2, 0.0), 0).unwrap_err().0, "ranges");
+        assert_eq!(
+            laser_scan_to_scan(&set(0, f32::NAN), 0).unwrap_err().0,
+            "ranges"
+        );
+        let (field, reason) = laser_scan_to_scan(&set(6, f32::NAN), 0).unwrap_err();
+        assert_eq!(field, "header values");
+        assert!(reason.contains("range_max"), "{reason}");
+        let (field, reason) = laser_scan_to_scan(&set(5, 30.0), 0).unwrap_err();
+        assert_eq!(field, "header values");
+        assert!(reason.contains("range_max"), "{reason}");
     }
 
     #[test]
