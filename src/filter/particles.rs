@@ -295,13 +295,10 @@ impl ParticleSet {
             }
             idx.push(i);
         }
-        let mut states = vec![0.0; self.dim * n];
+        let mut states = Vec::with_capacity(self.dim * n);
         for c in 0..self.dim {
             let src = self.component(c);
-            let dst = &mut states[c * n..(c + 1) * n];
-            for (d, &j) in dst.iter_mut().zip(&idx) {
-                *d = src[j];
-            }
+            states.extend(idx.iter().map(|&j| src[j]));
         }
         self.states = states;
         self.len = n;

@@ -295,10 +295,16 @@ mod tests {
         // The odometry believes the robot is at (5, 1) facing +x: 2 m ahead is (7, 1).
         let to = Pose2::new(5.0, 1.0, 0.0);
         let q = relocate([0.0, 2.0], from, to);
-        assert!((q[0] - 7.0).abs() < 1e-12 && (q[1] - 1.0).abs() < 1e-12, "{q:?}");
+        assert!(
+            (q[0] - 7.0).abs() < 1e-12 && (q[1] - 1.0).abs() < 1e-12,
+            "{q:?}"
+        );
         // Same pose: unchanged.
         let q = relocate([3.0, -4.0], to, to);
-        assert!((q[0] - 3.0).abs() < 1e-12 && (q[1] + 4.0).abs() < 1e-12, "{q:?}");
+        assert!(
+            (q[0] - 3.0).abs() < 1e-12 && (q[1] + 4.0).abs() < 1e-12,
+            "{q:?}"
+        );
     }
 
     #[test]
