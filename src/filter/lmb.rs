@@ -458,10 +458,8 @@ impl LmbFilter {
                 let detectable = w.iter().zip(&pd).any(|(w, d)| w * d > 0.0);
                 let mut gated: Vec<usize> = Vec::new();
                 if detectable && !z.is_empty() {
-                    let summary = TrackSummary {
-                        mean: p.mean(),
-                        std: p.std_dev(),
-                    };
+                    let (mean, std) = p.mean_and_std_dev();
+                    let summary = TrackSummary { mean, std };
                     gated = (0..z.len())
                         .filter(|&j| m.measurement.gate(z.get(j), &summary, ctx))
                         .collect();
@@ -481,7 +479,11 @@ impl LmbFilter {
                         scaled_eta.push(0.0);
                         continue;
                     }
-                    g.iter_mut().for_each(|v| *v = (*v - top).exp());
+                    // exp of anything below −746 is exactly 0: skip the call.
+                    g.iter_mut().for_each(|v| {
+                        let d = *v - top;
+                        *v = if d < -746.0 { 0.0 } else { d.exp() };
+                    });
                     let sum: f64 = g.iter().zip(w).zip(&pd).map(|((g, w), d)| g * w * d).sum();
                     log_eta.push(top + sum.ln());
                     scaled_eta.push(sum);
