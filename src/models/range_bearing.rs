@@ -210,12 +210,21 @@ impl RangeBearing {
     }
 
     /// The noiseless measurement [range, bearing] of `state` (position in components 0
-    /// and 2). States with fewer than three components give [NaN, NaN].
+    /// and 2). States with fewer than three components give [NaN, NaN]. One state at a time,
+    /// so the bearing comes from the library's `atan2` (the particle loops use the cheaper
+    /// one of equal precision).
     pub fn predict_measurement(&self, state: &[f64], ctx: &StepContext) -> [f64; 2] {
         match (state.first(), state.get(2)) {
             (Some(&x), Some(&y)) => {
-                let (r, b) = self.measure(&self.sensor(ctx), x, y);
-                [r, b]
+                let s = self.sensor(ctx);
+                let (dx, dy) = (x - s.x, y - s.y);
+                let lx = s.cos * dx + s.sin * dy;
+                let ly = -s.sin * dx + s.cos * dy;
+                let bearing = match self.convention {
+                    BearingConvention::FromXAxis => ly.atan2(lx),
+                    BearingConvention::FromYAxis => lx.atan2(ly),
+                };
+                [(dx * dx + dy * dy).sqrt(), bearing]
             }
             _ => [f64::NAN, f64::NAN],
         }
