@@ -1,11 +1,46 @@
 //! Criterion benchmark of the people-tracking pipeline on 361-beam scans: grouping the returns
 //! into person candidates alone, and grouping plus the LMB filter (500 particles per track)
-//! over a whole simulated run of scenario one (240 scans, five walkers, a moving robot).
+//! over a whole simulated run of scenario one (240 scans, five walkers, a moving robot) and
+//! over a crowd of twenty walkers (up to 20 tracks at 500 particles, 80 scans). Throughput is
+//! reported per scan, so criterion's "elem/s" reads as scans per second.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use smc_lmb::laser2d::{PeopleTracker, PeopleTrackerConfig};
-use smc_lmb::sim::PeopleScenario;
+use smc_lmb::sim::{PeopleScenario, PersonLeg, PersonSpec, RobotLeg};
 use std::time::Duration;
+
+/// Twenty people (radius 0.2 m) on a 4 × 5 grid 3 m apart, 5–14 m ahead of a robot creeping
+/// forward at 0.3 m/s for 10 s, each walking slowly (0.2–0.4 m/s) in its own direction: all
+/// twenty in the field of view, partly hiding one another.
+fn crowd_of_twenty() -> PeopleScenario {
+    let mut s = PeopleScenario::one();
+    s.name = "people2d-crowd-20".into();
+    s.duration = 10.0;
+    s.robot.legs = vec![RobotLeg {
+        duration: 10.0,
+        speed: 0.3,
+        turn_rate: 0.0,
+    }];
+    s.people = (0..20)
+        .map(|k| {
+            let (row, col) = ((k / 5) as f64, (k % 5) as f64);
+            let heading = 0.7 * k as f64;
+            let speed = 0.2 + 0.01 * k as f64;
+            PersonSpec {
+                id: k + 1,
+                radius: 0.2,
+                enter: 0.0,
+                leave: None,
+                start: [5.0 + 3.0 * row, -6.0 + 3.0 * col],
+                legs: vec![PersonLeg {
+                    duration: 10.0,
+                    velocity: [speed * heading.cos(), speed * heading.sin()],
+                }],
+            }
+        })
+        .collect();
+    s
+}
 
 fn laser2d_pipeline(c: &mut Criterion) {
     let scenario = PeopleScenario::one();
@@ -39,6 +74,35 @@ fn laser2d_pipeline(c: &mut Criterion) {
                 .sum::<usize>()
         })
     });
+    g.finish();
+
+    // The case: up to 20 tracks at 500 particles on 361-beam scans.
+    let crowd = crowd_of_twenty();
+    let crowd_run = crowd.generate(1).expect("crowd of twenty");
+    let s = &crowd.scanner;
+    let crowd_cfg = PeopleTrackerConfig::for_scanner(
+        s.sigma_range,
+        s.sigma_bearing,
+        s.range_max,
+        s.fov / 2.0,
+        crowd.mount,
+    );
+    let mut g = c.benchmark_group("laser2d_pipeline");
+    g.sample_size(10).measurement_time(Duration::from_secs(10));
+    g.throughput(Throughput::Elements(crowd_run.scans.len() as u64));
+    g.bench_function(
+        "grouping_and_tracking/361_beams_20_people_500_particles",
+        |b| {
+            b.iter(|| {
+                let mut t = PeopleTracker::new(crowd_cfg.clone()).expect("tracker");
+                crowd_run
+                    .scans
+                    .iter()
+                    .map(|scan| t.step(scan).expect("step").len())
+                    .sum::<usize>()
+            })
+        },
+    );
     g.finish();
 }
 

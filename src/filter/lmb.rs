@@ -196,6 +196,7 @@ impl LmbFilterBuilder {
             tracks: Vec::new(),
             step: 0,
             previous: None,
+            unmoved_detection: Vec::new(),
         })
     }
 }
@@ -256,6 +257,9 @@ pub struct LmbFilter {
     tracks: Vec<Track>,
     step: u32,
     previous: Option<Previous>,
+    /// p_D of every particle from the last update, for the tracks whose particles have not
+    /// moved since (not resampled), by label.
+    unmoved_detection: Vec<(Label, Vec<f64>)>,
 }
 
 impl std::fmt::Debug for LmbFilter {
@@ -294,6 +298,18 @@ impl LmbFilter {
         self.tracks.clear();
         self.step = 0;
         self.previous = None;
+        self.unmoved_detection.clear();
+    }
+
+    /// The detection probability of every particle of track `label` as the last step's update
+    /// computed it (clamped to [0, 1]), when that track's particles have not moved since (it
+    /// was not resampled): the same numbers the detection model gives for those particles at
+    /// that step, without evaluating it again. `None` for other tracks.
+    pub fn detection_probabilities(&self, label: Label) -> Option<&[f64]> {
+        self.unmoved_detection
+            .iter()
+            .find(|(l, _)| *l == label)
+            .map(|(_, pd)| pd.as_slice())
     }
 
     /// Runs one frame and returns the MAP multi-object estimate.
@@ -316,7 +332,13 @@ impl LmbFilter {
         self.add_births(&ctx, seed);
         let likelihoods = self.likelihoods(z, &ctx);
         let marginals = self.associate(z, &ctx, &likelihoods, seed);
-        let assigned = self.update(&likelihoods, &marginals, z.len(), seed);
+        let (assigned, resampled) = self.update(&likelihoods, &marginals, z.len(), seed);
+        self.unmoved_detection.clear();
+        for ((t, l), moved) in self.tracks.iter().zip(likelihoods).zip(resampled) {
+            if !moved {
+                self.unmoved_detection.push((t.label, l.pd));
+            }
+        }
         self.prune();
         let estimates = map_estimates(&self.tracks);
 
@@ -436,10 +458,8 @@ impl LmbFilter {
                 let detectable = w.iter().zip(&pd).any(|(w, d)| w * d > 0.0);
                 let mut gated: Vec<usize> = Vec::new();
                 if detectable && !z.is_empty() {
-                    let summary = TrackSummary {
-                        mean: p.mean(),
-                        std: p.std_dev(),
-                    };
+                    let (mean, std) = p.mean_and_std_dev();
+                    let summary = TrackSummary { mean, std };
                     gated = (0..z.len())
                         .filter(|&j| m.measurement.gate(z.get(j), &summary, ctx))
                         .collect();
@@ -459,7 +479,11 @@ impl LmbFilter {
                         scaled_eta.push(0.0);
                         continue;
                     }
-                    g.iter_mut().for_each(|v| *v = (*v - top).exp());
+                    // exp of anything below −746 is exactly 0: skip the call.
+                    g.iter_mut().for_each(|v| {
+                        let d = *v - top;
+                        *v = if d < -746.0 { 0.0 } else { d.exp() };
+                    });
                     let sum: f64 = g.iter().zip(w).zip(&pd).map(|((g, w), d)| g * w * d).sum();
                     log_eta.push(top + sum.ln());
                     scaled_eta.push(sum);
@@ -571,30 +595,34 @@ impl LmbFilter {
     }
 
     /// The GLMB → LMB update of existence and particle weights, then resampling. Returns, for
-    /// every measurement, the probability that some track generated it.
+    /// every measurement, the probability that some track generated it, and for every track
+    /// whether it was resampled.
     fn update(
         &mut self,
         lik: &[TrackLikelihoods],
         marg: &[TrackMarginals],
         n_meas: usize,
         seed: u64,
-    ) -> Vec<f64> {
+    ) -> (Vec<f64>, Vec<bool>) {
         let cfg = &self.config;
-        self.tracks
+        let resampled = self
+            .tracks
             .par_iter_mut()
             .zip(lik.par_iter())
             .zip(marg.par_iter())
-            .for_each(|((t, l), mg)| {
+            .map(|((t, l), mg)| {
                 update_track(t, l, mg);
                 let n = t.particles.len();
-                if n != cfg.particles
+                let resample = n != cfg.particles
                     || t.particles.effective_sample_size()
-                        < cfg.resample_threshold * cfg.particles as f64
-                {
+                        < cfg.resample_threshold * cfg.particles as f64;
+                if resample {
                     let mut rng = stream(seed, KEY_RESAMPLE ^ t.label.key());
                     t.particles.resample(cfg.particles, cfg.jitter, &mut rng);
                 }
-            });
+                resample
+            })
+            .collect();
         let mut assigned = vec![0.0; n_meas];
         for (l, mg) in lik.iter().zip(marg) {
             for &(k, p) in &mg.detect {
@@ -602,7 +630,7 @@ impl LmbFilter {
             }
         }
         assigned.iter_mut().for_each(|a| *a = a.min(1.0));
-        assigned
+        (assigned, resampled)
     }
 
     /// Removes tracks below the existence threshold and keeps at most `max_tracks`.
@@ -664,18 +692,22 @@ fn update_track(t: &mut Track, l: &TrackLikelihoods, mg: &TrackMarginals) {
         0.0
     };
     let mut factor: Vec<f64> = l.pd.iter().map(|d| miss * (1.0 - d)).collect();
-    let mut detect_sum = vec![0.0; factor.len()];
-    for (k, p) in detected {
-        let c = p / l.scaled_eta[k];
-        detect_sum
+    if let Some((&(k0, p0), rest)) = detected.split_first() {
+        // Σ_j P_j·ĝ_j,i / η̂_j, started from the first term (no zero-filled buffer).
+        let c0 = p0 / l.scaled_eta[k0];
+        let mut detect_sum: Vec<f64> = l.scaled_g[k0].iter().map(|g| c0 * g).collect();
+        for &(k, p) in rest {
+            let c = p / l.scaled_eta[k];
+            detect_sum
+                .iter_mut()
+                .zip(&l.scaled_g[k])
+                .for_each(|(s, g)| *s += c * g);
+        }
+        factor
             .iter_mut()
-            .zip(&l.scaled_g[k])
-            .for_each(|(s, g)| *s += c * g);
+            .zip(&l.pd)
+            .zip(&detect_sum)
+            .for_each(|((f, d), s)| *f += d * s);
     }
-    factor
-        .iter_mut()
-        .zip(&l.pd)
-        .zip(&detect_sum)
-        .for_each(|((f, d), s)| *f += d * s);
     t.particles.reweight(&factor);
 }

@@ -234,8 +234,13 @@ impl ParticleSet {
 
     /// Weighted standard deviation of every component.
     pub fn std_dev(&self) -> Vec<f64> {
+        self.mean_and_std_dev().1
+    }
+
+    /// Weighted mean and standard deviation of every component, the mean computed once.
+    pub fn mean_and_std_dev(&self) -> (Vec<f64>, Vec<f64>) {
         let mean = self.mean();
-        (0..self.dim)
+        let std = (0..self.dim)
             .map(|c| {
                 let m = mean[c];
                 let var: f64 = self
@@ -246,7 +251,8 @@ impl ParticleSet {
                     .sum();
                 var.max(0.0).sqrt()
             })
-            .collect()
+            .collect();
+        (mean, std)
     }
 
     /// Weighted covariance matrix (dim × dim).
@@ -295,13 +301,10 @@ impl ParticleSet {
             }
             idx.push(i);
         }
-        let mut states = vec![0.0; self.dim * n];
+        let mut states = Vec::with_capacity(self.dim * n);
         for c in 0..self.dim {
             let src = self.component(c);
-            let dst = &mut states[c * n..(c + 1) * n];
-            for (d, &j) in dst.iter_mut().zip(&idx) {
-                *d = src[j];
-            }
+            states.extend(idx.iter().map(|&j| src[j]));
         }
         self.states = states;
         self.len = n;

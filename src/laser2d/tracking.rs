@@ -400,15 +400,23 @@ impl PeopleTracker {
         let p_max = self.detection.field_of_view().p_inside();
         let tracks = self.filter.tracks();
         let mut out = Vec::with_capacity(estimates.len());
-        let mut pd = Vec::new();
+        let mut pd_buffer = Vec::new();
         for e in estimates {
             let Some(t) = tracks.iter().find(|t| t.label == e.label) else {
                 continue;
             };
             let p = &t.particles;
-            pd.resize(p.len(), 0.0);
-            self.detection.detection_probability(p, &ctx, &mut pd);
-            let seen: f64 = p.weights().iter().zip(&pd).map(|(w, d)| w * d).sum();
+            // The filter's own p_D when the particles have not moved since it computed them.
+            let pd = match self.filter.detection_probabilities(e.label) {
+                Some(known) if known.len() == p.len() => known,
+                _ => {
+                    pd_buffer.resize(p.len(), 0.0);
+                    self.detection
+                        .detection_probability(p, &ctx, &mut pd_buffer);
+                    &pd_buffer[..]
+                }
+            };
+            let seen: f64 = p.weights().iter().zip(pd).map(|(w, d)| w * d).sum();
             let p_moving = probability_moving(p, self.config.motion.v_min);
             out.push(PersonEstimate {
                 label: e.label,

@@ -142,6 +142,7 @@ pub trait ClutterModel: Send + Sync {
     fn log_intensity(&self, z: &[f64], ctx: &StepContext) -> f64;
 }
 
+mod atan;
 pub mod clutter;
 pub mod ct;
 pub mod cv;

@@ -28,6 +28,7 @@
 //! Not for: three-dimensional (elevation) measurements or sensors that rotate independently of
 //! the platform.
 
+use super::atan::atan2;
 use super::{MeasurementModel, StepContext, TrackSummary};
 use crate::error::{Error, Result};
 use crate::filter::ParticleSet;
@@ -200,8 +201,8 @@ impl RangeBearing {
         let lx = s.cos * dx + s.sin * dy;
         let ly = -s.sin * dx + s.cos * dy;
         let bearing = match self.convention {
-            BearingConvention::FromXAxis => ly.atan2(lx),
-            BearingConvention::FromYAxis => lx.atan2(ly),
+            BearingConvention::FromXAxis => atan2(ly, lx),
+            BearingConvention::FromYAxis => atan2(lx, ly),
         };
         // sqrt, not hypot: no overflow at these scales, and hypot's care costs a third of a
         // likelihood evaluation
@@ -209,12 +210,21 @@ impl RangeBearing {
     }
 
     /// The noiseless measurement [range, bearing] of `state` (position in components 0
-    /// and 2). States with fewer than three components give [NaN, NaN].
+    /// and 2). States with fewer than three components give [NaN, NaN]. One state at a time,
+    /// so the bearing comes from the library's `atan2` (the particle loops use the cheaper
+    /// one of equal precision).
     pub fn predict_measurement(&self, state: &[f64], ctx: &StepContext) -> [f64; 2] {
         match (state.first(), state.get(2)) {
             (Some(&x), Some(&y)) => {
-                let (r, b) = self.measure(&self.sensor(ctx), x, y);
-                [r, b]
+                let s = self.sensor(ctx);
+                let (dx, dy) = (x - s.x, y - s.y);
+                let lx = s.cos * dx + s.sin * dy;
+                let ly = -s.sin * dx + s.cos * dy;
+                let bearing = match self.convention {
+                    BearingConvention::FromXAxis => ly.atan2(lx),
+                    BearingConvention::FromYAxis => lx.atan2(ly),
+                };
+                [(dx * dx + dy * dy).sqrt(), bearing]
             }
             _ => [f64::NAN, f64::NAN],
         }
@@ -316,13 +326,12 @@ impl MeasurementModel for RangeBearing {
         }
         // The predicted measurement of every particle, once for all measurements.
         let s = self.sensor(ctx);
-        let n = particles.len();
-        let (mut ranges, mut bearings) = (Vec::with_capacity(n), Vec::with_capacity(n));
-        for (&x, &y) in particles.component(0).iter().zip(particles.component(2)) {
-            let (r, b) = self.measure(&s, x, y);
-            ranges.push(r);
-            bearings.push(b);
-        }
+        let predicted: Vec<(f64, f64)> = particles
+            .component(0)
+            .iter()
+            .zip(particles.component(2))
+            .map(|(&x, &y)| self.measure(&s, x, y))
+            .collect();
         let norm = self.log_normaliser();
         let inv_r = 1.0 / self.sigma_range;
         let inv_b = 1.0 / self.sigma_bearing;
@@ -334,7 +343,7 @@ impl MeasurementModel for RangeBearing {
                     continue;
                 }
             };
-            for ((o, &r), &b) in o.iter_mut().zip(&ranges).zip(&bearings) {
+            for (o, &(r, b)) in o.iter_mut().zip(&predicted) {
                 let er = (zr - r) * inv_r;
                 let eb = wrap_angle(zb - b) * inv_b;
                 let l = norm - 0.5 * (er * er + eb * eb);
