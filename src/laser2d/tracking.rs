@@ -406,9 +406,10 @@ impl PeopleTracker {
                 continue;
             };
             let p = &t.particles;
-            // The filter's own p_D when the particles have not moved since it computed them.
+            // Visibility is geometric (field of view, occlusion): the filter's own p_D when the
+            // particles have not moved since it computed them and no neighbour lowered it.
             let pd = match self.filter.detection_probabilities(e.label) {
-                Some(known) if known.len() == p.len() => known,
+                Some(known) if known.len() == p.len() && !self.resolution.lowers(p) => known,
                 _ => {
                     pd_buffer.resize(p.len(), 0.0);
                     self.detection

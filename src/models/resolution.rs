@@ -77,6 +77,42 @@ impl<D: DetectionModel> ResolutionDetection<D> {
         n.extend(positions);
     }
 
+    /// Whether some other track is near enough to lower the p_D of some particle of this set
+    /// (when false, the inner model's p_D stands unchanged).
+    pub fn lowers(&self, particles: &ParticleSet) -> bool {
+        self.share > 0.0 && particles.dim() >= 3 && !self.others_near(particles).is_empty()
+    }
+
+    /// The neighbours other than the set's own track that lie within reach of its weighted
+    /// mean (reach: `distance` + `fade` + 2 m for the particles' spread).
+    fn others_near(&self, particles: &ParticleSet) -> Vec<[f64; 2]> {
+        let neighbours = self.neighbours.read().unwrap_or_else(|e| e.into_inner());
+        if neighbours.is_empty() || particles.is_empty() {
+            return Vec::new();
+        }
+        let (xs, ys, w) = (
+            particles.component(0),
+            particles.component(2),
+            particles.weights(),
+        );
+        let total: f64 = w.iter().sum();
+        if !(total > 0.0) {
+            return Vec::new();
+        }
+        let mx = w.iter().zip(xs).map(|(w, x)| w * x).sum::<f64>() / total;
+        let my = w.iter().zip(ys).map(|(w, y)| w * y).sum::<f64>() / total;
+        let reach = self.distance + self.fade + 2.0;
+        let ex2 = self.exclusion * self.exclusion;
+        neighbours
+            .iter()
+            .filter(|n| {
+                let d2 = (n[0] - mx).powi(2) + (n[1] - my).powi(2);
+                d2 >= ex2 && d2 < reach * reach
+            })
+            .copied()
+            .collect()
+    }
+
     /// 1 − s · f(d) for the distance `d` to the nearest other neighbour.
     fn factor(&self, d: f64) -> f64 {
         let f = if d <= self.distance {
@@ -96,35 +132,11 @@ impl<D: DetectionModel> DetectionModel for ResolutionDetection<D> {
         if self.share == 0.0 || particles.dim() < 3 || particles.is_empty() {
             return;
         }
-        let neighbours = self.neighbours.read().unwrap_or_else(|e| e.into_inner());
-        if neighbours.is_empty() {
-            return;
-        }
-        let (xs, ys, w) = (
-            particles.component(0),
-            particles.component(2),
-            particles.weights(),
-        );
-        let total: f64 = w.iter().sum();
-        if !(total > 0.0) {
-            return;
-        }
-        let mx = w.iter().zip(xs).map(|(w, x)| w * x).sum::<f64>() / total;
-        let my = w.iter().zip(ys).map(|(w, y)| w * y).sum::<f64>() / total;
-        // Other tracks near enough to matter for some particle (spread allowance 2 m).
-        let reach = self.distance + self.fade + 2.0;
-        let ex2 = self.exclusion * self.exclusion;
-        let others: Vec<[f64; 2]> = neighbours
-            .iter()
-            .filter(|n| {
-                let d2 = (n[0] - mx).powi(2) + (n[1] - my).powi(2);
-                d2 >= ex2 && d2 < reach * reach
-            })
-            .copied()
-            .collect();
+        let others = self.others_near(particles);
         if others.is_empty() {
             return;
         }
+        let (xs, ys) = (particles.component(0), particles.component(2));
         for ((o, &x), &y) in out.iter_mut().zip(xs).zip(ys) {
             let d2 = others
                 .iter()
@@ -163,6 +175,7 @@ mod tests {
         m.set_neighbours([[0.05, 0.0], [10.0, 0.0]]);
         m.detection_probability(&s, &ctx, &mut out);
         assert_eq!(out, [0.9, 0.9]);
+        assert!(!m.lowers(&s));
     }
 
     #[test]
@@ -182,6 +195,7 @@ mod tests {
         let mut out = [0.0; 5];
         m.detection_probability(&s, &ctx, &mut out);
         let want = [0.9 * 0.5, 0.9 * 0.75, 0.9, 0.9, 0.9];
+        assert!(m.lowers(&s));
         for (o, w) in out.iter().zip(want) {
             assert!((o - w).abs() < 1e-12, "{out:?}");
         }
