@@ -172,7 +172,7 @@ pub fn evaluate_run(
             window.clear();
         }
         let seen = run.visible.get(k).map(Vec::as_slice).unwrap_or(&[]);
-        let (truth, unseen): (Vec<(u64, Vec<f64>)>, Vec<(u64, Vec<f64>)>) = run
+        let (truth, unseen): (Vec<Person>, Vec<Person>) = run
             .people_truth
             .get(k)
             .into_iter()
@@ -214,11 +214,14 @@ pub fn evaluate_run(
     })
 }
 
+/// A person's id and scored position.
+type Person = (u64, Vec<f64>);
+
 /// The estimates left after removing those that the optimal gated pairing of all present
 /// people (`seen` then `unseen`) gives to an unseen person.
 fn drop_unseen(
-    seen: &[(u64, Vec<f64>)],
-    unseen: &[(u64, Vec<f64>)],
+    seen: &[Person],
+    unseen: &[Person],
     estimates: Vec<(Label, Vec<f64>)>,
     c: f64,
     p: f64,

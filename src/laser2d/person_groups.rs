@@ -225,7 +225,7 @@ mod tests {
         let hits: Vec<(usize, f32)> = (0..361usize)
             .filter_map(|i| {
                 let b = -std::f64::consts::FRAC_PI_2 + i as f64 * std::f64::consts::PI / 360.0;
-                let (s, c) = b.sin_cos();
+                let c = b.cos();
                 // ray t·(c, s) against the circle |p − (d, 0)| = ρ
                 let disc = (d * c).powi(2) - (d * d - rho * rho);
                 (disc >= 0.0).then(|| (i, (d * c - disc.sqrt()) as f32))

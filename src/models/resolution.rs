@@ -96,7 +96,7 @@ impl<D: DetectionModel> ResolutionDetection<D> {
             particles.weights(),
         );
         let total: f64 = w.iter().sum();
-        if !(total > 0.0) {
+        if total.is_nan() || total <= 0.0 {
             return Vec::new();
         }
         let mx = w.iter().zip(xs).map(|(w, x)| w * x).sum::<f64>() / total;
@@ -204,8 +204,8 @@ mod tests {
     #[test]
     fn rejects_bad_parameters() {
         let inner = ConstantDetection::new(0.9).unwrap();
-        assert!(ResolutionDetection::new(inner.clone(), 1.5, 0.5, 1.5, 0.3).is_err());
-        assert!(ResolutionDetection::new(inner.clone(), f64::NAN, 0.5, 0.5, 0.3).is_err());
+        assert!(ResolutionDetection::new(inner, 1.5, 0.5, 1.5, 0.3).is_err());
+        assert!(ResolutionDetection::new(inner, f64::NAN, 0.5, 0.5, 0.3).is_err());
         assert!(ResolutionDetection::new(inner, 1.5, -1.0, 0.5, 0.3).is_err());
     }
 }
