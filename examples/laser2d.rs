@@ -4,7 +4,8 @@
 //!
 //! ```text
 //! cargo run --release --example laser2d -- --scenario one --runs 10 --seed 1 [--json]
-//!     [--trackers lmb,gnn,ml_ransac,jpda_imm] [--pose odometry|truth] [--frame robot|world]
+//!     [--trackers lmb,gnn,ml_ransac,jpda_imm] [--pose odometry|truth|icp] [--frame robot|world]
+//!     [--front-end segments|moving]
 //! cargo run --release --example laser2d -- --carmen intel.clf.bz2 --out people.json --plot tracks.svg
 //! cargo run --release --example laser2d -- --bag demo.bag --topic /scan --out people.json --plot tracks.png
 //! ```
@@ -15,6 +16,12 @@
 //! trackers the RMS prediction error and the time-averaged NIS with its 95 % interval.
 //! `--json` prints one object with a member per tracker.
 //!
+//! Front end (`--front-end`): `segments` hands the trackers every person-sized group of
+//! returns, `moving` only those the moving-object detector marks as moving. Without the flag
+//! it is chosen by scenario, and printed: `segments` for scenario one (no static structure to
+//! remove), `moving` for scenario two (the lobby's walls, pillars and desk) and for
+//! recordings. `--pose icp` hands the trackers the detector's ICP-corrected pose.
+//!
 //! With `--carmen` or `--bag` a recording is tracked end to end instead (LMB only): per-scan
 //! people as JSON (`--out`), a plot of the tracks over the scan points (`--plot`, `.svg` or
 //! `.png`), and a summary of the tracks on standard output.
@@ -24,6 +31,7 @@ use clap::Parser;
 use smc_lmb::laser2d::evaluate::{
     evaluate_run, summarise, EvalConfig, PoseSource, RunMetrics, ScoreFrame, Summary,
 };
+use smc_lmb::laser2d::front_end::FrontEnd;
 use smc_lmb::laser2d::{PeopleTracker, PeopleTrackerConfig};
 use smc_lmb::models::RangeBearing;
 use smc_lmb::sim::PeopleScenario;
@@ -52,6 +60,10 @@ struct Args {
     /// got — scores tracking apart from odometry drift) or `world` (drift counts as error).
     #[arg(long, default_value = "robot")]
     frame: String,
+    /// Which returns become measurements: `segments` or `moving`; default by scenario
+    /// (see the program documentation).
+    #[arg(long)]
+    front_end: Option<String>,
     /// Comma-separated trackers to run.
     #[arg(long, default_value = "lmb,gnn,ml_ransac,jpda_imm")]
     trackers: String,
@@ -104,13 +116,15 @@ fn run_simulated(args: &Args) -> Result<()> {
         pose: match args.pose.as_str() {
             "odometry" => PoseSource::Odometry,
             "truth" => PoseSource::Truth,
-            other => anyhow::bail!("--pose {other}: expected odometry or truth"),
+            "icp" => PoseSource::Icp,
+            other => anyhow::bail!("--pose {other}: expected odometry, truth or icp"),
         },
         frame: match args.frame.as_str() {
             "robot" => ScoreFrame::Robot,
             "world" => ScoreFrame::World,
             other => anyhow::bail!("--frame {other}: expected robot or world"),
         },
+        front_end: front_end(args)?,
         ..EvalConfig::default()
     };
     let names: Vec<&str> = args.trackers.split(',').map(str::trim).collect();
@@ -144,6 +158,18 @@ fn run_simulated(args: &Args) -> Result<()> {
         print_table(args, &names, &summaries);
         Ok(())
     }
+}
+
+/// The `--front-end` choice, or the scenario's default: `moving` wherever static structure
+/// is in view (the lobby, recordings), `segments` in scenario one's open space.
+fn front_end(args: &Args) -> Result<FrontEnd> {
+    Ok(match &args.front_end {
+        Some(name) => FrontEnd::parse(name)?,
+        None if args.carmen.is_none() && args.bag.is_none() && args.scenario == "one" => {
+            FrontEnd::Segments
+        }
+        None => FrontEnd::Moving,
+    })
 }
 
 /// Segmentation (and, for the LMB, filter) settings for the scenario's scanner.
@@ -199,6 +225,7 @@ fn build_tracker(
 fn print_json(args: &Args, names: &[&str], summaries: &[Summary]) -> Result<()> {
     let mut out = serde_json::json!({
         "scenario": args.scenario, "runs": args.runs, "seed": args.seed, "pose": args.pose, "frame": args.frame,
+        "front_end": front_end(args)?.name(),
     });
     for (name, s) in names.iter().zip(summaries) {
         out[*name] = serde_json::to_value(s)?;
@@ -210,12 +237,13 @@ fn print_json(args: &Args, names: &[&str], summaries: &[Summary]) -> Result<()> 
 fn print_table(args: &Args, names: &[&str], summaries: &[Summary]) {
     let scans = |s: &Summary| s.runs;
     println!(
-        "scenario {}, {} run(s) from seed {}, pose {}, {} frame; OSPA and OSPA(2) with c = 2 m, p = 1",
+        "scenario {}, {} run(s) from seed {}, pose {}, {} frame, front end {}; OSPA and OSPA(2) with c = 2 m, p = 1",
         args.scenario,
         summaries.first().map_or(0, scans),
         args.seed,
         args.pose,
-        args.frame
+        args.frame,
+        front_end(args).map_or("?", |f| f.name()),
     );
     println!(
         "{:<10} {:>8} {:>8} {:>9} {:>10} {:>9} {:>8} {:>22}",
