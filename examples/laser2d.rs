@@ -29,9 +29,13 @@
 use anyhow::{Context, Result};
 use clap::Parser;
 use smc_lmb::laser2d::evaluate::{
-    evaluate_run, summarise, EvalConfig, PoseSource, RunMetrics, ScoreFrame, Summary,
+    evaluate_run_with, summarise, EvalConfig, PoseSource, RunMetrics, ScoreFrame, Summary,
 };
-use smc_lmb::laser2d::front_end::FrontEnd;
+use smc_lmb::laser2d::front_end::{
+    adapt_tracker_config, default_detector_config, FrontEnd, MovingEvidence, PersonFrontEnd,
+    MOVING_CLUTTER_RATE, MOVING_DETECTION_PROBABILITY,
+};
+use smc_lmb::laser2d::moving::{MovingDetectorConfig, MovingRule};
 use smc_lmb::laser2d::{PeopleTracker, PeopleTrackerConfig};
 use smc_lmb::models::RangeBearing;
 use smc_lmb::sim::PeopleScenario;
@@ -64,6 +68,17 @@ struct Args {
     /// (see the program documentation).
     #[arg(long)]
     front_end: Option<String>,
+    /// Moving front end: which returns count as moving, `clusters` (the detector's moving
+    /// clusters) or `candidates` (every foreground return).
+    #[arg(long, default_value = "clusters")]
+    moving_evidence: String,
+    /// Moving front end: share of a person group's returns that must be moving.
+    #[arg(long, default_value_t = 0.5)]
+    moving_share: f64,
+    /// Moving front end: the detector's decision rule, `attenuation`, `veto` (attenuation
+    /// with the Fuzzy ART veto) or `voting` (seed 003).
+    #[arg(long, default_value = "attenuation")]
+    moving_rule: String,
     /// Comma-separated trackers to run.
     #[arg(long, default_value = "lmb,gnn,ml_ransac,jpda_imm")]
     trackers: String,
@@ -128,7 +143,7 @@ fn run_simulated(args: &Args) -> Result<()> {
         ..EvalConfig::default()
     };
     let names: Vec<&str> = args.trackers.split(',').map(str::trim).collect();
-    let detector = detector_config(&scenario, 0);
+    let detector = detector_config(&scenario, 0, eval.front_end);
     let mut per_tracker: Vec<Vec<RunMetrics>> = vec![Vec::new(); names.len()];
     for r in 0..args.runs {
         let seed = args.seed + r as u64;
@@ -136,8 +151,9 @@ fn run_simulated(args: &Args) -> Result<()> {
             .generate(seed)
             .with_context(|| format!("scenario {} seed {seed}", args.scenario))?;
         for (name, results) in names.iter().zip(per_tracker.iter_mut()) {
-            let mut tracker = build_tracker(name, &scenario, seed)?;
-            let m = evaluate_run(tracker.as_mut(), &run, &detector, &eval)
+            let mut tracker = build_tracker(name, &scenario, seed, eval.front_end)?;
+            let mut fe = build_front_end(args, &eval, &detector, &run)?;
+            let m = evaluate_run_with(tracker.as_mut(), &run, &mut fe, &eval)
                 .with_context(|| format!("{name} on seed {seed}"))?;
             if !args.json {
                 eprintln!(
@@ -172,8 +188,43 @@ fn front_end(args: &Args) -> Result<FrontEnd> {
     })
 }
 
+/// The front end of `eval` with the moving detector's options from the command line.
+fn build_front_end(
+    args: &Args,
+    eval: &EvalConfig,
+    people: &PeopleTrackerConfig,
+    run: &smc_lmb::sim::People2dRun,
+) -> Result<PersonFrontEnd> {
+    let needs_detector = eval.front_end == FrontEnd::Moving || eval.pose == PoseSource::Icp;
+    let moving = match run.scans.first() {
+        Some(scan) if needs_detector => Some(MovingDetectorConfig {
+            rule: moving_rule(args)?,
+            ..default_detector_config(people, scan.angle_increment)
+        }),
+        _ => None,
+    };
+    let mut fe = PersonFrontEnd::new(eval.front_end, people, moving)?;
+    fe.min_moving_share = args.moving_share;
+    fe.evidence = match args.moving_evidence.as_str() {
+        "clusters" => MovingEvidence::MovingClusters,
+        "candidates" => MovingEvidence::Candidates,
+        other => anyhow::bail!("--moving-evidence {other}: expected clusters or candidates"),
+    };
+    Ok(fe)
+}
+
+fn moving_rule(args: &Args) -> Result<MovingRule> {
+    Ok(match args.moving_rule.as_str() {
+        "attenuation" => MovingRule::Attenuation { veto: false },
+        "veto" => MovingRule::Attenuation { veto: true },
+        "voting" => MovingRule::Voting,
+        other => anyhow::bail!("--moving-rule {other}: expected attenuation, veto or voting"),
+    })
+}
+
 /// Segmentation (and, for the LMB, filter) settings for the scenario's scanner.
-fn detector_config(scenario: &PeopleScenario, seed: u64) -> PeopleTrackerConfig {
+/// With the moving front end the LMB assumes its detection probability and clutter rate.
+fn detector_config(scenario: &PeopleScenario, seed: u64, fe: FrontEnd) -> PeopleTrackerConfig {
     let s = &scenario.scanner;
     let mut cfg = PeopleTrackerConfig::for_scanner(
         s.sigma_range,
@@ -183,6 +234,7 @@ fn detector_config(scenario: &PeopleScenario, seed: u64) -> PeopleTrackerConfig 
         scenario.mount,
     );
     cfg.filter.seed = seed;
+    adapt_tracker_config(&mut cfg, fe);
     cfg
 }
 
@@ -200,10 +252,11 @@ fn build_tracker(
     name: &str,
     scenario: &PeopleScenario,
     seed: u64,
+    fe: FrontEnd,
 ) -> Result<Box<dyn PointTracker>> {
     let sensor = sensor_model(scenario)?;
     Ok(match name {
-        "lmb" => Box::new(PeopleTracker::new(detector_config(scenario, seed))?),
+        "lmb" => Box::new(PeopleTracker::new(detector_config(scenario, seed, fe))?),
         "gnn" => Box::new(GnnTracker::new(GnnConfig::new(sensor))?),
         "ml_ransac" => {
             let mut cfg = MlRansacConfig::new(sensor);
@@ -214,6 +267,11 @@ fn build_tracker(
             let mut cfg = JpdaImmConfig::new(sensor);
             let s = &scenario.scanner;
             cfg.clutter_density = 1.0 / (s.fov * s.range_max);
+            // The JPDA's P_D and clutter follow the front end as the LMB's do.
+            if fe == FrontEnd::Moving {
+                cfg.detection = MOVING_DETECTION_PROBABILITY;
+                cfg.clutter_density = MOVING_CLUTTER_RATE / (s.fov * s.range_max);
+            }
             Box::new(JpdaImmTracker::new(cfg)?)
         }
         other => {
