@@ -341,7 +341,7 @@ mod recording {
     use anyhow::{Context, Result};
     use plotters::prelude::*;
     use smc_lmb::laser2d::{
-        config_for_scans, read_bag, read_carmen, track_scans, write_people_json, BagOptions,
+        config_for_scans, read_bag, read_carmen, track_scans_with, write_people_json, BagOptions,
         CarmenOptions, PeopleRun, Scan, TimeOrder,
     };
     use std::path::Path;
@@ -361,7 +361,9 @@ mod recording {
         )?;
         cfg.filter.seed = args.seed;
         let t0 = Instant::now();
-        let run = track_scans(&scans, cfg)?;
+        let fe = super::front_end(args)?;
+        println!("front end {}", fe.name());
+        let run = track_scans_with(&scans, cfg, fe)?;
         let secs = t0.elapsed().as_secs_f64();
         if let Some(path) = &args.out {
             write_people_json(path, &run).with_context(|| format!("writing {}", path.display()))?;
@@ -446,11 +448,11 @@ mod recording {
         }
     }
 
-    /// World points of a scan: the sensor sits at the laser pose when the log has one, else at
-    /// the odometry pose, else at the origin.
-    fn world_points(s: &Scan) -> Vec<(f64, f64)> {
-        let pose = s.laser_pose.or(s.odometry);
-        let (x0, y0, th) = pose.map_or((0.0, 0.0, 0.0), |p| (p.x, p.y, p.theta));
+    /// World points of a scan: the sensor sits at the pose the tracker used (odometry or the
+    /// detector's ICP pose), else at the log's laser pose, else at the origin.
+    fn world_points(s: &Scan, used: Option<[f64; 3]>) -> Vec<(f64, f64)> {
+        let pose = used.or(s.laser_pose.or(s.odometry).map(|p| [p.x, p.y, p.theta]));
+        let (x0, y0, th) = pose.map_or((0.0, 0.0, 0.0), |p| (p[0], p[1], p[2]));
         let (sn, cs) = th.sin_cos();
         s.points()
             .map(|(_, [x, y])| (x0 + cs * x - sn * y, y0 + sn * x + cs * y))
@@ -459,7 +461,12 @@ mod recording {
 
     fn plot(path: &Path, scans: &[Scan], run: &PeopleRun) -> Result<()> {
         let every = (scans.len() / 200).max(1);
-        let points: Vec<(f64, f64)> = scans.iter().step_by(every).flat_map(world_points).collect();
+        let points: Vec<(f64, f64)> = scans
+            .iter()
+            .zip(&run.scans)
+            .step_by(every)
+            .flat_map(|(s, p)| world_points(s, p.pose))
+            .collect();
         let tracks: Vec<&smc_lmb::laser2d::PersonTrack> = run.tracks_with(8).collect();
         let mut paths: Vec<Vec<(f64, f64)>> = vec![Vec::new(); tracks.len()];
         for s in &run.scans {

@@ -59,7 +59,8 @@ pub use self::moving::{
 };
 pub use self::people_birth::PeopleBirth;
 pub use self::people_run::{
-    config_for_scans, track_scans, write_people_json, PeopleRun, PersonTrack, ScanPeople,
+    config_for_scans, track_scans, track_scans_with, write_people_json, PeopleRun, PersonTrack,
+    ScanPeople,
 };
 pub use self::person_groups::{person_groups, PersonGroup, PersonGrouping};
 pub use self::rosbag::{bag_topics, read_bag, BagOptions, BagScans, BagTopic, OdometryTopic};
