@@ -302,9 +302,7 @@ mod tests {
     fn a_group_is_kept_when_enough_of_its_returns_are_moving() {
         let s = scan();
         let mut moving = vec![false; 181];
-        for b in 10..=12 {
-            moving[b] = true;
-        }
+        moving[10..=12].fill(true);
         // 3 of 4 moving; 1 of 4 moving; none.
         let groups = vec![
             group(&[10, 11, 12, 13], &s),
