@@ -36,7 +36,7 @@ use smc_lmb::laser2d::front_end::{
     MOVING_CLUTTER_RATE, MOVING_DETECTION_PROBABILITY,
 };
 use smc_lmb::laser2d::moving::{MovingDetectorConfig, MovingRule};
-use smc_lmb::laser2d::{PeopleTracker, PeopleTrackerConfig};
+use smc_lmb::laser2d::{centre_noise, PeopleTracker, PeopleTrackerConfig};
 use smc_lmb::models::RangeBearing;
 use smc_lmb::sim::PeopleScenario;
 use smc_lmb::trackers::{
@@ -79,6 +79,10 @@ struct Args {
     /// with the Fuzzy ART veto) or `voting` (seed 003).
     #[arg(long, default_value = "attenuation")]
     moving_rule: String,
+    /// Score estimates of people who are present but unseen (hidden, too far, out of view) as
+    /// false instead of ignoring them.
+    #[arg(long)]
+    score_unseen: bool,
     /// Comma-separated trackers to run.
     #[arg(long, default_value = "lmb,gnn,ml_ransac,jpda_imm")]
     trackers: String,
@@ -140,6 +144,7 @@ fn run_simulated(args: &Args) -> Result<()> {
             other => anyhow::bail!("--frame {other}: expected robot or world"),
         },
         front_end: front_end(args)?,
+        ignore_unseen: !args.score_unseen,
         ..EvalConfig::default()
     };
     let names: Vec<&str> = args.trackers.split(',').map(str::trim).collect();
@@ -238,14 +243,12 @@ fn detector_config(scenario: &PeopleScenario, seed: u64, fe: FrontEnd) -> People
     cfg
 }
 
-/// The range-bearing sensor every baseline assumes: the scanner's noise (floored as the LMB
-/// floors it) and its mounting offset.
+/// The range-bearing sensor every baseline assumes: the noise of a person's measured centre,
+/// as the LMB assumes it, and the scanner's mounting offset.
 fn sensor_model(scenario: &PeopleScenario) -> Result<RangeBearing> {
     let s = &scenario.scanner;
-    Ok(
-        RangeBearing::new(s.sigma_range.max(0.05), s.sigma_bearing.max(0.005))?
-            .with_offset(scenario.mount[0], scenario.mount[1])?,
-    )
+    let (sr, sb) = centre_noise(s.sigma_range, s.sigma_bearing);
+    Ok(RangeBearing::new(sr, sb)?.with_offset(scenario.mount[0], scenario.mount[1])?)
 }
 
 fn build_tracker(

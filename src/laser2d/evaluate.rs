@@ -12,6 +12,13 @@
 //! they should be relative to the pose the tracker got. None of the trackers localises the
 //! robot, so drift is scored only with [`ScoreFrame::World`].
 //!
+//! The truth of a scan is the people the scanner saw (at least three beams ended on them).
+//! People who are present but unseen — hidden behind others, too far, outside the field of
+//! view — are "don't care" objects, as in the KITTI and MOT tracking benchmarks: an estimate
+//! the optimal gated pairing gives to one of them is dropped, neither right nor false, so a
+//! tracker is not punished for keeping a person through a short occlusion
+//! ([`EvalConfig::ignore_unseen`], on by default).
+//!
 //! Per run: mean OSPA and OSPA(2) (cut-off c and order p, seed-independent defaults c = 2 m,
 //! p = 1), label switches and whether every person kept one label ([`LabelConsistency`]),
 //! scans per second of segmentation plus tracking, and, for trackers that report innovations,
@@ -24,6 +31,8 @@
 use super::front_end::{default_detector_config, FrontEnd, PersonFrontEnd};
 use super::{PeopleTrackerConfig, Pose2};
 use crate::error::{Error, Result};
+use crate::filter::Label;
+use crate::metrics::gospa::gated_pairing;
 use crate::metrics::{average_nis, ospa, ospa2, tracks_from_frames, LabelConsistency, NisCheck};
 use crate::sim::People2dRun;
 use crate::trackers::{PointTracker, StepClock};
@@ -71,6 +80,9 @@ pub struct EvalConfig {
     pub nis_window: usize,
     /// Which returns become measurements. Default [`FrontEnd::Segments`].
     pub front_end: FrontEnd,
+    /// Estimates of people who are present but not seen (module documentation) are dropped
+    /// instead of scored as false. Default true.
+    pub ignore_unseen: bool,
 }
 
 impl Default for EvalConfig {
@@ -82,6 +94,7 @@ impl Default for EvalConfig {
             frame: ScoreFrame::Robot,
             nis_window: 20,
             front_end: FrontEnd::Segments,
+            ignore_unseen: true,
         }
     }
 }
@@ -196,21 +209,23 @@ pub fn evaluate_run_with(
             window.clear();
         }
         let seen = run.visible.get(k).map(Vec::as_slice).unwrap_or(&[]);
-        let truth: Vec<(u64, Vec<f64>)> = run
+        let (truth, unseen): (Vec<(u64, Vec<f64>)>, Vec<(u64, Vec<f64>)>) = run
             .people_truth
             .get(k)
             .into_iter()
             .flatten()
-            .filter(|(id, _, _)| seen.contains(id))
             .map(|(id, p, _)| {
                 let p = place.map_or(*p, |(from, to)| relocate(*p, from, to));
                 (*id, p.to_vec())
             })
-            .collect();
-        let x: Vec<_> = est
+            .partition(|(id, _)| seen.contains(id));
+        let mut x: Vec<_> = est
             .iter()
             .map(|e| (e.label, vec![e.state[0], e.state[2]]))
             .collect();
+        if config.ignore_unseen {
+            x = drop_unseen(&truth, &unseen, x, c, p)?;
+        }
         let tp: Vec<&Vec<f64>> = truth.iter().map(|(_, p)| p).collect();
         let xp: Vec<&Vec<f64>> = x.iter().map(|(_, p)| p).collect();
         ospa_sum += ospa(&tp, &xp, c, p)?.distance;
@@ -234,6 +249,36 @@ pub fn evaluate_run_with(
         nis,
         nis_windows: windows,
     })
+}
+
+/// The estimates left after removing those that the optimal gated pairing of all present
+/// people (`seen` then `unseen`) gives to an unseen person.
+fn drop_unseen(
+    seen: &[(u64, Vec<f64>)],
+    unseen: &[(u64, Vec<f64>)],
+    estimates: Vec<(Label, Vec<f64>)>,
+    c: f64,
+    p: f64,
+) -> Result<Vec<(Label, Vec<f64>)>> {
+    if unseen.is_empty() || estimates.is_empty() {
+        return Ok(estimates);
+    }
+    let people: Vec<&[f64]> = seen
+        .iter()
+        .chain(unseen)
+        .map(|(_, x)| x.as_slice())
+        .collect();
+    let ys: Vec<&[f64]> = estimates.iter().map(|(_, y)| y.as_slice()).collect();
+    let pairing = gated_pairing(&people, &ys, c, p)?;
+    let mut drop = vec![false; estimates.len()];
+    for j in pairing[seen.len()..].iter().flatten() {
+        drop[*j] = true;
+    }
+    Ok(estimates
+        .into_iter()
+        .zip(drop)
+        .filter_map(|(e, d)| (!d).then_some(e))
+        .collect())
 }
 
 /// The world point `p` seen from robot pose `from`, placed at the same spot relative to `to`.
@@ -342,6 +387,26 @@ mod tests {
             (q[0] - 3.0).abs() < 1e-12 && (q[1] + 4.0).abs() < 1e-12,
             "{q:?}"
         );
+    }
+
+    #[test]
+    fn estimates_of_unseen_people_are_dropped_not_scored() {
+        let l = |i| Label {
+            birth_step: 0,
+            index: i,
+        };
+        let seen = vec![(1, vec![0.0, 0.0])];
+        let unseen = vec![(2, vec![5.0, 0.0])];
+        let est = vec![
+            (l(0), vec![0.1, 0.0]),  // the seen person
+            (l(1), vec![5.2, 0.1]),  // the hidden person: dropped
+            (l(2), vec![20.0, 0.0]), // nobody: stays, a false estimate
+        ];
+        let kept = drop_unseen(&seen, &unseen, est.clone(), 2.0, 1.0).unwrap();
+        let labels: Vec<u32> = kept.iter().map(|(l, _)| l.index).collect();
+        assert_eq!(labels, vec![0, 2]);
+        // Nobody unseen: nothing dropped.
+        assert_eq!(drop_unseen(&seen, &[], est.clone(), 2.0, 1.0).unwrap(), est);
     }
 
     #[test]

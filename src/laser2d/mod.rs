@@ -67,5 +67,6 @@ pub use self::rosbag::{bag_topics, read_bag, BagOptions, BagScans, BagTopic, Odo
 pub use self::scan::{attach_odometry, OdometryRecord, Pose2, Scan};
 pub use self::segment::{breakpoint_threshold, segment_scan, BreakpointConfig, Segment};
 pub use self::tracking::{
-    person_measurements, person_segments, PeopleTracker, PeopleTrackerConfig, PersonEstimate,
+    centre_noise, person_measurements, person_segments, PeopleTracker, PeopleTrackerConfig,
+    PersonEstimate,
 };

@@ -149,6 +149,7 @@ pub mod detection;
 pub mod occlusion;
 pub mod position;
 pub mod range_bearing;
+pub mod resolution;
 pub mod survival;
 pub mod view_survival;
 
@@ -159,6 +160,7 @@ pub use detection::{ConstantDetection, FieldOfViewDetection, GaussianRangeDetect
 pub use occlusion::{BeamView, OcclusionDetection};
 pub use position::PositionMeasurement;
 pub use range_bearing::{wrap_angle, BearingConvention, RangeBearing};
+pub use resolution::ResolutionDetection;
 pub use survival::ConstantSurvival;
 pub use view_survival::FieldOfViewSurvival;
 
