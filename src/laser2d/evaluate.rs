@@ -99,6 +99,9 @@ impl Default for EvalConfig {
     }
 }
 
+/// A person of one scan: id and position.
+type Person = (u64, Vec<f64>);
+
 /// The scores of one run.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RunMetrics {
@@ -209,7 +212,7 @@ pub fn evaluate_run_with(
             window.clear();
         }
         let seen = run.visible.get(k).map(Vec::as_slice).unwrap_or(&[]);
-        let (truth, unseen): (Vec<(u64, Vec<f64>)>, Vec<(u64, Vec<f64>)>) = run
+        let (truth, unseen): (Vec<Person>, Vec<Person>) = run
             .people_truth
             .get(k)
             .into_iter()
