@@ -12,6 +12,8 @@
 //!   [`rigid`] (planar motions), [`icp`] (scan matching), [`local_map`] (averaged static
 //!   points), [`background`] (per-beam background map), [`features`] (segment shape
 //!   features) and [`fuzzy_art`] (on-line shape categories).
+//!   [`moving_rule`] decides which clusters are moving; [`front_end`] turns a scan into the
+//!   trackers' measurements (every person-sized segment, or only the moving ones).
 //! * [`tracking`]: people tracking with the LMB filter; [`people_birth`] its birth model,
 //!   [`motion_state`] the static/dynamic classification of its tracks, [`person_groups`]
 //!   the grouping of returns into person candidates, [`people_run`] a whole recording.
