@@ -1,7 +1,7 @@
 //! The people trackers' front end: turns one scan into the range-bearing measurements of the
 //! people's centres that every tracker (the LMB and the baselines) is handed.
 //!
-//! * [`FrontEnd::Segments`]: every person-sized group of returns ([`super::person_groups`]),
+//! * [`FrontEnd::Segments`]: every person-sized group of returns ([`super::person_groups()`]),
 //!   whatever it belongs to. Right in an open space; in a room every piece of wall, pillar or
 //!   furniture of person size becomes a "person".
 //! * [`FrontEnd::Moving`]: the same person groups, kept only when the moving-object detector
