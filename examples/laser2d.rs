@@ -4,7 +4,8 @@
 //!
 //! ```text
 //! cargo run --release --example laser2d -- --scenario one --runs 10 --seed 1 [--json]
-//!     [--trackers lmb,gnn,ml_ransac,jpda_imm] [--pose odometry|truth] [--frame robot|world]
+//!     [--trackers lmb,gnn,ml_ransac,jpda_imm] [--pose odometry|truth|icp] [--frame robot|world]
+//!     [--front-end segments|moving]
 //! cargo run --release --example laser2d -- --carmen intel.clf.bz2 [--scans 2000..2600] --out people.json --plot tracks.svg
 //! cargo run --release --example laser2d -- --bag demo.bag --topic /scan --out people.json --plot tracks.png
 //! ```
@@ -15,6 +16,12 @@
 //! trackers the RMS prediction error and the time-averaged NIS with its 95 % interval.
 //! `--json` prints one object with a member per tracker.
 //!
+//! Front end (`--front-end`): `segments` hands the trackers every person-sized group of
+//! returns, `moving` only those the moving-object detector marks as moving. Without the flag
+//! it is chosen by scenario, and printed: `segments` for scenario one (no static structure to
+//! remove), `moving` for scenario two (the lobby's walls, pillars and desk) and for
+//! recordings. `--pose icp` hands the trackers the detector's ICP-corrected pose.
+//!
 //! With `--carmen` or `--bag` a recording is tracked end to end instead (LMB only): per-scan
 //! people as JSON (`--out`), a plot of the tracks over the scan points (`--plot`, `.svg` or
 //! `.png`), and a summary of the tracks on standard output.
@@ -22,8 +29,13 @@
 use anyhow::{Context, Result};
 use clap::Parser;
 use smc_lmb::laser2d::evaluate::{
-    evaluate_run, summarise, EvalConfig, PoseSource, RunMetrics, ScoreFrame, Summary,
+    evaluate_run_with, summarise, EvalConfig, PoseSource, RunMetrics, ScoreFrame, Summary,
 };
+use smc_lmb::laser2d::front_end::{
+    adapt_tracker_config, default_detector_config, FrontEnd, MovingEvidence, PersonFrontEnd,
+    MOVING_CLUTTER_RATE, MOVING_DETECTION_PROBABILITY,
+};
+use smc_lmb::laser2d::moving::{MovingDetectorConfig, MovingRule};
 use smc_lmb::laser2d::{centre_noise, PeopleTracker, PeopleTrackerConfig};
 use smc_lmb::models::RangeBearing;
 use smc_lmb::sim::PeopleScenario;
@@ -52,6 +64,21 @@ struct Args {
     /// got — scores tracking apart from odometry drift) or `world` (drift counts as error).
     #[arg(long, default_value = "robot")]
     frame: String,
+    /// Which returns become measurements: `segments` or `moving`; default by scenario
+    /// (see the program documentation).
+    #[arg(long)]
+    front_end: Option<String>,
+    /// Moving front end: which returns count as moving, `clusters` (the detector's moving
+    /// clusters) or `candidates` (every foreground return).
+    #[arg(long, default_value = "clusters")]
+    moving_evidence: String,
+    /// Moving front end: share of a person group's returns that must be moving.
+    #[arg(long, default_value_t = 0.5)]
+    moving_share: f64,
+    /// Moving front end: the detector's decision rule, `attenuation`, `veto` (attenuation
+    /// with the Fuzzy ART veto) or `voting` (seed 003).
+    #[arg(long, default_value = "attenuation")]
+    moving_rule: String,
     /// Score estimates of people who are present but unseen (hidden, too far, out of view) as
     /// false instead of ignoring them.
     #[arg(long)]
@@ -111,18 +138,20 @@ fn run_simulated(args: &Args) -> Result<()> {
         pose: match args.pose.as_str() {
             "odometry" => PoseSource::Odometry,
             "truth" => PoseSource::Truth,
-            other => anyhow::bail!("--pose {other}: expected odometry or truth"),
+            "icp" => PoseSource::Icp,
+            other => anyhow::bail!("--pose {other}: expected odometry, truth or icp"),
         },
         frame: match args.frame.as_str() {
             "robot" => ScoreFrame::Robot,
             "world" => ScoreFrame::World,
             other => anyhow::bail!("--frame {other}: expected robot or world"),
         },
+        front_end: front_end(args)?,
         ignore_unseen: !args.score_unseen,
         ..EvalConfig::default()
     };
     let names: Vec<&str> = args.trackers.split(',').map(str::trim).collect();
-    let detector = detector_config(&scenario, 0);
+    let detector = detector_config(&scenario, 0, eval.front_end);
     let mut per_tracker: Vec<Vec<RunMetrics>> = vec![Vec::new(); names.len()];
     for r in 0..args.runs {
         let seed = args.seed + r as u64;
@@ -130,8 +159,9 @@ fn run_simulated(args: &Args) -> Result<()> {
             .generate(seed)
             .with_context(|| format!("scenario {} seed {seed}", args.scenario))?;
         for (name, results) in names.iter().zip(per_tracker.iter_mut()) {
-            let mut tracker = build_tracker(name, &scenario, seed)?;
-            let m = evaluate_run(tracker.as_mut(), &run, &detector, &eval)
+            let mut tracker = build_tracker(name, &scenario, seed, eval.front_end)?;
+            let mut fe = build_front_end(args, &eval, &detector, &run)?;
+            let m = evaluate_run_with(tracker.as_mut(), &run, &mut fe, &eval)
                 .with_context(|| format!("{name} on seed {seed}"))?;
             if !args.json {
                 eprintln!(
@@ -154,8 +184,55 @@ fn run_simulated(args: &Args) -> Result<()> {
     }
 }
 
+/// The `--front-end` choice, or the scenario's default: `moving` wherever static structure
+/// is in view (the lobby, recordings), `segments` in scenario one's open space.
+fn front_end(args: &Args) -> Result<FrontEnd> {
+    Ok(match &args.front_end {
+        Some(name) => FrontEnd::parse(name)?,
+        None if args.carmen.is_none() && args.bag.is_none() && args.scenario == "one" => {
+            FrontEnd::Segments
+        }
+        None => FrontEnd::Moving,
+    })
+}
+
+/// The front end of `eval` with the moving detector's options from the command line.
+fn build_front_end(
+    args: &Args,
+    eval: &EvalConfig,
+    people: &PeopleTrackerConfig,
+    run: &smc_lmb::sim::People2dRun,
+) -> Result<PersonFrontEnd> {
+    let needs_detector = eval.front_end == FrontEnd::Moving || eval.pose == PoseSource::Icp;
+    let moving = match run.scans.first() {
+        Some(scan) if needs_detector => Some(MovingDetectorConfig {
+            rule: moving_rule(args)?,
+            ..default_detector_config(people, scan.angle_increment)
+        }),
+        _ => None,
+    };
+    let mut fe = PersonFrontEnd::new(eval.front_end, people, moving)?;
+    fe.min_moving_share = args.moving_share;
+    fe.evidence = match args.moving_evidence.as_str() {
+        "clusters" => MovingEvidence::MovingClusters,
+        "candidates" => MovingEvidence::Candidates,
+        other => anyhow::bail!("--moving-evidence {other}: expected clusters or candidates"),
+    };
+    Ok(fe)
+}
+
+fn moving_rule(args: &Args) -> Result<MovingRule> {
+    Ok(match args.moving_rule.as_str() {
+        "attenuation" => MovingRule::Attenuation { veto: false },
+        "veto" => MovingRule::Attenuation { veto: true },
+        "voting" => MovingRule::Voting,
+        other => anyhow::bail!("--moving-rule {other}: expected attenuation, veto or voting"),
+    })
+}
+
 /// Segmentation (and, for the LMB, filter) settings for the scenario's scanner.
-fn detector_config(scenario: &PeopleScenario, seed: u64) -> PeopleTrackerConfig {
+/// With the moving front end the LMB assumes its detection probability and clutter rate.
+fn detector_config(scenario: &PeopleScenario, seed: u64, fe: FrontEnd) -> PeopleTrackerConfig {
     let s = &scenario.scanner;
     let mut cfg = PeopleTrackerConfig::for_scanner(
         s.sigma_range,
@@ -165,6 +242,7 @@ fn detector_config(scenario: &PeopleScenario, seed: u64) -> PeopleTrackerConfig 
         scenario.mount,
     );
     cfg.filter.seed = seed;
+    adapt_tracker_config(&mut cfg, fe);
     cfg
 }
 
@@ -180,10 +258,11 @@ fn build_tracker(
     name: &str,
     scenario: &PeopleScenario,
     seed: u64,
+    fe: FrontEnd,
 ) -> Result<Box<dyn PointTracker>> {
     let sensor = sensor_model(scenario)?;
     Ok(match name {
-        "lmb" => Box::new(PeopleTracker::new(detector_config(scenario, seed))?),
+        "lmb" => Box::new(PeopleTracker::new(detector_config(scenario, seed, fe))?),
         "gnn" => Box::new(GnnTracker::new(GnnConfig::new(sensor))?),
         "ml_ransac" => {
             let mut cfg = MlRansacConfig::new(sensor);
@@ -194,6 +273,11 @@ fn build_tracker(
             let mut cfg = JpdaImmConfig::new(sensor);
             let s = &scenario.scanner;
             cfg.clutter_density = 1.0 / (s.fov * s.range_max);
+            // The JPDA's P_D and clutter follow the front end as the LMB's do.
+            if fe == FrontEnd::Moving {
+                cfg.detection = MOVING_DETECTION_PROBABILITY;
+                cfg.clutter_density = MOVING_CLUTTER_RATE / (s.fov * s.range_max);
+            }
             Box::new(JpdaImmTracker::new(cfg)?)
         }
         other => {
@@ -205,6 +289,7 @@ fn build_tracker(
 fn print_json(args: &Args, names: &[&str], summaries: &[Summary]) -> Result<()> {
     let mut out = serde_json::json!({
         "scenario": args.scenario, "runs": args.runs, "seed": args.seed, "pose": args.pose, "frame": args.frame,
+        "front_end": front_end(args)?.name(),
     });
     for (name, s) in names.iter().zip(summaries) {
         out[*name] = serde_json::to_value(s)?;
@@ -216,12 +301,13 @@ fn print_json(args: &Args, names: &[&str], summaries: &[Summary]) -> Result<()> 
 fn print_table(args: &Args, names: &[&str], summaries: &[Summary]) {
     let scans = |s: &Summary| s.runs;
     println!(
-        "scenario {}, {} run(s) from seed {}, pose {}, {} frame; OSPA and OSPA(2) with c = 2 m, p = 1",
+        "scenario {}, {} run(s) from seed {}, pose {}, {} frame, front end {}; OSPA and OSPA(2) with c = 2 m, p = 1",
         args.scenario,
         summaries.first().map_or(0, scans),
         args.seed,
         args.pose,
-        args.frame
+        args.frame,
+        front_end(args).map_or("?", |f| f.name()),
     );
     println!(
         "{:<10} {:>8} {:>8} {:>9} {:>10} {:>9} {:>8} {:>22}",
@@ -260,7 +346,7 @@ mod recording {
     use super::Args;
     use anyhow::{Context, Result};
     use smc_lmb::laser2d::{
-        config_for_scans, read_bag, read_carmen, track_scans, write_people_json, BagOptions,
+        config_for_scans, read_bag, read_carmen, track_scans_with, write_people_json, BagOptions,
         CarmenOptions, PeopleRun, Scan, TimeOrder,
     };
     use smc_lmb::plot::{write_people_plot, PeoplePlotOptions};
@@ -281,7 +367,9 @@ mod recording {
         )?;
         cfg.filter.seed = args.seed;
         let t0 = Instant::now();
-        let run = track_scans(&scans, cfg)?;
+        let fe = super::front_end(args)?;
+        println!("front end {}", fe.name());
+        let run = track_scans_with(&scans, cfg, fe)?;
         let secs = t0.elapsed().as_secs_f64();
         if let Some(path) = &args.out {
             write_people_json(path, &run).with_context(|| format!("writing {}", path.display()))?;

@@ -1,7 +1,11 @@
 //! Scores a people tracker on a simulated run ([`People2dRun`]): every scan is turned into
-//! range-bearing measurements of person-sized segments ([`person_measurements`]), handed with
-//! the robot's pose to any [`PointTracker`], and the estimates are compared with the people the
-//! scanner actually saw (at least three beams on them).
+//! range-bearing measurements by the front end ([`FrontEnd`]: every person-sized segment, or
+//! only those the moving-object detector marks as moving), handed with the robot's pose to any
+//! [`PointTracker`], and the estimates are compared with the people the scanner actually saw
+//! (at least three beams on them).
+//!
+//! The pose is the odometry, the simulator's truth, or the moving-object detector's
+//! ICP-corrected pose ([`PoseSource::Icp`]; a detector then runs whatever the front end).
 //!
 //! With the odometry pose the truth is, by default, moved into the tracker's frame scan by
 //! scan ([`ScoreFrame::Robot`]): where the person is relative to the true robot pose is where
@@ -24,7 +28,8 @@
 //!
 //! Not for: real recordings without ground truth.
 
-use super::{person_measurements, PeopleTrackerConfig, Pose2};
+use super::front_end::{default_detector_config, FrontEnd, PersonFrontEnd};
+use super::{PeopleTrackerConfig, Pose2};
 use crate::error::{Error, Result};
 use crate::filter::Label;
 use crate::metrics::gospa::gated_pairing;
@@ -43,6 +48,8 @@ pub enum PoseSource {
     Odometry,
     /// The simulator's true robot pose (judges the tracker apart from localisation).
     Truth,
+    /// The odometry refined by the moving-object detector's ICP against its local map.
+    Icp,
 }
 
 /// The frame the estimates are scored in.
@@ -71,6 +78,8 @@ pub struct EvalConfig {
     pub frame: ScoreFrame,
     /// Steps K per time-averaged NIS window. Default 20.
     pub nis_window: usize,
+    /// Which returns become measurements. Default [`FrontEnd::Segments`].
+    pub front_end: FrontEnd,
     /// Estimates of people who are present but not seen (module documentation) are dropped
     /// instead of scored as false. Default true.
     pub ignore_unseen: bool,
@@ -84,10 +93,14 @@ impl Default for EvalConfig {
             pose: PoseSource::Odometry,
             frame: ScoreFrame::Robot,
             nis_window: 20,
+            front_end: FrontEnd::Segments,
             ignore_unseen: true,
         }
     }
 }
+
+/// A person of one scan: id and position.
+type Person = (u64, Vec<f64>);
 
 /// The scores of one run.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -123,11 +136,32 @@ impl RunMetrics {
     }
 }
 
-/// Runs `tracker` over `run`, measuring with `detector` (its segmentation settings).
+/// Runs `tracker` over `run`, measuring with `detector` (its segmentation settings) through
+/// the front end `config.front_end`; the moving-object detector, when one runs, takes
+/// [`default_detector_config`].
 pub fn evaluate_run(
     tracker: &mut dyn PointTracker,
     run: &People2dRun,
     detector: &PeopleTrackerConfig,
+    config: &EvalConfig,
+) -> Result<RunMetrics> {
+    let needs_detector = config.front_end == FrontEnd::Moving || config.pose == PoseSource::Icp;
+    let moving = match run.scans.first() {
+        Some(scan) if needs_detector => {
+            Some(default_detector_config(detector, scan.angle_increment))
+        }
+        _ => None,
+    };
+    let mut front_end = PersonFrontEnd::new(config.front_end, detector, moving)?;
+    evaluate_run_with(tracker, run, &mut front_end, config)
+}
+
+/// [`evaluate_run`] with a front end of the caller's (`config.front_end` is not read; a
+/// [`PoseSource::Icp`] run needs a front end that runs a detector).
+pub fn evaluate_run_with(
+    tracker: &mut dyn PointTracker,
+    run: &People2dRun,
+    front_end: &mut PersonFrontEnd,
     config: &EvalConfig,
 ) -> Result<RunMetrics> {
     let (c, p) = (config.cutoff, config.order);
@@ -144,19 +178,25 @@ pub fn evaluate_run(
         let true_pose = *run.robot_truth.get(k).ok_or_else(|| {
             Error::invalid("people run", format!("no true robot pose for scan {k}"))
         })?;
+        let t0 = Instant::now();
+        let out = front_end.measure(scan, scan.odometry)?;
         let pose = match config.pose {
             PoseSource::Odometry => scan.odometry,
             PoseSource::Truth => Some(true_pose),
+            PoseSource::Icp => Some(out.corrected_pose.ok_or_else(|| {
+                Error::invalid(
+                    "pose source icp",
+                    "the front end runs no moving-object detector",
+                )
+            })?),
         };
         let place = match (config.frame, pose) {
             (ScoreFrame::Robot, Some(given)) => Some((true_pose, given)),
             _ => None,
         };
         let ctx = clock.tick(scan.time, pose)?;
-        let t0 = Instant::now();
-        let z = person_measurements(detector, scan)?;
         tracker.observe_scan(scan);
-        let est = tracker.step(&z, &ctx)?;
+        let est = tracker.step(&out.measurements, &ctx)?;
         seconds += t0.elapsed().as_secs_f64();
         for inn in tracker.innovations() {
             sq += inn.position_error[0].powi(2) + inn.position_error[1].powi(2);
@@ -213,9 +253,6 @@ pub fn evaluate_run(
         nis_windows: windows,
     })
 }
-
-/// A person's id and scored position.
-type Person = (u64, Vec<f64>);
 
 /// The estimates left after removing those that the optimal gated pairing of all present
 /// people (`seen` then `unseen`) gives to an unseen person.

@@ -12,6 +12,8 @@
 //!   [`rigid`] (planar motions), [`icp`] (scan matching), [`local_map`] (averaged static
 //!   points), [`background`] (per-beam background map), [`features`] (segment shape
 //!   features) and [`fuzzy_art`] (on-line shape categories).
+//!   [`moving_rule`] decides which clusters are moving; [`front_end`] turns a scan into the
+//!   trackers' measurements (every person-sized segment, or only the moving ones).
 //! * [`tracking`]: people tracking with the LMB filter; [`people_birth`] its birth model,
 //!   [`motion_state`] the static/dynamic classification of its tracks, [`person_groups`]
 //!   the grouping of returns into person candidates, [`people_run`] a whole recording.
@@ -32,11 +34,13 @@ pub mod carmen;
 pub mod csv;
 pub mod evaluate;
 pub mod features;
+pub mod front_end;
 pub mod fuzzy_art;
 pub mod icp;
 pub mod local_map;
 pub mod motion_state;
 pub mod moving;
+pub mod moving_rule;
 pub mod people_birth;
 pub mod people_run;
 pub mod person_groups;
@@ -57,7 +61,8 @@ pub use self::moving::{
 };
 pub use self::people_birth::PeopleBirth;
 pub use self::people_run::{
-    config_for_scans, track_scans, write_people_json, PeopleRun, PersonTrack, ScanPeople,
+    config_for_scans, track_scans, track_scans_with, write_people_json, PeopleRun, PersonTrack,
+    ScanPeople,
 };
 pub use self::person_groups::{person_groups, PersonGroup, PersonGrouping};
 pub use self::rosbag::{bag_topics, read_bag, BagOptions, BagScans, BagTopic, OdometryTopic};

@@ -42,6 +42,11 @@
 //!    [`MovingDetectorConfig::vote_margin`] (15) of the highest (eq. 8). A kept cluster is a
 //!    moving target when its category is dominant and, with
 //!    [`MovingDetectorConfig::require_persistence`], it persists.
+//!    That is seed 003's rule ([`MovingRule::Voting`]); [`MovingRule::Attenuation`] instead
+//!    takes every cluster of foreground returns as moving (no local-minimum test, no
+//!    persistence) and lets a non-dominant category veto it only when asked to (see the
+//!    moving-rule module for the reasons). Every cluster is reported with the stage at which
+//!    it ended ([`MovingDetections::all_clusters`]), so each stage's recall can be measured.
 //! 5. The background is updated (eqs. 4, 6); beams of moving targets keep their weights.
 //!    Returns that are not foreground and whose beam weight reached
 //!    [`MovingDetectorConfig::map_min_weight`] join the local map (world frame).
@@ -53,6 +58,7 @@ use super::features::{normalise, segment_features, Features, SegmentContext, NUM
 use super::fuzzy_art::{FuzzyArt, FuzzyArtConfig};
 use super::icp::{Icp, IcpConfig, IcpFit};
 use super::local_map::LocalMap;
+pub use super::moving_rule::{ClusterEvidence, ClusterStage, MovingRule};
 use super::rigid::{between, compose, inverse, transform_point};
 use super::scan::{Pose2, Scan};
 use crate::error::{ensure_positive, Error, Result};
@@ -111,8 +117,11 @@ pub struct MovingDetectorConfig {
     /// Largest centroid displacement between scans for a cluster to persist (m).
     /// Default 0.8 m.
     pub association_gate: f64,
-    /// Only persisting clusters can be moving targets. Default true.
+    /// Only persisting clusters can be moving targets (with [`MovingRule::Voting`]).
+    /// Default true.
     pub require_persistence: bool,
+    /// How clusters become moving targets. Default [`MovingRule::Voting`] (seed 003).
+    pub rule: MovingRule,
 }
 
 impl Default for MovingDetectorConfig {
@@ -140,6 +149,7 @@ impl Default for MovingDetectorConfig {
             forget_every: 10,
             association_gate: 0.8,
             require_persistence: true,
+            rule: MovingRule::Voting,
         }
     }
 }
@@ -227,6 +237,17 @@ pub struct MovingCluster {
     pub persistent: bool,
 }
 
+/// One cluster of foreground returns and the stage at which it ended.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClusterReport {
+    /// Beam indices of its points, increasing.
+    pub beams: Vec<usize>,
+    /// Mean of the points, world (corrected odometry) frame.
+    pub centroid: [f64; 2],
+    /// Where the decision rule left it.
+    pub stage: ClusterStage,
+}
+
 /// What [`MovingObjectDetector::process`] found in one scan.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MovingDetections {
@@ -244,6 +265,10 @@ pub struct MovingDetections {
     pub candidate_points: usize,
     /// Returns not classified as foreground.
     pub background_points: usize,
+    /// Beam indices of the candidates (foreground returns off the static map), increasing.
+    pub candidates: Vec<usize>,
+    /// Every cluster of candidates, in order of its first beam, with its stage.
+    pub all_clusters: Vec<ClusterReport>,
 }
 
 /// A kept cluster before the voting decides (internal).
@@ -364,14 +389,34 @@ impl MovingObjectDetector {
                 }
             }
         }
-        // 3. Clusters with a local minimum.
+        // 3. Clusters (with a local minimum when the rule asks for one).
         let clusters = self.cluster(&candidates);
         self.smooth(scan);
-        let kept_beams: Vec<Vec<usize>> = clusters
-            .into_iter()
-            .filter(|c| c.len() >= self.config.min_cluster_points)
-            .filter(|c| c.iter().any(|&i| self.is_local_minimum(i)))
-            .collect();
+        let rule = self.config.rule;
+        let mut all_clusters = Vec::new();
+        let mut kept_beams: Vec<Vec<usize>> = Vec::new();
+        for c in clusters {
+            let local_minimum = c.iter().any(|&i| self.is_local_minimum(i));
+            let early = rule.decide(
+                &ClusterEvidence {
+                    points: c.len(),
+                    local_minimum,
+                    persistent: true,
+                    dominant: true,
+                },
+                self.config.min_cluster_points,
+                false,
+            );
+            if early == ClusterStage::Moving {
+                kept_beams.push(c);
+            } else {
+                all_clusters.push(ClusterReport {
+                    centroid: self.world_centroid(&c, sensor_pose),
+                    beams: c,
+                    stage: early,
+                });
+            }
+        }
         // 4. Features, categories, votes.
         let mut kept = Vec::with_capacity(kept_beams.len());
         for beams in kept_beams {
@@ -399,7 +444,22 @@ impl MovingObjectDetector {
         let kept_clusters = kept.len();
         let mut moving = Vec::new();
         for k in &kept {
-            if dominant(k.category) && (k.persistent || !self.config.require_persistence) {
+            let stage = rule.decide(
+                &ClusterEvidence {
+                    points: k.beams.len(),
+                    local_minimum: true,
+                    persistent: k.persistent,
+                    dominant: dominant(k.category),
+                },
+                self.config.min_cluster_points,
+                self.config.require_persistence,
+            );
+            all_clusters.push(ClusterReport {
+                beams: k.beams.clone(),
+                centroid: k.centroid,
+                stage,
+            });
+            if stage == ClusterStage::Moving {
                 for &b in &k.beams {
                     self.occluded[b] = true;
                 }
@@ -419,6 +479,7 @@ impl MovingObjectDetector {
                 });
             }
         }
+        all_clusters.sort_by_key(|c| c.beams[0]);
         self.previous_centroids.clear();
         self.previous_centroids
             .extend(kept.iter().map(|k| k.centroid));
@@ -434,6 +495,8 @@ impl MovingObjectDetector {
             kept_clusters,
             candidate_points: candidates.len(),
             background_points,
+            candidates,
+            all_clusters,
         })
     }
 
@@ -540,10 +603,23 @@ impl MovingObjectDetector {
     }
 
     fn is_local_minimum(&self, i: usize) -> bool {
+        if !self.config.rule.uses_local_minimum() {
+            return false;
+        }
         let n = self.smoothed.len();
         let w = self.config.minima_window;
         let v = self.smoothed[i];
         v.is_finite() && (i.saturating_sub(w)..(i + w + 1).min(n)).all(|j| self.smoothed[j] >= v)
+    }
+
+    /// Mean of the cluster's returns in the world frame.
+    fn world_centroid(&self, beams: &[usize], sensor_pose: Pose2) -> [f64; 2] {
+        let n = beams.len().max(1) as f64;
+        let c = beams
+            .iter()
+            .filter_map(|&b| self.sensor_points[b])
+            .fold([0.0, 0.0], |a, p| [a[0] + p[0] / n, a[1] + p[1] / n]);
+        transform_point(sensor_pose, c)
     }
 
     /// Features, category and persistence of one kept cluster.

@@ -3,13 +3,22 @@
 //! it lived, how fast it went, how often it was dynamic) and writes the per-scan estimates as
 //! JSON.
 //!
+//! The measurements come from a front end ([`FrontEnd`]): every person-sized segment
+//! ([`track_scans`]), or, with [`track_scans_with`] and [`FrontEnd::Moving`], only those the
+//! moving-object detector marks as moving; the tracker then assumes that front end's
+//! detection probability and clutter rate ([`adapt_tracker_config`]) and is handed the
+//! detector's ICP-corrected pose instead of the raw odometry, so that odometry drift does not
+//! make furniture look like walking people.
+//!
 //! Not for: reading the recordings (see [`super::carmen`], [`super::rosbag`]), plotting, or
 //! scoring against ground truth.
 
+use super::front_end::{adapt_tracker_config, default_detector_config, FrontEnd, PersonFrontEnd};
 use super::tracking::{PeopleTracker, PeopleTrackerConfig, PersonEstimate};
 use super::{Pose2, Scan};
 use crate::error::{Error, Result};
 use crate::filter::Label;
+use crate::trackers::platform_isometry;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -20,7 +29,8 @@ pub struct ScanPeople {
     pub scan: usize,
     /// Time stamp (s).
     pub time: f64,
-    /// Robot pose used for the scan (odometry), if any.
+    /// Robot pose used for the scan (the odometry, or with the moving front end the
+    /// detector's ICP-corrected pose), if any.
     pub pose: Option<[f64; 3]>,
     /// Every person of the filter's estimate, visible or not (see
     /// [`PersonEstimate::visibility`]).
@@ -93,19 +103,41 @@ pub fn config_for_scans(
     ))
 }
 
-/// Runs a tracker built from `config` over `scans` in order.
+/// Runs a tracker built from `config` over `scans` in order, on every person-sized segment.
 pub fn track_scans(scans: &[Scan], config: PeopleTrackerConfig) -> Result<PeopleRun> {
+    track_scans_with(scans, config, FrontEnd::Segments)
+}
+
+/// Runs a tracker built from `config` over `scans` in order, measuring through `front_end`
+/// (see the module documentation; the moving detector takes [`default_detector_config`]).
+pub fn track_scans_with(
+    scans: &[Scan],
+    mut config: PeopleTrackerConfig,
+    front_end: FrontEnd,
+) -> Result<PeopleRun> {
     let min_visibility = config.min_visibility;
+    let detector = match (front_end, scans.first()) {
+        (FrontEnd::Moving, Some(first)) => {
+            Some(default_detector_config(&config, first.angle_increment))
+        }
+        _ => None,
+    };
+    adapt_tracker_config(&mut config, front_end);
+    let mut fe = PersonFrontEnd::new(front_end, &config, detector)?;
     let mut tracker = PeopleTracker::new(config)?;
     let mut run = PeopleRun::default();
     for (i, scan) in scans.iter().enumerate() {
+        let at = |e: Error| Error::invalid(format!("scan {i} (time {})", scan.time), e.to_string());
+        let out = fe.measure(scan, scan.odometry).map_err(at)?;
+        let pose = out.corrected_pose.or(scan.odometry);
+        tracker.observe(scan);
         let people = tracker
-            .step_people(scan)
-            .map_err(|e| Error::invalid(format!("scan {i} (time {})", scan.time), e.to_string()))?;
+            .step_measured(out.measurements, scan.time, pose.map(platform_isometry))
+            .map_err(at)?;
         run.scans.push(ScanPeople {
             scan: i,
             time: scan.time,
-            pose: scan.odometry.map(|p: Pose2| [p.x, p.y, p.theta]),
+            pose: pose.map(|p: Pose2| [p.x, p.y, p.theta]),
             people,
         });
     }

@@ -78,11 +78,14 @@ impl TrackPath {
     }
 }
 
-/// The pose a scan was tracked with: its odometry, else the logged sensor pose, else none.
-fn frame_of(s: &Scan) -> (f64, f64, f64) {
-    s.odometry
-        .or(s.laser_pose)
-        .map_or((0.0, 0.0, 0.0), |p| (p.x, p.y, p.theta))
+/// The pose a scan was tracked with: the one the run recorded (odometry, or the moving front
+/// end's ICP-corrected pose), else the scan's odometry, else the logged sensor pose, else none.
+fn frame_of(s: &Scan, used: Option<[f64; 3]>) -> (f64, f64, f64) {
+    used.map(|p| (p[0], p[1], p[2])).unwrap_or_else(|| {
+        s.odometry
+            .or(s.laser_pose)
+            .map_or((0.0, 0.0, 0.0), |p| (p.x, p.y, p.theta))
+    })
 }
 
 /// Draws `run` over `scans` (the scans it was computed from, in the same order) to `path`.
@@ -106,9 +109,10 @@ pub fn write_people_plot(
     let every = scans.len().div_ceil(options.point_scans.max(1));
     let points: Vec<(f64, f64)> = scans
         .iter()
+        .zip(&run.scans)
         .step_by(every)
-        .flat_map(|s| {
-            let (x0, y0, th) = frame_of(s);
+        .flat_map(|(s, r)| {
+            let (x0, y0, th) = frame_of(s, r.pose);
             let (sn, cs) = th.sin_cos();
             s.points()
                 .map(move |(_, [x, y])| (x0 + cs * x - sn * y, y0 + sn * x + cs * y))
@@ -116,8 +120,9 @@ pub fn write_people_plot(
         .collect();
     let sensor: Vec<(f64, f64)> = scans
         .iter()
-        .map(|s| {
-            let (x, y, _) = frame_of(s);
+        .zip(&run.scans)
+        .map(|(s, r)| {
+            let (x, y, _) = frame_of(s, r.pose);
             (x, y)
         })
         .collect();
