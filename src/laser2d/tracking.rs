@@ -407,9 +407,16 @@ impl PeopleTracker {
             };
             let p = &t.particles;
             // Visibility is geometric (field of view, occlusion): the filter's own p_D when the
-            // particles have not moved since it computed them and no neighbour lowered it.
+            // particles have not moved since it computed them, with the neighbours' lowering
+            // divided out again.
             let pd = match self.filter.detection_probabilities(e.label) {
-                Some(known) if known.len() == p.len() && !self.resolution.lowers(p) => known,
+                Some(known) if known.len() == p.len() => {
+                    pd_buffer.clear();
+                    pd_buffer.extend_from_slice(known);
+                    self.resolution
+                        .apply_factors(p, &mut pd_buffer, |o, f| *o /= f);
+                    &pd_buffer[..]
+                }
                 _ => {
                     pd_buffer.resize(p.len(), 0.0);
                     self.detection

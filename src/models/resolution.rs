@@ -76,7 +76,9 @@ impl<D: DetectionModel> ResolutionDetection<D> {
         n.clear();
         n.extend(positions);
     }
+}
 
+impl<D> ResolutionDetection<D> {
     /// Whether some other track is near enough to lower the p_D of some particle of this set
     /// (when false, the inner model's p_D stands unchanged).
     pub fn lowers(&self, particles: &ParticleSet) -> bool {
@@ -129,6 +131,19 @@ impl<D: DetectionModel> ResolutionDetection<D> {
 impl<D: DetectionModel> DetectionModel for ResolutionDetection<D> {
     fn detection_probability(&self, particles: &ParticleSet, ctx: &StepContext, out: &mut [f64]) {
         self.inner.detection_probability(particles, ctx, out);
+        self.apply_factors(particles, out, |o, f| *o *= f);
+    }
+}
+
+impl<D> ResolutionDetection<D> {
+    /// Calls `apply(out[i], 1 − s·f(dᵢ))` for every particle i that some other track lowers;
+    /// particles out of every neighbour's reach are left alone.
+    pub fn apply_factors(
+        &self,
+        particles: &ParticleSet,
+        out: &mut [f64],
+        apply: impl Fn(&mut f64, f64),
+    ) {
         if self.share == 0.0 || particles.dim() < 3 || particles.is_empty() {
             return;
         }
@@ -142,7 +157,10 @@ impl<D: DetectionModel> DetectionModel for ResolutionDetection<D> {
                 .iter()
                 .map(|n| (n[0] - x).powi(2) + (n[1] - y).powi(2))
                 .fold(f64::INFINITY, f64::min);
-            *o *= self.factor(d2.sqrt());
+            let f = self.factor(d2.sqrt());
+            if f != 1.0 {
+                apply(o, f);
+            }
         }
     }
 }
