@@ -435,22 +435,20 @@ mod recording {
         ] {
             let t: Vec<_> = run.tracks_with(min).collect();
             let dynamic: Vec<_> = t.iter().filter(|t| t.dynamic_fraction >= 0.5).collect();
-            let median = |mut v: Vec<f64>| {
+            // "–" for no tracks, not NaN.
+            let median = |mut v: Vec<f64>, digits: usize| {
                 v.sort_by(f64::total_cmp);
-                if v.is_empty() {
-                    f64::NAN
-                } else {
-                    v[v.len() / 2]
-                }
+                v.get(v.len() / 2)
+                    .map_or_else(|| "–".to_string(), |m| format!("{m:.digits$}"))
             };
             println!(
-                "tracks ({what}): {} ({} mostly dynamic); median length {:.0} scans / {:.1} s; median speed of dynamic ones {:.2} m/s, median displacement {:.1} m",
+                "tracks ({what}): {} ({} mostly dynamic); median length {} scans / {} s; median speed of dynamic ones {} m/s, median displacement {} m",
                 t.len(),
                 dynamic.len(),
-                median(t.iter().map(|t| t.scans as f64).collect()),
-                median(t.iter().map(|t| t.last_time - t.first_time).collect()),
-                median(dynamic.iter().map(|t| t.mean_speed).collect()),
-                median(dynamic.iter().map(|t| t.displacement).collect()),
+                median(t.iter().map(|t| t.scans as f64).collect(), 0),
+                median(t.iter().map(|t| t.last_time - t.first_time).collect(), 1),
+                median(dynamic.iter().map(|t| t.mean_speed).collect(), 2),
+                median(dynamic.iter().map(|t| t.displacement).collect(), 1),
             );
         }
     }
