@@ -11,24 +11,8 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-fn vendored(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data/laser2d")
-        .join(name)
-}
-
-/// A file of the shared real-data folder, or `None` (with a note) when it is not there.
-fn shared(name: &str) -> Option<PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/laser2d")
-        .join(name);
-    if p.exists() {
-        Some(p)
-    } else {
-        println!("note: {} not found, test skipped", p.display());
-        None
-    }
-}
+mod common;
+use common::{shared_laser2d as shared, vendored_laser2d as vendored};
 
 fn keep_order() -> CarmenOptions {
     CarmenOptions {

@@ -1,4 +1,5 @@
-//! Shared helpers of the integration tests: synthetic KITTI raw drives written to disk.
+//! Shared helpers of the integration tests: synthetic KITTI raw drives written to disk, and
+//! the paths of the vendored and shared 2-D laser recordings.
 //!
 //! A drive is laid out exactly as KITTI's (`DATE/DATE_drive_NNNN_sync/...`), with the real
 //! 2011_09_26 calibration copied from the vendored excerpt, OXTS packets built from planar
@@ -147,4 +148,24 @@ pub fn box_surface(c: [f64; 3], size: [f64; 3], spacing: f64) -> Vec<Point3<f64>
         }
     }
     pts
+}
+
+/// A vendored 2-D laser excerpt (`tests/data/laser2d/`).
+pub fn vendored_laser2d(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/laser2d")
+        .join(name)
+}
+
+/// A file of the shared 2-D laser data folder, or `None` (with a note) when it is not there.
+pub fn shared_laser2d(name: &str) -> Option<PathBuf> {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/laser2d")
+        .join(name);
+    if p.exists() {
+        Some(p)
+    } else {
+        println!("note: {} not found, test skipped", p.display());
+        None
+    }
 }
