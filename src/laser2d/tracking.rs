@@ -24,7 +24,7 @@ use crate::filter::{
 };
 use crate::models::{
     BearingConvention, DetectionModel, FieldOfViewDetection, FieldOfViewSurvival,
-    OcclusionDetection, RangeBearing, ResolutionDetection, StepContext,
+    OcclusionDetection, RangeBearing, ResolutionDetection, ResolutionLikelihood, StepContext,
 };
 use crate::rng::{seeded, FilterRng};
 use nalgebra::{Isometry3, Vector3};
@@ -63,6 +63,10 @@ pub struct PeopleTrackerConfig {
     pub resolution_fade: f64,
     /// Share of scans in which a person that close is not resolved. Default 0.5.
     pub unresolved_share: f64,
+    /// Near another track the measurement noise is scaled by this: a merged measurement of
+    /// two people lies anywhere between them and should pull each track less
+    /// ([`crate::models::ResolutionLikelihood`]). Default 2; 1 turns it off.
+    pub unresolved_noise_scale: f64,
     /// A person is reported by [`PeopleTracker::step`] when the expected share of their
     /// beams the scanner sees is at least this. Default 0.5.
     pub min_visibility: f64,
@@ -104,6 +108,7 @@ impl PeopleTrackerConfig {
             resolution_distance: 1.5,
             resolution_fade: 0.5,
             unresolved_share: 0.5,
+            unresolved_noise_scale: 2.0,
             min_visibility: 0.5,
             motion: MotionConfig::default(),
             filter: RunConfig {
@@ -268,9 +273,16 @@ impl PeopleTracker {
             // two bodies of radius ρ cannot stand closer than 2ρ: nearer is the track itself
             1.5 * config.body_radius,
         )?;
-        let filter = config
-            .filter
-            .builder()?
+        let mut builder = config.filter.builder()?;
+        let widen = config.unresolved_noise_scale;
+        if widen != 1.0 {
+            let wide = RangeBearing::new(sigma_range * widen, sigma_bearing * widen)?
+                .with_offset(sensor_offset[0], sensor_offset[1])?
+                .with_convention(convention);
+            builder =
+                builder.measurement(ResolutionLikelihood::new(sensor, wide, resolution.clone()));
+        }
+        let filter = builder
             .detection(resolution.clone())
             .survival(survival)
             .birth(birth.clone())

@@ -161,7 +161,7 @@ pub use detection::{ConstantDetection, FieldOfViewDetection, GaussianRangeDetect
 pub use occlusion::{BeamView, OcclusionDetection};
 pub use position::PositionMeasurement;
 pub use range_bearing::{wrap_angle, BearingConvention, RangeBearing};
-pub use resolution::ResolutionDetection;
+pub use resolution::{ResolutionDetection, ResolutionLikelihood};
 pub use survival::ConstantSurvival;
 pub use view_survival::FieldOfViewSurvival;
 
