@@ -274,13 +274,12 @@ impl PeopleTracker {
             1.5 * config.body_radius,
         )?;
         let mut builder = config.filter.builder()?;
-        let widen = config.unresolved_noise_scale;
-        if widen != 1.0 {
-            let wide = RangeBearing::new(sigma_range * widen, sigma_bearing * widen)?
-                .with_offset(sensor_offset[0], sensor_offset[1])?
-                .with_convention(convention);
-            builder =
-                builder.measurement(ResolutionLikelihood::new(sensor, wide, resolution.clone()));
+        if config.unresolved_noise_scale != 1.0 {
+            builder = builder.measurement(ResolutionLikelihood::new(
+                sensor,
+                config.unresolved_noise_scale,
+                resolution.clone(),
+            )?);
         }
         let filter = builder
             .detection(resolution.clone())
