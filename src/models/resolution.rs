@@ -158,6 +158,16 @@ impl<D> ResolutionDetection<D> {
         out: &mut [f64],
         apply: impl Fn(&mut f64, f64),
     ) {
+        self.for_each_lowered(particles, |i, f| {
+            if let Some(o) = out.get_mut(i) {
+                apply(o, f);
+            }
+        });
+    }
+
+    /// Calls `visit(i, 1 − s·f(dᵢ))` for every particle i that some other track lowers, in
+    /// particle order; the neighbours are looked up once per call.
+    pub fn for_each_lowered(&self, particles: &ParticleSet, mut visit: impl FnMut(usize, f64)) {
         if self.share == 0.0 || particles.dim() < 3 || particles.is_empty() {
             return;
         }
@@ -166,14 +176,14 @@ impl<D> ResolutionDetection<D> {
             return;
         }
         let (xs, ys) = (particles.component(0), particles.component(2));
-        for ((o, &x), &y) in out.iter_mut().zip(xs).zip(ys) {
+        for (i, (&x, &y)) in xs.iter().zip(ys).enumerate() {
             let d2 = others
                 .iter()
                 .map(|n| (n[0] - x).powi(2) + (n[1] - y).powi(2))
                 .fold(f64::INFINITY, f64::min);
             let f = self.factor(d2.sqrt());
             if f != 1.0 {
-                apply(o, f);
+                visit(i, f);
             }
         }
     }
@@ -234,7 +244,7 @@ impl<D: Send + Sync> MeasurementModel for ResolutionLikelihood<D> {
         out: &mut [f64],
     ) {
         self.narrow.log_likelihood(z, particles, ctx, out);
-        self.widen(particles, out);
+        self.widen(particles, &mut [out]);
     }
 
     fn log_likelihood_batch(
@@ -245,9 +255,7 @@ impl<D: Send + Sync> MeasurementModel for ResolutionLikelihood<D> {
         out: &mut [Vec<f64>],
     ) {
         self.narrow.log_likelihood_batch(zs, particles, ctx, out);
-        for row in out.iter_mut() {
-            self.widen(particles, row);
-        }
+        self.widen(particles, out);
     }
 
     fn gate(&self, z: &[f64], track: &TrackSummary, ctx: &StepContext) -> bool {
@@ -265,15 +273,20 @@ impl<D: Send + Sync> MeasurementModel for ResolutionLikelihood<D> {
 }
 
 impl<D> ResolutionLikelihood<D> {
-    /// Replaces the narrow log-likelihood of every particle next to another track by the wide one.
-    fn widen(&self, particles: &ParticleSet, row: &mut [f64]) {
+    /// Replaces, in every row, the narrow log-likelihood of each particle next to another
+    /// track by the wide one (the neighbours are looked up once for all rows).
+    fn widen<R: AsMut<[f64]>>(&self, particles: &ParticleSet, rows: &mut [R]) {
         if self.scale == 1.0 {
             return;
         }
         let c = self.narrow.log_normaliser();
         let (shift, inv_s2) = (2.0 * self.scale.ln(), 1.0 / (self.scale * self.scale));
-        self.resolution.apply_factors(particles, row, |l, _| {
-            *l = c - shift - (c - *l) * inv_s2;
+        self.resolution.for_each_lowered(particles, |i, _| {
+            for row in rows.iter_mut() {
+                if let Some(l) = row.as_mut().get_mut(i) {
+                    *l = c - shift - (c - *l) * inv_s2;
+                }
+            }
         });
     }
 }
