@@ -98,6 +98,21 @@ pub enum TransitionConfig {
     },
 }
 
+impl TransitionConfig {
+    /// Checks the values and builds the model.
+    pub fn model(&self) -> Result<Box<dyn crate::models::TransitionModel>> {
+        Ok(match *self {
+            TransitionConfig::ConstantVelocity { dims, sigma_accel } => {
+                Box::new(ConstantVelocity::new(dims, sigma_accel)?)
+            }
+            TransitionConfig::CoordinatedTurn {
+                sigma_vel,
+                sigma_turn,
+            } => Box::new(CoordinatedTurn::new(sigma_vel, sigma_turn)?),
+        })
+    }
+}
+
 /// Built-in measurement models.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "model", rename_all = "snake_case", deny_unknown_fields)]
@@ -227,15 +242,7 @@ impl RunConfig {
             .config(self.filter.clone())
             .associator(self.association)
             .clutter(UniformClutter::new(self.clutter.rate, self.clutter.volume)?);
-        let builder = match self.transition {
-            TransitionConfig::ConstantVelocity { dims, sigma_accel } => {
-                builder.transition(ConstantVelocity::new(dims, sigma_accel)?)
-            }
-            TransitionConfig::CoordinatedTurn {
-                sigma_vel,
-                sigma_turn,
-            } => builder.transition(CoordinatedTurn::new(sigma_vel, sigma_turn)?),
-        };
+        let builder = builder.transition(self.transition.model()?);
         let builder = match &self.detection {
             DetectionConfig::Constant { probability } => {
                 builder.detection(ConstantDetection::new(*probability)?)

@@ -47,6 +47,9 @@ pub struct PeopleBirth {
     pub suppress_radius: f64,
     /// Tracks with at least this existence count as confirmed.
     pub suppress_existence: f64,
+    /// Births carry a fifth state component, the detectability mode
+    /// ([`crate::models::detectability`]), set to detectable (the person was just detected).
+    pub with_detectability: bool,
     confirmed: Arc<RwLock<Vec<[f64; 2]>>>,
 }
 
@@ -79,6 +82,7 @@ impl PeopleBirth {
             velocity_std: velocity_std.abs(),
             suppress_radius: suppress_radius.max(0.0),
             suppress_existence: 0.5,
+            with_detectability: false,
             confirmed: Arc::new(RwLock::new(Vec::new())),
         })
     }
@@ -103,17 +107,11 @@ impl PeopleBirth {
 
     fn sample(&self, z: [f64; 2], ctx: &StepContext, rng: &mut FilterRng) -> ParticleSet {
         let centre = self.sensor.to_cartesian(z, ctx);
-        let mut set = ParticleSet::gaussian(
-            &[centre[0], 0.0, centre[1], 0.0],
-            &[
-                self.position_std,
-                self.velocity_std,
-                self.position_std,
-                self.velocity_std,
-            ],
-            self.particles,
-            rng,
-        );
+        let (p, v) = (self.position_std, self.velocity_std);
+        let mean = [centre[0], 0.0, centre[1], 0.0, 1.0];
+        let std = [p, v, p, v, 0.0];
+        let dim = if self.with_detectability { 5 } else { 4 };
+        let mut set = ParticleSet::gaussian(&mean[..dim], &std[..dim], self.particles, rng);
         let (sr, sb) = self.sensor.noise();
         let mut comps = set.components_mut().into_iter();
         let (x, _, y) = (

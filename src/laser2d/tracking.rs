@@ -23,8 +23,10 @@ use crate::filter::{
     AssociationMethod, Estimate, Frame, Label, LmbConfig, LmbFilter, Measurements,
 };
 use crate::models::{
-    BearingConvention, DetectionModel, FieldOfViewDetection, FieldOfViewSurvival,
-    OcclusionDetection, RangeBearing, ResolutionDetection, ResolutionLikelihood, StepContext,
+    BearingConvention, ConstantVelocity, Detectability, DetectabilityDetection,
+    DetectabilityTransition, DetectionModel, FieldOfViewDetection, FieldOfViewSurvival,
+    ManoeuvringVelocity, OcclusionDetection, RangeBearing, ResolutionDetection,
+    ResolutionLikelihood, StepContext, TransitionModel,
 };
 use crate::rng::{seeded, FilterRng};
 use nalgebra::{Isometry3, Vector3};
@@ -67,6 +69,29 @@ pub struct PeopleTrackerConfig {
     /// two people lies anywhere between them and should pull each track less
     /// ([`crate::models::ResolutionLikelihood`]). Default 2; 1 turns it off.
     pub unresolved_noise_scale: f64,
+    /// Share of particles per scan whose acceleration is drawn with `manoeuvre_sigma` instead
+    /// of the filter's calm σ ([`crate::models::ManoeuvringVelocity`]): people who turn
+    /// round or stop. Default 0.05: in scenario one (people walking straight) 98 % of 50 runs
+    /// keep every label, against 92 % with plain constant velocity; in the lobby, where people
+    /// turn round, lobby OSPA(2) falls from 1.45 to 1.26 (seeds 1–8, moving front end). 0 turns
+    /// it off.
+    pub manoeuvre_probability: f64,
+    /// Acceleration noise (m/s²) of a manoeuvring particle. Default 5: a reversal of 1 m/s
+    /// within 0.25 s.
+    pub manoeuvre_sigma: f64,
+    /// Misses that come in runs: when set, each person carries a detectable/undetectable mode
+    /// as a fifth state component ([`crate::models::detectability`]) and `filter.detection`'s
+    /// p_D applies to detectable people only. Default `None` (misses independent per scan).
+    pub detectability: Option<Detectability>,
+    /// A track becomes a person once its existence has reached this (and stays one while it
+    /// is in the filter's estimate): the confirmation threshold of IPDA-style track
+    /// management. A track that flickers above 0.5 on a few detections is never reported.
+    /// Default 0.99; 0.5 reports every estimate.
+    pub confirm_existence: f64,
+    /// … and once it has collected this many expected detections (the sum over its life of
+    /// the probability that it was detected; the birth scan's measurement is not counted).
+    /// Default 0.
+    pub confirm_detections: f64,
     /// A person is reported by [`PeopleTracker::step`] when the expected share of their
     /// beams the scanner sees is at least this. Default 0.5.
     pub min_visibility: f64,
@@ -109,6 +134,11 @@ impl PeopleTrackerConfig {
             resolution_fade: 0.5,
             unresolved_share: 0.5,
             unresolved_noise_scale: 2.0,
+            manoeuvre_probability: 0.05,
+            manoeuvre_sigma: 5.0,
+            detectability: None,
+            confirm_existence: 0.99,
+            confirm_detections: 0.0,
             min_visibility: 0.5,
             motion: MotionConfig::default(),
             filter: RunConfig {
@@ -199,8 +229,10 @@ pub struct PeopleTracker {
     rng: FilterRng,
     detection: OcclusionDetection,
     resolution: ResolutionDetection<OcclusionDetection>,
+    detectability: Option<DetectabilityDetection<ResolutionDetection<OcclusionDetection>>>,
     birth: PeopleBirth,
     motion: MotionClassifier,
+    confirmed: std::collections::BTreeSet<Label>,
     last_time: Option<f64>,
 }
 
@@ -254,7 +286,7 @@ impl PeopleTracker {
         let sensor = RangeBearing::new(sigma_range, sigma_bearing)?
             .with_offset(sensor_offset[0], sensor_offset[1])?
             .with_convention(convention);
-        let birth = PeopleBirth::new(
+        let mut birth = PeopleBirth::new(
             sensor,
             expected_births,
             max_existence,
@@ -263,6 +295,7 @@ impl PeopleTracker {
             velocity_std,
             config.birth_suppress_radius,
         )?;
+        birth.with_detectability = config.detectability.is_some();
         let survival =
             FieldOfViewSurvival::new(fov, config.filter.survival, config.survival_outside)?;
         let resolution = ResolutionDetection::new(
@@ -281,11 +314,22 @@ impl PeopleTracker {
                 resolution.clone(),
             )?);
         }
-        let filter = builder
-            .detection(resolution.clone())
-            .survival(survival)
-            .birth(birth.clone())
-            .build()?;
+        let motion = Self::transition(&config)?;
+        let detectability = match config.detectability {
+            Some(chain) => {
+                let transition = DetectabilityTransition::new(motion, chain)?;
+                let mode = transition.mode_component();
+                builder = builder.transition(transition);
+                let d = DetectabilityDetection::new(resolution.clone(), chain, mode)?;
+                builder = builder.detection(d.clone());
+                Some(d)
+            }
+            None => {
+                builder = builder.transition(motion).detection(resolution.clone());
+                None
+            }
+        };
+        let filter = builder.survival(survival).birth(birth.clone()).build()?;
         let rng = seeded(config.filter.seed);
         let motion = MotionClassifier::new(config.motion)?;
         Ok(PeopleTracker {
@@ -294,10 +338,31 @@ impl PeopleTracker {
             rng,
             detection,
             resolution,
+            detectability,
             birth,
             motion,
+            confirmed: Default::default(),
             last_time: None,
         })
+    }
+
+    /// The people's motion: the filter's transition, with manoeuvres when configured.
+    fn transition(config: &PeopleTrackerConfig) -> Result<Box<dyn TransitionModel>> {
+        if config.manoeuvre_probability == 0.0 {
+            return config.filter.transition.model();
+        }
+        let TransitionConfig::ConstantVelocity { dims, sigma_accel } = config.filter.transition
+        else {
+            return Err(Error::invalid(
+                "people tracker config field `manoeuvre_probability`",
+                "manoeuvres need a constant-velocity `filter.transition`",
+            ));
+        };
+        Ok(Box::new(ManoeuvringVelocity::new(
+            ConstantVelocity::new(dims, sigma_accel)?,
+            config.manoeuvre_probability,
+            config.manoeuvre_sigma,
+        )?))
     }
 
     /// The configuration.
@@ -410,22 +475,40 @@ impl PeopleTracker {
         ctx.platform = platform;
         let p_max = self.detection.field_of_view().p_inside();
         let tracks = self.filter.tracks();
+        let (confirm, detections) = (
+            self.config.confirm_existence,
+            self.config.confirm_detections,
+        );
+        self.confirmed
+            .retain(|l| tracks.iter().any(|t| t.label == *l));
+        self.confirmed.extend(
+            tracks
+                .iter()
+                .filter(|t| t.existence >= confirm && t.expected_detections >= detections)
+                .map(|t| t.label),
+        );
         let mut out = Vec::with_capacity(estimates.len());
         let mut pd_buffer = Vec::new();
         for e in estimates {
+            if !self.confirmed.contains(&e.label) {
+                continue;
+            }
             let Some(t) = tracks.iter().find(|t| t.label == e.label) else {
                 continue;
             };
             let p = &t.particles;
             // Visibility is geometric (field of view, occlusion): the filter's own p_D when the
             // particles have not moved since it computed them, with the neighbours' lowering
-            // divided out again.
+            // and the detectability mode divided out again.
             let pd = match self.filter.detection_probabilities(e.label) {
                 Some(known) if known.len() == p.len() => {
                     pd_buffer.clear();
                     pd_buffer.extend_from_slice(known);
                     self.resolution
                         .apply_factors(p, &mut pd_buffer, |o, f| *o /= f);
+                    if let Some(d) = &self.detectability {
+                        d.remove_mode(p, &mut pd_buffer);
+                    }
                     &pd_buffer[..]
                 }
                 _ => {
