@@ -79,6 +79,10 @@ struct Args {
     /// with the Fuzzy ART veto) or `voting` (seed 003).
     #[arg(long, default_value = "attenuation")]
     moving_rule: String,
+    /// LMB: share of particles per scan that manoeuvre (turn round, stop); 0 gives plain
+    /// constant velocity. Default: the tracker's (0.05).
+    #[arg(long)]
+    manoeuvre: Option<f64>,
     /// Score estimates of people who are present but unseen (hidden, too far, out of view) as
     /// false instead of ignoring them.
     #[arg(long)]
@@ -159,7 +163,7 @@ fn run_simulated(args: &Args) -> Result<()> {
             .generate(seed)
             .with_context(|| format!("scenario {} seed {seed}", args.scenario))?;
         for (name, results) in names.iter().zip(per_tracker.iter_mut()) {
-            let mut tracker = build_tracker(name, &scenario, seed, eval.front_end)?;
+            let mut tracker = build_tracker(args, name, &scenario, seed, eval.front_end)?;
             let mut fe = build_front_end(args, &eval, &detector, &run)?;
             let m = evaluate_run_with(tracker.as_mut(), &run, &mut fe, &eval)
                 .with_context(|| format!("{name} on seed {seed}"))?;
@@ -246,6 +250,20 @@ fn detector_config(scenario: &PeopleScenario, seed: u64, fe: FrontEnd) -> People
     cfg
 }
 
+/// [`detector_config`] with the command line's LMB settings.
+fn lmb_config(
+    args: &Args,
+    scenario: &PeopleScenario,
+    seed: u64,
+    fe: FrontEnd,
+) -> PeopleTrackerConfig {
+    let mut cfg = detector_config(scenario, seed, fe);
+    if let Some(p) = args.manoeuvre {
+        cfg.manoeuvre_probability = p;
+    }
+    cfg
+}
+
 /// The range-bearing sensor every baseline assumes: the noise of a person's measured centre,
 /// as the LMB assumes it, and the scanner's mounting offset.
 fn sensor_model(scenario: &PeopleScenario) -> Result<RangeBearing> {
@@ -255,6 +273,7 @@ fn sensor_model(scenario: &PeopleScenario) -> Result<RangeBearing> {
 }
 
 fn build_tracker(
+    args: &Args,
     name: &str,
     scenario: &PeopleScenario,
     seed: u64,
@@ -262,7 +281,7 @@ fn build_tracker(
 ) -> Result<Box<dyn PointTracker>> {
     let sensor = sensor_model(scenario)?;
     Ok(match name {
-        "lmb" => Box::new(PeopleTracker::new(detector_config(scenario, seed, fe))?),
+        "lmb" => Box::new(PeopleTracker::new(lmb_config(args, scenario, seed, fe))?),
         "gnn" => Box::new(GnnTracker::new(GnnConfig::new(sensor))?),
         "ml_ransac" => {
             let mut cfg = MlRansacConfig::new(sensor);
@@ -366,6 +385,9 @@ mod recording {
             [0.0, 0.0],
         )?;
         cfg.filter.seed = args.seed;
+        if let Some(p) = args.manoeuvre {
+            cfg.manoeuvre_probability = p;
+        }
         let t0 = Instant::now();
         let fe = super::front_end(args)?;
         println!("front end {}", fe.name());
