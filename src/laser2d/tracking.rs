@@ -714,6 +714,23 @@ mod tests {
         labels.iter().flatten().copied().collect()
     }
 
+    /// One label over the whole walk, and the person reported in every scan from the 12th.
+    fn assert_one_label(labels: &[Vec<Label>]) {
+        let births: Vec<Vec<u32>> = labels
+            .iter()
+            .map(|l| l.iter().map(|x| x.birth_step).collect())
+            .collect();
+        assert_eq!(
+            labels_of(labels).len(),
+            1,
+            "birth steps per scan {births:?}"
+        );
+        assert!(
+            labels[12..].iter().all(|l| l.len() == 1),
+            "birth steps per scan {births:?}"
+        );
+    }
+
     /// A person walks at 1 m/s and turns round between 3 s and 4 s (decelerating at 2 m/s²,
     /// 6.7 σ of the calm model, and walking back). With manoeuvres the track follows them back
     /// under the same label; with plain constant velocity (σ 0.3 m/s²) it overshoots and the
@@ -730,23 +747,7 @@ mod tests {
             }
         };
         let (labels, last) = walk(moving_front_end_config(), 64, y, 0..0);
-        assert_eq!(
-            labels_of(&labels).len(),
-            1,
-            "{:?}",
-            labels
-                .iter()
-                .map(|l| l.iter().map(|x| x.birth_step).collect::<Vec<_>>())
-                .collect::<Vec<_>>()
-        );
-        assert!(
-            labels[12..].iter().all(|l| l.len() == 1),
-            "{:?}",
-            labels
-                .iter()
-                .map(|l| l.iter().map(|x| x.birth_step).collect::<Vec<_>>())
-                .collect::<Vec<_>>()
-        );
+        assert_one_label(&labels);
         let e = &last[0];
         let t = 63.0 * 0.125;
         assert!((e.state[2] - y(t)).abs() < 0.2, "{e:?}");
@@ -766,23 +767,7 @@ mod tests {
     fn a_run_of_misses_does_not_end_the_track() {
         let y = |t: f64| -3.0 + 0.8 * t;
         let (labels, _) = walk(moving_front_end_config(), 64, y, 24..40);
-        assert_eq!(
-            labels_of(&labels).len(),
-            1,
-            "{:?}",
-            labels
-                .iter()
-                .map(|l| l.iter().map(|x| x.birth_step).collect::<Vec<_>>())
-                .collect::<Vec<_>>()
-        );
-        assert!(
-            labels[12..].iter().all(|l| l.len() == 1),
-            "{:?}",
-            labels
-                .iter()
-                .map(|l| l.iter().map(|x| x.birth_step).collect::<Vec<_>>())
-                .collect::<Vec<_>>()
-        );
+        assert_one_label(&labels);
 
         let mut independent = moving_front_end_config();
         independent.detectability = None;
