@@ -15,6 +15,59 @@ use crate::error::{Error, Result};
 use plotters::prelude::*;
 use std::path::Path;
 
+/// Something that draws itself on a plotters drawing area of any backend.
+pub(crate) trait Draw {
+    /// Draws everything on `root`; errors as text.
+    fn draw_on<DB: DrawingBackend>(
+        &self,
+        root: DrawingArea<DB, plotters::coord::Shift>,
+    ) -> std::result::Result<(), String>
+    where
+        DB::ErrorType: 'static;
+}
+
+/// Writes `drawing` as an image of `size` (width, height) pixels: SVG for a `.svg` path, PNG
+/// for a `.png` path, atomically (a temporary file beside `path` is renamed over it).
+pub(crate) fn write_image(path: &Path, size: (u32, u32), drawing: &impl Draw) -> Result<()> {
+    let what = || format!("plot file {}", path.display());
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("svg") => {
+            let mut svg = String::new();
+            {
+                let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+                drawing
+                    .draw_on(root)
+                    .map_err(|e| Error::invalid(what(), e))?;
+            }
+            crate::atomic::write_bytes(path, svg.as_bytes())
+        }
+        Some("png") => {
+            let name = path
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            let tmp = path.with_file_name(format!(".{name}.{}.tmp.png", std::process::id()));
+            let drawn = {
+                let root = BitMapBackend::new(&tmp, size).into_drawing_area();
+                drawing.draw_on(root)
+            };
+            if let Err(e) = drawn {
+                let _ = std::fs::remove_file(&tmp);
+                return Err(Error::io(path, std::io::Error::other(e)));
+            }
+            std::fs::rename(&tmp, path).map_err(|e| {
+                let _ = std::fs::remove_file(&tmp);
+                Error::io(path, e)
+            })
+        }
+        _ => Err(Error::invalid(what(), "extension must be .svg or .png")),
+    }
+}
+
 /// A connected line through `points` (m).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Polyline {
@@ -74,47 +127,13 @@ impl BirdsEyePlot {
     /// Writes the plot as a square image of `size` pixels: SVG for a `.svg` path, PNG for a
     /// `.png` path, atomically (a temporary file beside `path` is renamed over it).
     pub fn write(&self, path: &Path, size: u32) -> Result<()> {
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
         let size = size.max(64);
-        match ext.as_deref() {
-            Some("svg") => {
-                let mut svg = String::new();
-                {
-                    let root = SVGBackend::with_string(&mut svg, (size, size)).into_drawing_area();
-                    self.draw(root).map_err(|e| Error::invalid("plot", e))?;
-                }
-                crate::atomic::write_bytes(path, svg.as_bytes())
-            }
-            Some("png") => {
-                let name = path
-                    .file_name()
-                    .map(|n| n.to_string_lossy().into_owned())
-                    .unwrap_or_default();
-                let tmp = path.with_file_name(format!(".{name}.{}.tmp.png", std::process::id()));
-                let drawn = {
-                    let root = BitMapBackend::new(&tmp, (size, size)).into_drawing_area();
-                    self.draw(root)
-                };
-                if let Err(e) = drawn {
-                    let _ = std::fs::remove_file(&tmp);
-                    return Err(Error::io(path, std::io::Error::other(e)));
-                }
-                std::fs::rename(&tmp, path).map_err(|e| {
-                    let _ = std::fs::remove_file(&tmp);
-                    Error::io(path, e)
-                })
-            }
-            _ => Err(Error::invalid(
-                format!("plot file {}", path.display()),
-                "extension must be .svg or .png",
-            )),
-        }
+        write_image(path, (size, size), self)
     }
+}
 
-    fn draw<DB: DrawingBackend>(
+impl Draw for BirdsEyePlot {
+    fn draw_on<DB: DrawingBackend>(
         &self,
         root: DrawingArea<DB, plotters::coord::Shift>,
     ) -> std::result::Result<(), String>

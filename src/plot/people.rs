@@ -181,42 +181,7 @@ pub fn write_people_plot(
     let inner = f64::from(width - LEFT - RIGHT);
     let height =
         (inner * (hi.1 - lo.1) / (hi.0 - lo.0)).clamp(200.0, 3.0 * inner) as u32 + TOP + BOTTOM;
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    match ext.as_deref() {
-        Some("svg") => {
-            let mut svg = String::new();
-            {
-                let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
-                scene
-                    .draw(&root, (lo, hi))
-                    .map_err(|e| Error::invalid(what(), e))?;
-            }
-            crate::atomic::write_bytes(path, svg.as_bytes())?;
-        }
-        Some("png") => {
-            let name = path
-                .file_name()
-                .map(|n| n.to_string_lossy().into_owned())
-                .unwrap_or_default();
-            let tmp = path.with_file_name(format!(".{name}.{}.tmp.png", std::process::id()));
-            let drawn = {
-                let root = BitMapBackend::new(&tmp, (width, height)).into_drawing_area();
-                scene.draw(&root, (lo, hi))
-            };
-            if let Err(e) = drawn {
-                let _ = std::fs::remove_file(&tmp);
-                return Err(Error::io(path, std::io::Error::other(e)));
-            }
-            std::fs::rename(&tmp, path).map_err(|e| {
-                let _ = std::fs::remove_file(&tmp);
-                Error::io(path, e)
-            })?;
-        }
-        _ => return Err(Error::invalid(what(), "extension must be .svg or .png")),
-    }
+    super::write_image(path, (width, height), &Framed { scene, lo, hi })?;
     Ok(counts)
 }
 
@@ -228,6 +193,25 @@ const INK: RGBColor = RGBColor(20, 20, 20);
 const POINT: RGBColor = RGBColor(175, 175, 175);
 const GRID: RGBColor = RGBColor(232, 232, 232);
 const STATIC: RGBColor = RGBColor(60, 60, 60);
+
+/// A scene with the bounds it is drawn in.
+struct Framed<'a> {
+    scene: Scene<'a>,
+    lo: (f64, f64),
+    hi: (f64, f64),
+}
+
+impl super::Draw for Framed<'_> {
+    fn draw_on<DB: DrawingBackend>(
+        &self,
+        root: DrawingArea<DB, Shift>,
+    ) -> std::result::Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        self.scene.draw(&root, (self.lo, self.hi))
+    }
+}
 
 struct Scene<'a> {
     title: &'a str,
