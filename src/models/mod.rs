@@ -143,6 +143,7 @@ pub trait ClutterModel: Send + Sync {
 }
 
 mod atan;
+pub mod cloud_bounds;
 pub mod clutter;
 pub mod ct;
 pub mod cv;
@@ -154,6 +155,7 @@ pub mod resolution;
 pub mod survival;
 pub mod view_survival;
 
+pub use cloud_bounds::{CloudBox, PolarBounds};
 pub use clutter::UniformClutter;
 pub use ct::CoordinatedTurn;
 pub use cv::ConstantVelocity;
