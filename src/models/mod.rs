@@ -148,6 +148,7 @@ pub mod clutter;
 pub mod ct;
 pub mod cv;
 pub mod detection;
+pub(crate) mod exp;
 pub mod occlusion;
 pub mod position;
 pub mod range_bearing;

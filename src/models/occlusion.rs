@@ -27,8 +27,9 @@
 //!
 //! Without a view set, no beam is blocked and the model equals the field-of-view model.
 
-use super::cloud_bounds::CloudBox;
+use super::cloud_bounds::{CloudBox, PolarBounds};
 use super::detection::FieldOfViewDetection;
+use super::exp::exp_in_place;
 use super::{DetectionModel, StepContext};
 use crate::error::{ensure_finite, ensure_positive, Error, Result};
 use crate::filter::ParticleSet;
@@ -406,18 +407,13 @@ impl OcclusionDetection {
     /// The beams the windows of the particles can cover, from the bounds of the cloud's
     /// positions: bearings widened by the widest window (that of the nearest possible
     /// particle), a bearing slack and one beam on either side.
-    fn reach(
-        &self,
-        view: &BeamView,
-        particles: &ParticleSet,
-        (sx, sy, c, s): (f64, f64, f64, f64),
-    ) -> CloudReach {
+    fn reach(&self, view: &BeamView, bounds: Option<&PolarBounds>) -> CloudReach {
         let n = view.ranges.len();
         let inc = view.angle_increment;
         if n == 0 {
             return CloudReach::NOTHING;
         }
-        let Some(b) = CloudBox::of(particles).and_then(|b| b.polar_from(sx, sy, c, s)) else {
+        let Some(b) = bounds else {
             return CloudReach::UNKNOWN;
         };
         if !(inc > 0.0) || b.d_min <= self.object_radius * (1.0 + 1e-9) {
@@ -504,14 +500,21 @@ impl OcclusionDetection {
         let spacing = view.angle_increment.abs();
         let xs = particles.component(0);
         let ys = particles.component(2);
+        let poisson = self.min_returns > 0 && spacing > 0.0;
+        let bounds = if whole_cloud_first {
+            CloudBox::of(particles).and_then(|b| b.polar_from(sx, sy, c, s))
+        } else {
+            None
+        };
         let reach = if whole_cloud_first {
-            self.reach(&view, particles, sensor)
+            self.reach(&view, bounds.as_ref())
         } else {
             CloudReach::UNKNOWN
         };
+        let all_inside = bounds.is_some_and(|b| self.fov.surely_contains(&b));
         for ((o, &x), &y) in out.iter_mut().zip(xs).zip(ys) {
-            if !self.fov.contains_from(x, y, sx, sy, c, s) {
-                *o = p_out;
+            if !all_inside && !self.fov.contains_from(x, y, sx, sy, c, s) {
+                *o = if poisson { -1.0 } else { p_out };
                 continue;
             }
             let (dx, dy) = (x - sx, y - sy);
@@ -530,7 +533,48 @@ impl OcclusionDetection {
                     1.0 - blocked as f64 / total as f64
                 }
             };
-            *o = self.probability(d, free, spacing);
+            *o = if poisson {
+                // μ for now; the Poisson tail follows for all particles at once
+                free * 2.0 * self.half_width(d) / spacing
+            } else {
+                self.probability(d, free, spacing)
+            };
+        }
+        if poisson {
+            self.poisson_tails(out, p_out);
+        }
+    }
+
+    /// Replaces every μ ≥ 0 of `out` by p_inside · P(N ≥ m), N ~ Poisson(μ) (as
+    /// [`poisson_at_least`], 0 for μ = 0 or NaN), and every negative entry (outside the field
+    /// of view) by `p_out`; in passes over the whole slice that run on vector lanes.
+    fn poisson_tails(&self, out: &mut [f64], p_out: f64) {
+        let n = out.len();
+        let mut buffer = vec![0.0; 2 * n];
+        let (term, below) = buffer.split_at_mut(n);
+        for (t, &mu) in term.iter_mut().zip(out.iter()) {
+            *t = -mu;
+        }
+        exp_in_place(term);
+        below.copy_from_slice(term);
+        for j in 1..self.min_returns {
+            let j = j as f64;
+            for ((t, b), &mu) in term.iter_mut().zip(below.iter_mut()).zip(out.iter()) {
+                *t *= mu / j;
+                *b += *t;
+            }
+        }
+        let p_in = self.fov.p_inside();
+        for (o, &b) in out.iter_mut().zip(below.iter()) {
+            let mu = *o;
+            let tail = (1.0 - b).clamp(0.0, 1.0);
+            *o = if mu < 0.0 {
+                p_out
+            } else if mu > 0.0 {
+                p_in * tail
+            } else {
+                0.0
+            };
         }
     }
 }
