@@ -151,6 +151,17 @@ impl<D> ResolutionDetection<D> {
             .collect()
     }
 
+    /// Whether [`Self::others_near_point`] would find any neighbour (without collecting them).
+    fn any_other_near_point(&self, mx: f64, my: f64) -> bool {
+        let neighbours = self.neighbours.read().unwrap_or_else(|e| e.into_inner());
+        let reach = self.distance + self.fade + 2.0;
+        let ex2 = self.exclusion * self.exclusion;
+        neighbours.iter().any(|n| {
+            let d2 = (n[0] - mx).powi(2) + (n[1] - my).powi(2);
+            d2 >= ex2 && d2 < reach * reach
+        })
+    }
+
     /// 1 − s · f(d) for the distance `d` to the nearest other neighbour.
     fn factor(&self, d: f64) -> f64 {
         let f = if d <= self.distance {
@@ -288,10 +299,9 @@ impl<D: Send + Sync> MeasurementModel for ResolutionLikelihood<D> {
 
     fn gate(&self, z: &[f64], track: &TrackSummary, ctx: &StepContext) -> bool {
         let near = track.mean.len() >= 3
-            && !self
+            && self
                 .resolution
-                .others_near_point(track.mean[0], track.mean[2])
-                .is_empty();
+                .any_other_near_point(track.mean[0], track.mean[2]);
         if near {
             self.wide.gate(z, track, ctx)
         } else {
