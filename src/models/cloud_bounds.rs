@@ -90,7 +90,7 @@ impl CloudBox {
         for (x, y) in self.corners() {
             let (dx, dy) = (x - sx, y - sy);
             let (lx, ly) = (c * dx + s * dy, -s * dx + c * dy);
-            if !(lx > 0.0) {
+            if lx.is_nan() || lx <= 0.0 {
                 return None;
             }
             let b = ly.atan2(lx);

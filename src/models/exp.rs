@@ -10,8 +10,8 @@
 /// log₂ e.
 const LOG2_E: f64 = std::f64::consts::LOG2_E;
 /// ln 2 in two parts: the high one has trailing zero bits, so k·LN2_HI is exact for |k| < 2^11.
-const LN2_HI: f64 = 6.931_471_803_691_238_164_9e-1;
-const LN2_LO: f64 = 1.908_214_929_270_587_700_02e-10;
+const LN2_HI: f64 = 6.931_471_803_691_238e-1;
+const LN2_LO: f64 = 1.908_214_929_270_587_7e-10;
 /// 1.5 · 2^52: adding it rounds to an integer, which then sits in the low mantissa bits.
 const ROUND: f64 = 6_755_399_441_055_744.0;
 /// Below this the result is flushed to 0 (e^−707 ≈ 9e-308 > 2^−1020).

@@ -416,7 +416,7 @@ impl OcclusionDetection {
         let Some(b) = bounds else {
             return CloudReach::UNKNOWN;
         };
-        if !(inc > 0.0) || b.d_min <= self.object_radius * (1.0 + 1e-9) {
+        if inc.is_nan() || inc <= 0.0 || b.d_min <= self.object_radius * (1.0 + 1e-9) {
             return CloudReach::UNKNOWN;
         }
         // The series used per particle stays below asin.
