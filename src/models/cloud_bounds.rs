@@ -43,7 +43,8 @@ pub struct PolarBounds {
 
 impl CloudBox {
     /// The box around components 0 (x) and 2 (y) of every particle; `None` for sets without
-    /// particles, of dimension below 3, or with a non-finite position.
+    /// particles, of dimension below 3, or with a non-finite position (or positions beyond
+    /// 1e300 m, whose sum overflows).
     pub fn of(particles: &ParticleSet) -> Option<Self> {
         if particles.dim() < 3 || particles.is_empty() {
             return None;
@@ -116,18 +117,19 @@ fn extent(v: &[f64]) -> (f64, f64, bool) {
             let x = c[k];
             lo[k] = if x < lo[k] { x } else { lo[k] };
             hi[k] = if x > hi[k] { x } else { hi[k] };
-            // 0 · x is NaN exactly when x is NaN or infinite.
-            probe[k] += 0.0 * x;
+            // the sum turns non-finite with any NaN or infinite x (positions never come near
+            // overflowing it)
+            probe[k] += x;
         }
     }
     for &x in rest {
         lo[0] = if x < lo[0] { x } else { lo[0] };
         hi[0] = if x > hi[0] { x } else { hi[0] };
-        probe[0] += 0.0 * x;
+        probe[0] += x;
     }
     let min = lo.iter().copied().fold(f64::INFINITY, f64::min);
     let max = hi.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    (min, max, probe.iter().sum::<f64>() == 0.0)
+    (min, max, probe.iter().sum::<f64>().is_finite())
 }
 
 #[cfg(test)]

@@ -99,7 +99,7 @@ impl WindowExtremes {
     }
 
     /// (min, max) of beams `first..=last` (first ≤ last < n).
-    #[inline]
+    #[inline(always)]
     fn query(&self, first: usize, last: usize) -> (f64, f64) {
         let len = last - first + 1;
         let k = (usize::BITS - 1 - len.leading_zeros()) as usize;

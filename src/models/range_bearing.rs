@@ -194,7 +194,7 @@ impl RangeBearing {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn measure(&self, s: &Sensor, px: f64, py: f64) -> (f64, f64) {
         let dx = px - s.x;
         let dy = py - s.y;
@@ -327,11 +327,14 @@ impl MeasurementModel for RangeBearing {
         // The predicted measurement of every particle, once for all measurements.
         let s = self.sensor(ctx);
         let n = particles.len();
-        let (mut ranges, mut bearings) = (Vec::with_capacity(n), Vec::with_capacity(n));
-        for (&x, &y) in particles.component(0).iter().zip(particles.component(2)) {
-            let (r, b) = self.measure(&s, x, y);
-            ranges.push(r);
-            bearings.push(b);
+        let (mut ranges, mut bearings) = (vec![0.0; n], vec![0.0; n]);
+        for (((r, b), &x), &y) in ranges
+            .iter_mut()
+            .zip(bearings.iter_mut())
+            .zip(particles.component(0))
+            .zip(particles.component(2))
+        {
+            (*r, *b) = self.measure(&s, x, y);
         }
         let norm = self.log_normaliser();
         let inv_r = 1.0 / self.sigma_range;
