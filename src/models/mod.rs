@@ -143,6 +143,7 @@ pub trait ClutterModel: Send + Sync {
 }
 
 mod atan;
+pub mod beam_view;
 pub mod cloud_bounds;
 pub mod clutter;
 pub mod ct;
