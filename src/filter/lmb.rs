@@ -16,6 +16,7 @@ use super::groups::partition;
 use super::track::{Estimate, Track};
 use super::{Jitter, Label, Measurements};
 use crate::error::{Error, Result};
+use crate::models::exp::exp_in_place;
 use crate::models::{
     ClutterModel, ConstantSurvival, DetectionModel, MeasurementModel, StepContext, SurvivalModel,
     TrackSummary, TransitionModel,
@@ -479,11 +480,9 @@ impl LmbFilter {
                         scaled_eta.push(0.0);
                         continue;
                     }
-                    // exp of anything below −746 is exactly 0: skip the call.
-                    g.iter_mut().for_each(|v| {
-                        let d = *v - top;
-                        *v = if d < -746.0 { 0.0 } else { d.exp() };
-                    });
+                    // Relative likelihoods below e^−707 ≈ 1e-307 count as 0.
+                    g.iter_mut().for_each(|v| *v -= top);
+                    exp_in_place(g);
                     let sum: f64 = g.iter().zip(w).zip(&pd).map(|((g, w), d)| g * w * d).sum();
                     log_eta.push(top + sum.ln());
                     scaled_eta.push(sum);

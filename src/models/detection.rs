@@ -173,6 +173,16 @@ impl FieldOfViewDetection {
         (px + a * c - b * s, py + a * s + b * c, c, s)
     }
 
+    /// Whether every point within the polar bounds `b` (taken from this sensor, see
+    /// [`super::CloudBox::polar_from`]) is inside the sector with room to spare, so that
+    /// [`FieldOfViewDetection::contains_from`] holds for each of them.
+    pub(crate) fn surely_contains(&self, b: &super::PolarBounds) -> bool {
+        let inside_range = b.d_max < self.max_range * (1.0 - 1e-9);
+        let inside_angle = self.half_angle >= std::f64::consts::PI
+            || (b.bearing_max < self.half_angle - 1e-9 && b.bearing_min > -self.half_angle + 1e-9);
+        inside_range && inside_angle
+    }
+
     /// |bearing| ≤ half angle is tested as cos(bearing) ≥ cos(half angle), i.e.
     /// l_x ≥ d · cos(half angle) (cos falls on [0, π]), which avoids an atan2 per particle.
     #[inline]

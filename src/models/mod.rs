@@ -143,11 +143,14 @@ pub trait ClutterModel: Send + Sync {
 }
 
 mod atan;
+pub mod beam_view;
+pub mod cloud_bounds;
 pub mod clutter;
 pub mod ct;
 pub mod cv;
 pub mod detectability;
 pub mod detection;
+pub(crate) mod exp;
 pub mod manoeuvring;
 pub mod occlusion;
 pub mod position;
@@ -156,6 +159,7 @@ pub mod resolution;
 pub mod survival;
 pub mod view_survival;
 
+pub use cloud_bounds::{CloudBox, PolarBounds};
 pub use clutter::UniformClutter;
 pub use ct::CoordinatedTurn;
 pub use cv::ConstantVelocity;

@@ -29,6 +29,7 @@
 //! Not for: occlusion by nearer objects ([`super::OcclusionDetection`]) or merged-measurement
 //! likelihoods (the merged measurement is treated as the measurement of one of the objects).
 
+use super::cloud_bounds::CloudBox;
 use super::{DetectionModel, MeasurementModel, RangeBearing, StepContext, TrackSummary};
 use crate::error::{ensure_probability, Error, Result};
 use crate::filter::ParticleSet;
@@ -92,11 +93,33 @@ impl<D> ResolutionDetection<D> {
     }
 
     /// The neighbours other than the set's own track that lie within reach of its weighted
-    /// mean (reach: `distance` + `fade` + 2 m for the particles' spread).
+    /// mean (reach: `distance` + `fade` + 2 m for the particles' spread) and near enough to
+    /// some particle to lower its p_D: a neighbour farther than `distance` + `fade` from the
+    /// box around every particle changes no particle's factor, so it is left out.
     fn others_near(&self, particles: &ParticleSet) -> Vec<[f64; 2]> {
-        let neighbours = self.neighbours.read().unwrap_or_else(|e| e.into_inner());
-        if neighbours.is_empty() || particles.is_empty() {
-            return Vec::new();
+        let Some(cloud) = CloudBox::of(particles) else {
+            return self.others_near_mean(particles);
+        };
+        let reach2 = (self.distance + self.fade).powi(2);
+        let touches = |n: &[f64; 2]| cloud.min_distance_squared(n[0], n[1]) <= reach2;
+        {
+            let neighbours = self.neighbours.read().unwrap_or_else(|e| e.into_inner());
+            if !neighbours.iter().any(touches) {
+                return Vec::new();
+            }
+        }
+        let mut near = self.others_near_mean(particles);
+        near.retain(touches);
+        near
+    }
+
+    /// The neighbours other than the set's own track within reach of its weighted mean.
+    fn others_near_mean(&self, particles: &ParticleSet) -> Vec<[f64; 2]> {
+        {
+            let neighbours = self.neighbours.read().unwrap_or_else(|e| e.into_inner());
+            if neighbours.is_empty() || particles.is_empty() {
+                return Vec::new();
+            }
         }
         let (xs, ys, w) = (
             particles.component(0),
@@ -109,7 +132,6 @@ impl<D> ResolutionDetection<D> {
         }
         let mx = w.iter().zip(xs).map(|(w, x)| w * x).sum::<f64>() / total;
         let my = w.iter().zip(ys).map(|(w, y)| w * y).sum::<f64>() / total;
-        drop(neighbours);
         self.others_near_point(mx, my)
     }
 
@@ -127,6 +149,17 @@ impl<D> ResolutionDetection<D> {
             })
             .copied()
             .collect()
+    }
+
+    /// Whether [`Self::others_near_point`] would find any neighbour (without collecting them).
+    fn any_other_near_point(&self, mx: f64, my: f64) -> bool {
+        let neighbours = self.neighbours.read().unwrap_or_else(|e| e.into_inner());
+        let reach = self.distance + self.fade + 2.0;
+        let ex2 = self.exclusion * self.exclusion;
+        neighbours.iter().any(|n| {
+            let d2 = (n[0] - mx).powi(2) + (n[1] - my).powi(2);
+            d2 >= ex2 && d2 < reach * reach
+        })
     }
 
     /// 1 − s · f(d) for the distance `d` to the nearest other neighbour.
@@ -176,11 +209,17 @@ impl<D> ResolutionDetection<D> {
             return;
         }
         let (xs, ys) = (particles.component(0), particles.component(2));
+        // Beyond `distance` + `fade` the factor is 1; squared distances clearly above that
+        // skip the square root (the margin covers its rounding).
+        let beyond = (self.distance + self.fade).powi(2) * (1.0 + 1e-9);
         for (i, (&x, &y)) in xs.iter().zip(ys).enumerate() {
             let d2 = others
                 .iter()
                 .map(|n| (n[0] - x).powi(2) + (n[1] - y).powi(2))
                 .fold(f64::INFINITY, f64::min);
+            if d2 > beyond {
+                continue;
+            }
             let f = self.factor(d2.sqrt());
             if f != 1.0 {
                 visit(i, f);
@@ -260,10 +299,9 @@ impl<D: Send + Sync> MeasurementModel for ResolutionLikelihood<D> {
 
     fn gate(&self, z: &[f64], track: &TrackSummary, ctx: &StepContext) -> bool {
         let near = track.mean.len() >= 3
-            && !self
+            && self
                 .resolution
-                .others_near_point(track.mean[0], track.mean[2])
-                .is_empty();
+                .any_other_near_point(track.mean[0], track.mean[2]);
         if near {
             self.wide.gate(z, track, ctx)
         } else {
@@ -368,6 +406,55 @@ mod tests {
         m.set_neighbours([[5.0, 0.0], [5.0, 5.0]]);
         l.log_likelihood(z, &s, &ctx, &mut a);
         assert_eq!(a, n); // far away
+    }
+
+    proptest::proptest! {
+        /// Skipping neighbours out of reach of the cloud's box changes no particle's p_D: the
+        /// rule evaluated particle by particle over every neighbour the mean admits.
+        #[test]
+        fn p_d_matches_the_rule_particle_by_particle(
+            points in proptest::collection::vec((-3.0f64..3.0, -3.0f64..3.0), 1..50),
+            neighbours in proptest::collection::vec((-6.0f64..6.0, -6.0f64..6.0), 0..8),
+            fade in 0.0f64..1.0,
+        ) {
+            let m = ResolutionDetection::new(ConstantDetection::new(0.9).unwrap(), 1.5, fade, 0.5, 0.3)
+                .unwrap();
+            let pts: Vec<[f64; 2]> = points.iter().map(|p| [p.0, p.1]).collect();
+            let ns: Vec<[f64; 2]> = neighbours.iter().map(|n| [n.0, n.1]).collect();
+            m.set_neighbours(ns.iter().copied());
+            let s = set(&pts);
+            let mut out = vec![0.0; pts.len()];
+            m.detection_probability(&s, &StepContext::new(0, 0.0, 0.1), &mut out);
+            let n = pts.len() as f64;
+            let (mx, my) = (
+                pts.iter().map(|p| p[0] / n).sum::<f64>(),
+                pts.iter().map(|p| p[1] / n).sum::<f64>(),
+            );
+            let reach = 1.5 + fade + 2.0;
+            let admitted: Vec<[f64; 2]> = ns
+                .iter()
+                .filter(|q| {
+                    let d = ((q[0] - mx).powi(2) + (q[1] - my).powi(2)).sqrt();
+                    d >= 0.3 && d < reach
+                })
+                .copied()
+                .collect();
+            for (p, o) in pts.iter().zip(&out) {
+                let d = admitted
+                    .iter()
+                    .map(|q| ((q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2)).sqrt())
+                    .fold(f64::INFINITY, f64::min);
+                let f = if d <= 1.5 {
+                    1.0
+                } else if fade > 0.0 && d < 1.5 + fade {
+                    1.0 - (d - 1.5) / fade
+                } else {
+                    0.0
+                };
+                let want = 0.9 * (1.0 - 0.5 * f);
+                proptest::prop_assert!((o - want).abs() < 1e-9, "{o} vs {want} at {p:?}");
+            }
+        }
     }
 
     #[test]

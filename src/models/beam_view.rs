@@ -1,0 +1,302 @@
+//! The beams of one planar scan as the occlusion-aware detection model reads them
+//! ([`super::OcclusionDetection`]): bearing of beam i = `angle_min + i · increment`, its range,
+//! and how many beams of a bearing window end nearer than a limit, with range extremes of
+//! power-of-two runs of beams so that most windows are answered by two lookups.
+//!
+//! Not for: reading scans from files ([`crate::laser2d`]) or deciding what blocks whom.
+
+use crate::error::{ensure_finite, Error, Result};
+
+/// The beams of one scan in the sensor frame: bearing of beam i = `angle_min + i · increment`,
+/// its range (`+∞` for "no return").
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BeamView {
+    pub(super) angle_min: f64,
+    pub(super) angle_increment: f64,
+    pub(super) ranges: Vec<f64>,
+    /// Range extremes of power-of-two runs of beams, for whole-window answers.
+    pub(super) extremes: WindowExtremes,
+}
+
+/// Sparse tables of the range minimum and maximum: level k holds, for every first beam i, the
+/// extremes of beams i..i + 2^k. Any window is the union of two (overlapping) runs of one
+/// level, so its extremes cost two lookups. Rebuilt once per scan, reusing its buffers.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(super) struct WindowExtremes {
+    /// Level k starts at `offsets[k]` in `min` and `max` and has n − 2^k + 1 entries.
+    offsets: Vec<usize>,
+    min: Vec<f64>,
+    max: Vec<f64>,
+}
+
+impl WindowExtremes {
+    fn rebuild(&mut self, ranges: &[f64]) {
+        let n = ranges.len();
+        self.offsets.clear();
+        let mut total = 0;
+        let mut width = 1;
+        while width <= n {
+            self.offsets.push(total);
+            total += n + 1 - width;
+            width *= 2;
+        }
+        self.min.resize(total, 0.0);
+        self.max.resize(total, 0.0);
+        if n == 0 {
+            return;
+        }
+        self.min[..n].copy_from_slice(ranges);
+        self.max[..n].copy_from_slice(ranges);
+        for k in 1..self.offsets.len() {
+            let half = 1 << (k - 1);
+            let (prev, this) = (self.offsets[k - 1], self.offsets[k]);
+            let len = n + 1 - 2 * half;
+            let (done, next) = self.min.split_at_mut(this);
+            for ((o, &a), &b) in next[..len]
+                .iter_mut()
+                .zip(&done[prev..prev + len])
+                .zip(&done[prev + half..prev + half + len])
+            {
+                *o = a.min(b);
+            }
+            let (done, next) = self.max.split_at_mut(this);
+            for ((o, &a), &b) in next[..len]
+                .iter_mut()
+                .zip(&done[prev..prev + len])
+                .zip(&done[prev + half..prev + half + len])
+            {
+                *o = a.max(b);
+            }
+        }
+    }
+
+    /// (min, max) of beams `first..=last` (first ≤ last < n).
+    #[inline(always)]
+    pub(super) fn query(&self, first: usize, last: usize) -> (f64, f64) {
+        let len = last - first + 1;
+        let k = (usize::BITS - 1 - len.leading_zeros()) as usize;
+        let o = self.offsets[k];
+        let (a, b) = (o + first, o + last + 1 - (1 << k));
+        (self.min[a].min(self.min[b]), self.max[a].max(self.max[b]))
+    }
+}
+
+/// ⌈x⌉, exact: the integer conversion is much cheaper than the library call on targets
+/// without a rounding instruction.
+#[inline]
+fn ceil_exact(x: f64) -> f64 {
+    if x.abs() < 4.5e15 {
+        let t = x as i64 as f64;
+        if t < x {
+            t + 1.0
+        } else {
+            t
+        }
+    } else {
+        x.ceil()
+    }
+}
+
+/// ⌊x⌋, exact (see [`ceil_exact`]).
+#[inline]
+fn floor_exact(x: f64) -> f64 {
+    if x.abs() < 4.5e15 {
+        let t = x as i64 as f64;
+        if t > x {
+            t - 1.0
+        } else {
+            t
+        }
+    } else {
+        x.floor()
+    }
+}
+
+/// x rounded half away from zero, exact (see [`ceil_exact`]).
+#[inline]
+fn round_exact(x: f64) -> f64 {
+    if x.abs() < 4.5e15 {
+        let t = x as i64 as f64;
+        let frac = x - t;
+        if frac >= 0.5 {
+            t + 1.0
+        } else if frac <= -0.5 {
+            t - 1.0
+        } else {
+            t
+        }
+    } else {
+        x.round()
+    }
+}
+
+impl BeamView {
+    /// A view from the scan header and its ranges; non-finite or non-positive ranges mean "no
+    /// return" and never block.
+    pub fn new(angle_min: f64, angle_increment: f64, ranges: &[f64]) -> Result<Self> {
+        ensure_finite("beam view header", &[angle_min, angle_increment])?;
+        if angle_increment == 0.0 && ranges.len() > 1 {
+            return Err(Error::invalid(
+                "beam view",
+                "angle increment is zero with several beams",
+            ));
+        }
+        let mut view = BeamView {
+            angle_min,
+            angle_increment,
+            ranges: Vec::with_capacity(ranges.len()),
+            extremes: WindowExtremes::default(),
+        };
+        view.set_ranges(ranges.iter().copied());
+        Ok(view)
+    }
+
+    /// Replaces the ranges, keeping the header (reuses the buffer).
+    pub fn set_ranges(&mut self, ranges: impl IntoIterator<Item = f64>) {
+        self.ranges.clear();
+        self.ranges.extend(ranges.into_iter().map(|r| {
+            if r.is_finite() && r > 0.0 {
+                r
+            } else {
+                f64::INFINITY
+            }
+        }));
+        self.extremes.rebuild(&self.ranges);
+    }
+
+    /// Number of beams.
+    pub fn len(&self) -> usize {
+        self.ranges.len()
+    }
+
+    /// True without beams.
+    pub fn is_empty(&self) -> bool {
+        self.ranges.is_empty()
+    }
+
+    /// (blocked, total) beams of the window `bearing ± half_width` whose return is shorter than
+    /// `limit`; the window holds at least the beam nearest to `bearing` when that lies in the
+    /// scan. (0, 0) when the window misses the scan.
+    #[inline]
+    pub fn blocked(&self, bearing: f64, half_width: f64, limit: f64) -> (usize, usize) {
+        let n = self.ranges.len();
+        if n == 0 {
+            return (0, 0);
+        }
+        let inc = if self.angle_increment == 0.0 {
+            1.0
+        } else {
+            self.angle_increment
+        };
+        let a = (bearing - half_width - self.angle_min) / inc;
+        let b = (bearing + half_width - self.angle_min) / inc;
+        let (lo, hi) = if a <= b { (a, b) } else { (b, a) };
+        let (mut first, mut last) = (ceil_exact(lo), floor_exact(hi));
+        if first > last {
+            let c = round_exact((bearing - self.angle_min) / inc);
+            first = c;
+            last = c;
+        }
+        let first = first.max(0.0);
+        let last = last.min((n - 1) as f64);
+        if first > last {
+            return (0, 0);
+        }
+        // Both are whole numbers in [0, n − 1] here (max/min drop a NaN), so the conversion
+        // through i64 is exact and cheaper than the saturating one to usize.
+        let (first, last) = (first as i64 as usize, last as i64 as usize);
+        let total = last - first + 1;
+        // Whole-window answers first: most windows are entirely clear or entirely blocked.
+        let (min, max) = self.extremes.query(first, last);
+        if min >= limit {
+            return (0, total);
+        }
+        if max < limit {
+            return (total, total);
+        }
+        let window = &self.ranges[first..=last];
+        let blocked = window.iter().map(|&r| usize::from(r < limit)).sum();
+        (blocked, total)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::{FRAC_PI_2, PI};
+
+    /// 181 beams over ±90°, 1° apart, all at 20 m except a wall piece at 3 m over beams
+    /// 85..=95 (bearings −5°..=5°).
+    fn view() -> BeamView {
+        let ranges: Vec<f64> = (0..181)
+            .map(|i| if (85..=95).contains(&i) { 3.0 } else { 20.0 })
+            .collect();
+        BeamView::new(-FRAC_PI_2, PI / 180.0, &ranges).unwrap()
+    }
+
+    #[test]
+    fn window_counts_blocked_beams() {
+        let v = view();
+        // straight ahead, ±2°: beams 88..=92, all at 3 m < 5 m
+        assert_eq!(v.blocked(0.0, 2f64.to_radians(), 5.0), (5, 5));
+        // 10° left, ±2°: beams 98..=102 at 20 m
+        assert_eq!(
+            v.blocked(10f64.to_radians(), 2f64.to_radians(), 5.0),
+            (0, 5)
+        );
+        // straddling the wall's edge at 5°: beams 93..=97 → 93, 94, 95 blocked
+        assert_eq!(v.blocked(5f64.to_radians(), 2f64.to_radians(), 5.0), (3, 5));
+        // a window narrower than a beam takes the nearest beam
+        assert_eq!(v.blocked(0.2f64.to_radians(), 1e-4, 5.0), (1, 1));
+        // behind the scanner: nothing
+        assert_eq!(v.blocked(PI, 0.01, 5.0), (0, 0));
+    }
+
+    /// The window rule evaluated beam by beam with the library's rounding.
+    fn blocked_by_hand(v: &BeamView, bearing: f64, half: f64, limit: f64) -> (usize, usize) {
+        let n = v.len() as f64;
+        let inc = v.angle_increment;
+        let (mut first, mut last) = (
+            ((bearing - half - v.angle_min) / inc).ceil(),
+            ((bearing + half - v.angle_min) / inc).floor(),
+        );
+        if first > last {
+            first = ((bearing - v.angle_min) / inc).round();
+            last = first;
+        }
+        let (first, last) = (first.max(0.0), last.min(n - 1.0));
+        if first > last {
+            return (0, 0);
+        }
+        let window = &v.ranges[first as usize..=last as usize];
+        (window.iter().filter(|&&r| r < limit).count(), window.len())
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn window_rounding_matches_the_library(
+            ranges in proptest::collection::vec(0.5f64..12.0, 1..400),
+            bearing in -2.0f64..2.0,
+            half in 0.0f64..0.8,
+            limit in 0.0f64..13.0,
+        ) {
+            let v = BeamView::new(-FRAC_PI_2, PI / 360.0, &ranges).unwrap();
+            proptest::prop_assert_eq!(
+                v.blocked(bearing, half, limit),
+                blocked_by_hand(&v, bearing, half, limit)
+            );
+        }
+    }
+
+    #[test]
+    fn exact_rounding_matches_the_library() {
+        for x in [
+            0.0, -0.0, 0.5, -0.5, 1.5, 2.5, -2.5, 3.0, -3.0, 1e-300, -7.999, 7.999, 1e17,
+        ] {
+            assert_eq!(ceil_exact(x), x.ceil(), "{x}");
+            assert_eq!(floor_exact(x), x.floor(), "{x}");
+            assert_eq!(round_exact(x), x.round(), "{x}");
+        }
+        assert!(ceil_exact(f64::NAN).is_nan() && floor_exact(f64::INFINITY).is_infinite());
+    }
+}
