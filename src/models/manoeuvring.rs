@@ -73,6 +73,31 @@ impl TransitionModel for ManoeuvringVelocity {
             self.probability,
         );
         let mut comps = particles.components_mut();
+        if dims == 2 {
+            // The planar case as one zipped pass (no index checks), the hot path of people.
+            let mut it = comps.iter_mut();
+            let (x, vx, y, vy) = match (it.next(), it.next(), it.next(), it.next()) {
+                (Some(x), Some(vx), Some(y), Some(vy)) => (x, vx, y, vy),
+                _ => return,
+            };
+            for (((x, vx), y), vy) in x
+                .iter_mut()
+                .zip(vx.iter_mut())
+                .zip(y.iter_mut())
+                .zip(vy.iter_mut())
+            {
+                let u: f64 = rng.random();
+                let sigma = if u < eps { wide } else { calm };
+                let ex: f64 = StandardNormal.sample(rng);
+                let ey: f64 = StandardNormal.sample(rng);
+                let (ax, ay) = (sigma * ex, sigma * ey);
+                *x += dt * *vx + half_dt2 * ax;
+                *vx += dt * ax;
+                *y += dt * *vy + half_dt2 * ay;
+                *vy += dt * ay;
+            }
+            return;
+        }
         for i in 0..comps[0].len() {
             let u: f64 = rng.random();
             let sigma = if u < eps { wide } else { calm };
