@@ -47,10 +47,14 @@ pub struct PeopleBirth {
     pub suppress_radius: f64,
     /// Tracks with at least this existence count as confirmed.
     pub suppress_existence: f64,
+    /// … and no proposal within this many standard deviations of a confirmed track's
+    /// position spread either (when larger than `suppress_radius`): a track that coasted
+    /// unseen has spread out, and the person it lost is still most likely its own.
+    pub suppress_spread: f64,
     /// Births carry a fifth state component, the detectability mode
     /// ([`crate::models::detectability`]), set to detectable (the person was just detected).
     pub with_detectability: bool,
-    confirmed: Arc<RwLock<Vec<[f64; 2]>>>,
+    confirmed: Arc<RwLock<Vec<([f64; 2], f64)>>>,
 }
 
 impl PeopleBirth {
@@ -82,6 +86,7 @@ impl PeopleBirth {
             velocity_std: velocity_std.abs(),
             suppress_radius: suppress_radius.max(0.0),
             suppress_existence: 0.5,
+            suppress_spread: 0.0,
             with_detectability: false,
             confirmed: Arc::new(RwLock::new(Vec::new())),
         })
@@ -90,13 +95,23 @@ impl PeopleBirth {
     /// Replaces the list of tracks (world positions at the previous scan, with their existence)
     /// around which no birth is proposed; tracks below `suppress_existence` are ignored.
     pub fn set_confirmed(&self, tracks: impl IntoIterator<Item = ([f64; 2], f64)>) {
+        self.set_confirmed_with_spread(tracks.into_iter().map(|(p, r)| (p, r, 0.0)));
+    }
+
+    /// [`PeopleBirth::set_confirmed`] with each track's position spread σ (m): no proposal
+    /// within max(`suppress_radius`, `spread_factor` · σ) of it.
+    pub fn set_confirmed_with_spread(
+        &self,
+        tracks: impl IntoIterator<Item = ([f64; 2], f64, f64)>,
+    ) {
         let mut c = self.confirmed.write().unwrap_or_else(|e| e.into_inner());
         c.clear();
+        let k = self.suppress_spread;
         c.extend(
             tracks
                 .into_iter()
-                .filter(|(_, r)| *r >= self.suppress_existence)
-                .map(|(p, _)| p),
+                .filter(|(_, r, _)| *r >= self.suppress_existence)
+                .map(|(p, _, s)| (p, self.suppress_radius.max(k * s).powi(2))),
         );
     }
 
@@ -143,7 +158,6 @@ impl BirthModel for PeopleBirth {
             return Vec::new();
         };
         let confirmed = self.confirmed.read().unwrap_or_else(|e| e.into_inner());
-        let r2 = self.suppress_radius * self.suppress_radius;
         ev.measurements
             .iter()
             .zip(ev.assigned)
@@ -154,9 +168,9 @@ impl BirthModel for PeopleBirth {
                 }
                 let zz = [z[0], z[1]];
                 let p = self.sensor.to_cartesian(zz, ev.context);
-                let near = confirmed.iter().any(|c| {
+                let near = confirmed.iter().any(|(c, r2)| {
                     let (dx, dy) = (c[0] - p[0], c[1] - p[1]);
-                    dx * dx + dy * dy < r2
+                    dx * dx + dy * dy < *r2
                 });
                 (!near).then(|| BirthTrack {
                     existence: r,
@@ -186,6 +200,30 @@ mod tests {
         assert!((b.existence(0.99) - 0.002).abs() < 1e-12);
         assert!((b.existence(0.0) - 0.2).abs() < 1e-12);
         assert!((b.existence(0.5) - 0.1).abs() < 1e-12);
+    }
+
+    /// A track that has spread out (σ = 1 m after coasting) suppresses proposals within
+    /// 2 σ of it, a tight one only within the fixed radius.
+    #[test]
+    fn spread_out_tracks_suppress_farther() {
+        let mut b = birth();
+        b.suppress_spread = 2.0;
+        let ctx = StepContext::new(0, 0.0, 0.1);
+        let m = Measurements::from_rows(2, &[[5.0, 0.0]]).unwrap();
+        let ev = BirthEvidence {
+            measurements: &m,
+            assigned: &[0.0],
+            context: &ctx,
+        };
+        // the track stands 1.5 m from the measurement's (5, 0)
+        b.set_confirmed_with_spread([([6.5, 0.0], 0.9, 0.1)]);
+        assert_eq!(b.birth(&ctx, Some(&ev), &mut seeded(1)).len(), 1);
+        b.set_confirmed_with_spread([([6.5, 0.0], 0.9, 1.0)]);
+        assert!(b.birth(&ctx, Some(&ev), &mut seeded(1)).is_empty());
+        // without the spread rule only the fixed radius counts
+        b.suppress_spread = 0.0;
+        b.set_confirmed_with_spread([([6.5, 0.0], 0.9, 1.0)]);
+        assert_eq!(b.birth(&ctx, Some(&ev), &mut seeded(1)).len(), 1);
     }
 
     #[test]

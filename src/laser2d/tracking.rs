@@ -57,6 +57,12 @@ pub struct PeopleTrackerConfig {
     pub survival_outside: f64,
     /// No birth within this distance (m) of a confirmed track. Default 0.8 m.
     pub birth_suppress_radius: f64,
+    /// … nor within this many standard deviations of its position spread, when that is
+    /// farther: a track that coasted through a run of misses or an occlusion has spread out,
+    /// and a person reappearing inside that spread is most likely the one it lost. Default 2
+    /// (lobby OSPA(2) 1.245 → 1.235 on seeds 1–8, 1.292 → 1.269 on seeds 11–18; scenario one
+    /// 98 % → 96 % of 50 runs keeping every label). 0 turns it off.
+    pub birth_suppress_spread: f64,
     /// A person within this distance (m) of another confirmed track is often not resolved
     /// as a separate measurement ([`crate::models::ResolutionDetection`]). Default 1.5 m.
     pub resolution_distance: f64,
@@ -129,6 +135,7 @@ impl PeopleTrackerConfig {
             occlusion_margin: (3.0 * sigma_range).max(0.15),
             survival_outside: 0.8,
             birth_suppress_radius: 0.8,
+            birth_suppress_spread: 2.0,
             resolution_distance: 1.5,
             resolution_fade: 0.5,
             unresolved_share: 0.5,
@@ -295,6 +302,7 @@ impl PeopleTracker {
             config.birth_suppress_radius,
         )?;
         birth.with_detectability = config.detectability.is_some();
+        birth.suppress_spread = config.birth_suppress_spread;
         let survival =
             FieldOfViewSurvival::new(fov, config.filter.survival, config.survival_outside)?;
         let resolution = ResolutionDetection::new(
@@ -450,17 +458,27 @@ impl PeopleTracker {
                 weighted_mean(w, p.component(1)),
                 weighted_mean(w, p.component(3)),
             );
-            ([x, y], [x + vx * dt, y + vy * dt], t.existence)
+            let var: f64 = w
+                .iter()
+                .zip(p.component(0).iter().zip(p.component(2)))
+                .map(|(w, (px, py))| w * ((px - x).powi(2) + (py - y).powi(2)))
+                .sum();
+            (
+                [x, y],
+                [x + vx * dt, y + vy * dt],
+                t.existence,
+                (0.5 * var).sqrt(),
+            )
         });
         let confirmed: Vec<_> = confirmed.collect();
         self.birth
-            .set_confirmed(confirmed.iter().map(|&(at, _, r)| (at, r)));
+            .set_confirmed_with_spread(confirmed.iter().map(|&(at, _, r, s)| (at, r, s)));
         let min_r = self.birth.suppress_existence;
         self.resolution.set_neighbours(
             confirmed
                 .iter()
                 .filter(|c| c.2 >= min_r)
-                .map(|&(_, next, _)| next),
+                .map(|&(_, next, _, _)| next),
         );
         let estimates = self.filter.step(
             &Frame {
