@@ -78,8 +78,8 @@ pub struct PeopleTrackerConfig {
     /// Share of particles per scan whose acceleration is drawn with `manoeuvre_sigma` instead
     /// of the filter's calm σ ([`crate::models::ManoeuvringVelocity`]): people who turn
     /// round or stop. Default 0.05. People who walk straight barely need it (scenario one, 50
-    /// runs: 98 % keep every label, 100 % without); people who turn round do (the lobby,
-    /// seeds 1–8, moving front end: OSPA(2) 1.25 against 1.44 without). 0 turns it off.
+    /// runs: 96 % keep every label, 100 % without); people who turn round do (the lobby,
+    /// seeds 1–8, moving front end: OSPA(2) 1.235 against 1.435 without). 0 turns it off.
     pub manoeuvre_probability: f64,
     /// Acceleration noise (m/s²) of a manoeuvring particle. Default 5: a reversal of 1 m/s
     /// within 0.25 s.
