@@ -26,6 +26,10 @@ use crate::rng::FilterRng;
 use rand_distr::{Distribution, StandardNormal};
 use std::sync::{Arc, RwLock};
 
+/// Confirmed tracks' positions, each with the squared radius around it in which no birth is
+/// proposed; shared by clones.
+type Suppressors = Arc<RwLock<Vec<([f64; 2], f64)>>>;
+
 /// Measurement-driven birth with suppression near confirmed tracks (module documentation).
 /// Clones share the list of confirmed positions.
 #[derive(Clone, Debug)]
@@ -54,7 +58,7 @@ pub struct PeopleBirth {
     /// Births carry a fifth state component, the detectability mode
     /// ([`crate::models::detectability`]), set to detectable (the person was just detected).
     pub with_detectability: bool,
-    confirmed: Arc<RwLock<Vec<([f64; 2], f64)>>>,
+    confirmed: Suppressors,
 }
 
 impl PeopleBirth {
