@@ -221,13 +221,13 @@ impl BeamView {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use std::f64::consts::{FRAC_PI_2, PI};
 
     /// 181 beams over ±90°, 1° apart, all at 20 m except a wall piece at 3 m over beams
-    /// 85..=95 (bearings −5°..=5°).
-    fn view() -> BeamView {
+    /// 85..=95 (bearings −5°..=5°). Shared with the occlusion model's tests.
+    pub(crate) fn view() -> BeamView {
         let ranges: Vec<f64> = (0..181)
             .map(|i| if (85..=95).contains(&i) { 3.0 } else { 20.0 })
             .collect();

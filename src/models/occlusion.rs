@@ -373,14 +373,7 @@ mod tests {
     use nalgebra::{Isometry3, Vector3};
     use std::f64::consts::{FRAC_PI_2, PI};
 
-    /// 181 beams over ±90°, 1° apart, all at 20 m except a wall piece at 3 m over beams
-    /// 85..=95 (bearings −5°..=5°).
-    fn view() -> BeamView {
-        let ranges: Vec<f64> = (0..181)
-            .map(|i| if (85..=95).contains(&i) { 3.0 } else { 20.0 })
-            .collect();
-        BeamView::new(-FRAC_PI_2, PI / 180.0, &ranges).unwrap()
-    }
+    use crate::models::beam_view::tests::view;
 
     fn model() -> OcclusionDetection {
         let fov = FieldOfViewDetection::new(0.9, 0.0, 30.0, FRAC_PI_2).unwrap();
