@@ -83,6 +83,9 @@ struct Args {
     /// constant velocity. Default: the tracker's (0.05).
     #[arg(long)]
     manoeuvre: Option<f64>,
+    /// LMB: particles per track. Default: the tracker's (500).
+    #[arg(long)]
+    particles: Option<usize>,
     /// Score estimates of people who are present but unseen (hidden, too far, out of view) as
     /// false instead of ignoring them.
     #[arg(long)]
@@ -258,10 +261,18 @@ fn lmb_config(
     fe: FrontEnd,
 ) -> PeopleTrackerConfig {
     let mut cfg = detector_config(scenario, seed, fe);
+    apply_lmb_args(args, &mut cfg);
+    cfg
+}
+
+/// The command line's LMB settings: manoeuvre share and particles per track.
+fn apply_lmb_args(args: &Args, cfg: &mut PeopleTrackerConfig) {
     if let Some(p) = args.manoeuvre {
         cfg.manoeuvre_probability = p;
     }
-    cfg
+    if let Some(n) = args.particles {
+        cfg.set_particles(n);
+    }
 }
 
 /// The range-bearing sensor every baseline assumes: the noise of a person's measured centre,
@@ -385,9 +396,7 @@ mod recording {
             [0.0, 0.0],
         )?;
         cfg.filter.seed = args.seed;
-        if let Some(p) = args.manoeuvre {
-            cfg.manoeuvre_probability = p;
-        }
+        super::apply_lmb_args(args, &mut cfg);
         let t0 = Instant::now();
         let fe = super::front_end(args)?;
         println!("front end {}", fe.name());
@@ -406,9 +415,10 @@ mod recording {
 
     fn load(args: &Args) -> Result<Vec<Scan>> {
         if let Some(path) = &args.carmen {
-            // Real logs have the odd record whose time stamp steps back: skip it.
+            // Real logs have the odd stamp that jumps while the file order is right: drop the
+            // fewest scans that leave time in order.
             let options = CarmenOptions {
-                time_order: TimeOrder::Skip,
+                time_order: TimeOrder::DropFewest,
                 ..CarmenOptions::default()
             };
             let log = read_carmen(path, options)

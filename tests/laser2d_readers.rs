@@ -178,6 +178,17 @@ fn vendored_intel_excerpt() {
         lenient.flaser.len() + lenient.odometry.len() + lenient.stats.backwards_skipped,
         50
     );
+    // Dropping the fewest: each of the three ODOM stamps that step back costs one record
+    // (the longest ordered run, by an independent O(n²) count, keeps 29 of 32).
+    let fewest = CarmenOptions {
+        time_order: TimeOrder::DropFewest,
+        ..CarmenOptions::default()
+    };
+    let kept = read_carmen(&path, fewest).unwrap();
+    assert_eq!((kept.flaser.len(), kept.odometry.len()), (18, 29));
+    assert_eq!(kept.stats.backwards_skipped, 3);
+    assert!(kept.odometry.windows(2).all(|w| w[0].time <= w[1].time));
+    assert!(kept.odometry.len() >= lenient.odometry.len());
 
     // Every scan segments; segments cover only valid beams, in order, without overlap.
     for s in &log.flaser {

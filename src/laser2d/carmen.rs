@@ -39,9 +39,14 @@
 //! [`Error::Parse`] naming file, line and field — or, with [`OnMalformed::Skip`], skipped
 //! and counted in [`CarmenStats`]. A record whose time is earlier than the last kept
 //! record *of the same type* is handled by [`TimeOrder`]: an error (default), skipped, or
-//! kept in file order. Real logs do this: the Intel Research Lab log has hundreds of
-//! `FLASER` and `ODOM` stamps that step back by up to 0.9 s, so reading it whole needs
-//! [`TimeOrder::Keep`]. Different types are not compared with one another.
+//! kept in file order; or, reading a whole log with [`read_carmen`], the fewest records are
+//! dropped that leave each type's stamps in order ([`TimeOrder::DropFewest`]). Real logs need
+//! this: the Intel Research Lab log has hundreds of `FLASER` and `ODOM` stamps that jump
+//! forward or back by up to 0.9 s while the poses in file order move on smoothly — the file
+//! order is right and single stamps are off. Skipping against the last kept record then drops
+//! every record after a stamp that jumped forward until the clock catches up (1,612 of 13,631
+//! scans); dropping the fewest drops about one record per jump (631). Different types are not
+//! compared with one another.
 
 use super::scan::{OdometryRecord, Pose2, Scan};
 use crate::error::{Error, Result};
@@ -69,6 +74,12 @@ pub enum TimeOrder {
     Skip,
     /// Keep the record in file order (still counted in [`CarmenStats::time_backwards`]).
     Keep,
+    /// Keep file order and drop, per record type, the fewest records that leave the time
+    /// stamps non-decreasing (a longest non-decreasing subsequence; counted in
+    /// [`CarmenStats::backwards_skipped`]). A single stamp that jumped forward costs that one
+    /// record, not every record until the clock catches up. Needs the whole log: only
+    /// [`read_carmen`] takes it ([`CarmenReader`] refuses it).
+    DropFewest,
 }
 
 /// Options of the CARMEN reader. The default is strict: every malformed line and every
@@ -99,7 +110,8 @@ impl CarmenOptions {
         Self::default()
     }
 
-    /// Skips (and counts) malformed lines and records whose time goes backwards.
+    /// Skips (and counts) malformed lines and records whose time goes backwards (streaming;
+    /// a whole log keeps more records with [`TimeOrder::DropFewest`]).
     pub fn lenient() -> Self {
         CarmenOptions {
             on_malformed: OnMalformed::Skip,
@@ -139,7 +151,7 @@ pub struct CarmenStats {
     /// Records whose time was earlier than the last kept record of their type (in every
     /// mode that did not stop at the first one).
     pub time_backwards: usize,
-    /// Of those, records skipped ([`TimeOrder::Skip`]).
+    /// Records dropped to keep time in order ([`TimeOrder::Skip`], [`TimeOrder::DropFewest`]).
     pub backwards_skipped: usize,
 }
 
@@ -189,7 +201,16 @@ pub struct CarmenLog {
 
 /// Reads a whole CARMEN log (plain, `.gz` or `.bz2`).
 pub fn read_carmen(path: impl AsRef<Path>, options: CarmenOptions) -> Result<CarmenLog> {
-    let mut reader = CarmenReader::open(path, options)?;
+    let drop_fewest = options.time_order == TimeOrder::DropFewest;
+    let streamed = CarmenOptions {
+        time_order: if drop_fewest {
+            TimeOrder::Keep
+        } else {
+            options.time_order
+        },
+        ..options
+    };
+    let mut reader = CarmenReader::open(path, streamed)?;
     let mut log = CarmenLog::default();
     for record in reader.by_ref() {
         match record? {
@@ -199,7 +220,54 @@ pub fn read_carmen(path: impl AsRef<Path>, options: CarmenOptions) -> Result<Car
         }
     }
     log.stats = reader.stats().clone();
+    if drop_fewest {
+        let mut dropped = 0;
+        dropped += keep_in_time_order(&mut log.flaser, |s| s.time);
+        dropped += keep_in_time_order(&mut log.robot_laser, |s| s.time);
+        dropped += keep_in_time_order(&mut log.odometry, |o| o.time);
+        log.stats.backwards_skipped = dropped;
+        log.stats.flaser = log.flaser.len();
+        log.stats.robot_laser = log.robot_laser.len();
+        log.stats.odometry = log.odometry.len();
+    }
     Ok(log)
+}
+
+/// Keeps the records of a longest subsequence whose times never decrease (file order kept)
+/// and returns how many were dropped.
+fn keep_in_time_order<T>(records: &mut Vec<T>, time: impl Fn(&T) -> f64) -> usize {
+    let times: Vec<f64> = records.iter().map(&time).collect();
+    let keep = longest_non_decreasing(&times);
+    let before = records.len();
+    let mut k = keep.iter();
+    records.retain(|_| *k.next().expect("one flag per record"));
+    before - records.len()
+}
+
+/// Flags of a longest non-decreasing subsequence of `t` (patience sorting, O(n log n)); among
+/// the longest, the one ending in the smallest values is chosen at every length.
+pub(crate) fn longest_non_decreasing(t: &[f64]) -> Vec<bool> {
+    // tails[l]: index of the smallest last value of a run of length l + 1 found so far.
+    let mut tails: Vec<usize> = Vec::new();
+    let mut previous = vec![usize::MAX; t.len()];
+    for (i, &v) in t.iter().enumerate() {
+        let l = tails.partition_point(|&j| t[j] <= v);
+        if l > 0 {
+            previous[i] = tails[l - 1];
+        }
+        if l == tails.len() {
+            tails.push(i);
+        } else {
+            tails[l] = i;
+        }
+    }
+    let mut keep = vec![false; t.len()];
+    let mut at = tails.last().copied().unwrap_or(usize::MAX);
+    while at != usize::MAX {
+        keep[at] = true;
+        at = previous[at];
+    }
+    keep
 }
 
 /// A streaming reader: an iterator over the records of a CARMEN log, one line at a time.
@@ -246,6 +314,12 @@ impl<R: BufRead> CarmenReader<R> {
     /// Reads CARMEN text from `input`; `path` is only used to name the source in errors.
     pub fn new(input: R, path: impl Into<PathBuf>, options: CarmenOptions) -> Result<Self> {
         options.validate()?;
+        if options.time_order == TimeOrder::DropFewest {
+            return Err(Error::invalid(
+                "CarmenOptions::time_order",
+                "DropFewest needs the whole log: read it with read_carmen",
+            ));
+        }
         Ok(CarmenReader {
             input,
             path: path.into(),
@@ -319,7 +393,7 @@ impl<R: BufRead> CarmenReader<R> {
                             self.stats.backwards_skipped += 1;
                             continue;
                         }
-                        TimeOrder::Keep => {}
+                        TimeOrder::Keep | TimeOrder::DropFewest => {}
                     }
                 }
             }
@@ -711,6 +785,69 @@ mod tests {
         let (recs, stats) = read(text, keep).unwrap();
         assert_eq!(recs.len(), 4);
         assert_eq!((stats.time_backwards, stats.backwards_skipped), (1, 0));
+    }
+
+    #[test]
+    fn drop_fewest_drops_only_the_stamp_that_jumped() {
+        // The third scan's stamp jumped 0.8 s ahead; skipping against the last kept stamp
+        // loses the three scans after it, dropping the fewest loses only that one.
+        let times = [1.0, 1.2, 2.2, 1.6, 1.8, 2.0, 2.4, 2.6];
+        let text: String = times
+            .iter()
+            .enumerate()
+            .map(|(i, t)| format!("FLASER 1 1.0 0 0 0 {i} 0 0 {t} h 0\n"))
+            .collect();
+        let (skipped, stats) = read(&text, CarmenOptions::lenient()).unwrap();
+        assert_eq!((skipped.len(), stats.backwards_skipped), (5, 3));
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("jump.clf");
+        std::fs::write(&path, &text).unwrap();
+        let fewest = CarmenOptions {
+            time_order: TimeOrder::DropFewest,
+            ..CarmenOptions::default()
+        };
+        let log = read_carmen(&path, fewest).unwrap();
+        let xs: Vec<f64> = log.flaser.iter().map(|s| s.odometry.unwrap().x).collect();
+        assert_eq!(xs, [0.0, 1.0, 3.0, 4.0, 5.0, 6.0, 7.0]);
+        assert_eq!(
+            (
+                log.stats.flaser,
+                log.stats.backwards_skipped,
+                log.stats.time_backwards
+            ),
+            (7, 1, 1)
+        );
+        // The streaming reader cannot look ahead: it refuses the option.
+        assert!(CarmenReader::new(text.as_bytes(), "jump.clf", fewest).is_err());
+    }
+
+    /// The length of a longest non-decreasing subsequence by trying every subset.
+    fn brute_longest(t: &[f64]) -> usize {
+        (0u32..1 << t.len())
+            .filter(|mask| {
+                let picked: Vec<f64> = (0..t.len())
+                    .filter(|i| mask & (1 << i) != 0)
+                    .map(|i| t[i])
+                    .collect();
+                picked.windows(2).all(|w| w[0] <= w[1])
+            })
+            .map(|mask| mask.count_ones() as usize)
+            .max()
+            .unwrap_or(0)
+    }
+
+    proptest::proptest! {
+        /// The kept stamps never decrease and are as many as any ordered choice can keep.
+        #[test]
+        fn longest_non_decreasing_is_ordered_and_longest(
+            t in proptest::collection::vec(0u8..6, 0..12)
+        ) {
+            let t: Vec<f64> = t.into_iter().map(f64::from).collect();
+            let keep = longest_non_decreasing(&t);
+            let kept: Vec<f64> = t.iter().zip(&keep).filter(|(_, k)| **k).map(|(v, _)| *v).collect();
+            proptest::prop_assert!(kept.windows(2).all(|w| w[0] <= w[1]));
+            proptest::prop_assert_eq!(kept.len(), brute_longest(&t));
+        }
     }
 
     #[test]

@@ -192,6 +192,17 @@ impl PeopleTrackerConfig {
     }
 }
 
+impl PeopleTrackerConfig {
+    /// Sets the number of particles per track, for the filter's resampling and for new
+    /// tracks (the birth model's draw).
+    pub fn set_particles(&mut self, n: usize) {
+        self.filter.filter.particles = n;
+        if let BirthConfig::Adaptive { particles, .. } = &mut self.filter.birth {
+            *particles = n;
+        }
+    }
+}
+
 /// Noise (σ_range m, σ_bearing rad) of a person's measured centre for a scanner whose beams
 /// have noise `sigma_range`, `sigma_bearing`: the centre is the mean of the person's returns
 /// (four or more on a person within 15 m of a 0.5° scanner), so its noise is about half a
@@ -683,6 +694,32 @@ mod tests {
             (e.state[3] - 0.8).abs() < 0.25 && e.state[1].abs() < 0.25,
             "velocity {e:?}"
         );
+    }
+
+    #[test]
+    fn set_particles_sizes_new_and_resampled_tracks() {
+        let mut cfg = PeopleTrackerConfig::for_scanner(
+            0.02,
+            0.005,
+            30.0,
+            std::f64::consts::FRAC_PI_2,
+            [0.0, 0.0],
+        );
+        cfg.set_particles(64);
+        let mut tracker = PeopleTracker::new(cfg).unwrap();
+        for k in 0..6 {
+            let t = k as f64 * 0.125;
+            tracker
+                .step(&scan_with_person(t, 5.0, -2.0 + 0.8 * t))
+                .unwrap();
+            // Births come from the previous scan's measurements.
+            let tracks = tracker.filter().tracks();
+            assert_eq!(tracks.is_empty(), k == 0, "step {k}");
+            assert!(tracks.iter().all(|t| t.particles.len() == 64), "step {k}");
+        }
+        let mut none = PeopleTrackerConfig::for_scanner(0.02, 0.005, 30.0, 1.5, [0.0, 0.0]);
+        none.set_particles(0);
+        assert!(PeopleTracker::new(none).is_err());
     }
 
     /// Walks a person at (5, y(t)) past a static scanner for `scans` scans; the front end
