@@ -292,7 +292,12 @@ fn build_tracker(
 ) -> Result<Box<dyn PointTracker>> {
     let sensor = sensor_model(scenario)?;
     Ok(match name {
-        "lmb" => Box::new(PeopleTracker::new(lmb_config(args, scenario, seed, fe))?),
+        "lmb" => {
+            let mut t = PeopleTracker::new(lmb_config(args, scenario, seed, fe))?;
+            // RMS prediction error and NIS as the baselines report them.
+            t.record_innovations(true);
+            Box::new(t)
+        }
         "gnn" => Box::new(GnnTracker::new(GnnConfig::new(sensor))?),
         "ml_ransac" => {
             let mut cfg = MlRansacConfig::new(sensor);

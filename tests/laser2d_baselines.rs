@@ -128,6 +128,37 @@ fn people_tracker_behind_the_same_interface_beats_the_baselines() {
     }
 }
 
+/// The people tracker's innovations, from its predicted particle clouds, against the GNN's
+/// from its EKF covariances on the same run: both assume the same centre noise, so their
+/// time-averaged NIS must agree (both sit below two: the assumed noise of a person's centre
+/// is larger than the simulator's), and the LMB's prediction error is that of a tracker
+/// that follows the people.
+#[test]
+fn people_tracker_innovations_agree_with_the_gnn() {
+    let (_, _, detector, sensor) = setup();
+    let mut cfg = detector.clone();
+    cfg.filter.seed = 1;
+    let mut lmb = smc_lmb::laser2d::PeopleTracker::new(cfg).unwrap();
+    lmb.record_innovations(true);
+    let m = score(&mut lmb);
+    let g = score(&mut GnnTracker::new(GnnConfig::new(sensor)).unwrap());
+    let nis = |m: &RunMetrics| m.nis.iter().sum::<f64>() / m.nis.len() as f64;
+    let (nl, ng) = (nis(&m), nis(&g));
+    eprintln!(
+        "NIS lmb {nl} gnn {ng}; RMS lmb {:?} gnn {:?}",
+        m.rms_prediction_error(),
+        g.rms_prediction_error()
+    );
+    // Five people over 240 scans, most of them seen in most scans.
+    assert!(m.innovations > 500, "{} innovations", m.innovations);
+    assert!((nl - ng).abs() < 0.5 * ng, "NIS lmb {nl} vs gnn {ng}");
+    let (rl, rg) = (
+        m.rms_prediction_error().unwrap(),
+        g.rms_prediction_error().unwrap(),
+    );
+    assert!(rl < 1.5 * rg && rl < 0.5, "RMS lmb {rl} vs gnn {rg}");
+}
+
 /// Label keeping, the hard part of scenario one (people pass within 0.9–2 m of each other
 /// while hiding one another): over five runs with the robot's drifting odometry, at least four
 /// keep every person on a single label from start to end.

@@ -198,6 +198,9 @@ impl LmbFilterBuilder {
             step: 0,
             previous: None,
             unmoved_detection: Vec::new(),
+            most_probable: Vec::new(),
+            keep_predicted: false,
+            predicted: Vec::new(),
         })
     }
 }
@@ -245,6 +248,18 @@ struct TrackMarginals {
     detect: Vec<(usize, f64)>,
 }
 
+/// A track's most probable measurement in a step, with the association's marginal
+/// probability that the track generated it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MostProbableMeasurement {
+    /// The track.
+    pub label: Label,
+    /// Index of the measurement in the step's [`Measurements`].
+    pub measurement: usize,
+    /// P(the track exists and generated this measurement).
+    pub probability: f64,
+}
+
 /// Stream keys, combined with a label key or group key, for each random stage.
 const KEY_PREDICT: u64 = 0x01 << 60;
 const KEY_BIRTH: u64 = 0x02 << 60;
@@ -261,6 +276,13 @@ pub struct LmbFilter {
     /// p_D of every particle from the last update, for the tracks whose particles have not
     /// moved since (not resampled), by label.
     unmoved_detection: Vec<(Label, Vec<f64>)>,
+    /// Each track's most probable measurement of the last step (tracks that could explain
+    /// some measurement).
+    most_probable: Vec<MostProbableMeasurement>,
+    /// Whether to keep the predicted particle sets of each step (consistency checks).
+    keep_predicted: bool,
+    /// The predicted particle sets of the last step (births as drawn), when kept.
+    predicted: Vec<(Label, crate::filter::ParticleSet)>,
 }
 
 impl std::fmt::Debug for LmbFilter {
@@ -300,6 +322,33 @@ impl LmbFilter {
         self.step = 0;
         self.previous = None;
         self.unmoved_detection.clear();
+        self.most_probable.clear();
+        self.predicted.clear();
+    }
+
+    /// Each track's most probable measurement of the last step, with its marginal
+    /// association probability (tracks that could explain no measurement are left out).
+    pub fn most_probable_measurements(&self) -> &[MostProbableMeasurement] {
+        &self.most_probable
+    }
+
+    /// Keeps (or stops keeping) a copy of every track's predicted particle set in each step,
+    /// for consistency checks of the prediction (innovations, NIS); off by default, as it
+    /// copies every particle once per step.
+    pub fn keep_predicted(&mut self, on: bool) {
+        self.keep_predicted = on;
+        if !on {
+            self.predicted.clear();
+        }
+    }
+
+    /// The predicted particle set of track `label` in the last step (the density the update
+    /// started from; for a track born in that step, its birth draw), when kept.
+    pub fn predicted(&self, label: Label) -> Option<&crate::filter::ParticleSet> {
+        self.predicted
+            .iter()
+            .find(|(l, _)| *l == label)
+            .map(|(_, p)| p)
     }
 
     /// The detection probability of every particle of track `label` as the last step's update
@@ -331,8 +380,24 @@ impl LmbFilter {
 
         self.predict(&ctx, seed);
         self.add_births(&ctx, seed);
+        self.predicted.clear();
+        if self.keep_predicted {
+            self.predicted
+                .extend(self.tracks.iter().map(|t| (t.label, t.particles.clone())));
+        }
         let likelihoods = self.likelihoods(z, &ctx);
         let marginals = self.associate(z, &ctx, &likelihoods, seed);
+        self.most_probable.clear();
+        for ((t, l), mg) in self.tracks.iter().zip(&likelihoods).zip(&marginals) {
+            let best = mg.detect.iter().max_by(|a, b| a.1.total_cmp(&b.1));
+            if let Some(&(k, probability)) = best {
+                self.most_probable.push(MostProbableMeasurement {
+                    label: t.label,
+                    measurement: l.gated[k],
+                    probability,
+                });
+            }
+        }
         let (assigned, resampled) = self.update(&likelihoods, &marginals, z.len(), seed);
         self.unmoved_detection.clear();
         for ((t, l), moved) in self.tracks.iter().zip(likelihoods).zip(resampled) {

@@ -21,7 +21,7 @@ pub use birth::{
     StaticBirth,
 };
 pub use label::Label;
-pub use lmb::{Frame, LmbConfig, LmbFilter, LmbFilterBuilder};
+pub use lmb::{Frame, LmbConfig, LmbFilter, LmbFilterBuilder, MostProbableMeasurement};
 pub use measurements::Measurements;
 pub use particles::{Jitter, ParticleSet};
 pub use track::{Estimate, Track};

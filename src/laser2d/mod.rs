@@ -15,6 +15,7 @@
 //!   [`moving_rule`] decides which clusters are moving; [`front_end`] turns a scan into the
 //!   trackers' measurements (every person-sized segment, or only the moving ones).
 //! * [`tracking`]: people tracking with the LMB filter; [`people_birth`] its birth model,
+//!   [`innovation`] the innovations of its tracks for consistency checks,
 //!   [`motion_state`] the static/dynamic classification of its tracks, [`person_groups`]
 //!   the grouping of returns into person candidates, [`people_run`] a whole recording.
 //!
@@ -37,6 +38,7 @@ pub mod features;
 pub mod front_end;
 pub mod fuzzy_art;
 pub mod icp;
+pub mod innovation;
 pub mod local_map;
 pub mod motion_state;
 pub mod moving;

@@ -11,6 +11,7 @@
 //! Not for: deciding which segments belong to moving objects on a cluttered map (background
 //! attenuation and shape learning), or the baseline trackers.
 
+use super::innovation::particle_innovation;
 use super::motion_state::{probability_moving, MotionClassifier, MotionConfig};
 use super::people_birth::PeopleBirth;
 use super::person_groups::{person_groups, PersonGrouping};
@@ -29,6 +30,7 @@ use crate::models::{
     ResolutionLikelihood, StepContext, TransitionModel,
 };
 use crate::rng::{seeded, FilterRng};
+use crate::trackers::Innovation;
 use nalgebra::{Isometry3, Vector3};
 
 /// What counts as a person and how they are tracked.
@@ -251,6 +253,10 @@ pub struct PeopleTracker {
     motion: MotionClassifier,
     confirmed: std::collections::BTreeSet<Label>,
     last_time: Option<f64>,
+    /// The range-bearing model of the people's centres (births, innovations).
+    sensor: RangeBearing,
+    /// Innovations of the last step's reported people, when recorded.
+    innovations: Option<Vec<Innovation>>,
 }
 
 impl PeopleTracker {
@@ -361,6 +367,8 @@ impl PeopleTracker {
             motion,
             confirmed: Default::default(),
             last_time: None,
+            sensor,
+            innovations: None,
         })
     }
 
@@ -381,6 +389,20 @@ impl PeopleTracker {
             config.manoeuvre_probability,
             config.manoeuvre_sigma,
         )?))
+    }
+
+    /// Records (or stops recording) the innovation of every reported person's most probable
+    /// measurement in each step, against the predicted particle cloud
+    /// ([`super::innovation`]), for the RMS prediction error and NIS checks. Off by default:
+    /// it copies the predicted particles of every track once per step.
+    pub fn record_innovations(&mut self, on: bool) {
+        self.filter.keep_predicted(on);
+        self.innovations = on.then(Vec::new);
+    }
+
+    /// The innovations of the last step (empty unless recorded).
+    pub fn innovations(&self) -> &[Innovation] {
+        self.innovations.as_deref().unwrap_or(&[])
     }
 
     /// The configuration.
@@ -491,6 +513,7 @@ impl PeopleTracker {
                 .filter(|c| c.2 >= min_r)
                 .map(|&(_, next, _, _)| next),
         );
+        let recorded = self.innovations.is_some().then(|| measurements.clone());
         let estimates = self.filter.step(
             &Frame {
                 time,
@@ -564,6 +587,31 @@ impl PeopleTracker {
             });
         }
         self.motion.retain(|l| tracks.iter().any(|t| t.label == l));
+        if let (Some(z), Some(innovations)) = (recorded, self.innovations.as_mut()) {
+            innovations.clear();
+            // The people reported now, by the measurement they most probably made (not
+            // people born in this step, whose cloud was drawn from their measurement).
+            let born_now = self.filter.steps() - 1;
+            for m in self.filter.most_probable_measurements() {
+                if m.probability <= 0.5
+                    || m.label.birth_step == born_now
+                    || !out.iter().any(|p| p.label == m.label)
+                {
+                    continue;
+                }
+                let Some(predicted) = self.filter.predicted(m.label) else {
+                    continue;
+                };
+                let row = z.get(m.measurement);
+                innovations.extend(particle_innovation(
+                    m.label,
+                    predicted,
+                    [row[0], row[1]],
+                    &self.sensor,
+                    &ctx,
+                ));
+            }
+        }
         Ok(out)
     }
 
@@ -587,6 +635,10 @@ impl crate::trackers::PointTracker for PeopleTracker {
     fn step(&mut self, z: &Measurements, ctx: &StepContext) -> Result<Vec<Estimate>> {
         let people = self.step_measured(z.clone(), ctx.time, ctx.platform)?;
         Ok(self.visible(people))
+    }
+
+    fn innovations(&self) -> &[Innovation] {
+        PeopleTracker::innovations(self)
     }
 }
 

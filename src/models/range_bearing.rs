@@ -230,6 +230,31 @@ impl RangeBearing {
         }
     }
 
+    /// The residual h(xᵢ) − `z` of every particle (position in components 0 and 2), range
+    /// into `range` and bearing, wrapped to (−π, π], into `bearing` (one slot per particle;
+    /// NaN for states with fewer than three components).
+    pub fn residuals(
+        &self,
+        z: [f64; 2],
+        particles: &ParticleSet,
+        ctx: &StepContext,
+        range: &mut [f64],
+        bearing: &mut [f64],
+    ) {
+        if particles.dim() < 3 {
+            range.fill(f64::NAN);
+            bearing.fill(f64::NAN);
+            return;
+        }
+        let s = self.sensor(ctx);
+        let (xs, ys) = (particles.component(0), particles.component(2));
+        for (((r, b), &x), &y) in range.iter_mut().zip(bearing.iter_mut()).zip(xs).zip(ys) {
+            let (hr, hb) = self.measure(&s, x, y);
+            *r = hr - z[0];
+            *b = wrap_angle(hb - z[1]);
+        }
+    }
+
     /// The world point (x, y) at which a noiseless measurement would read `z` = [range,
     /// bearing] — the inverse of [`RangeBearing::predict_measurement`] on positions.
     pub fn to_cartesian(&self, z: [f64; 2], ctx: &StepContext) -> [f64; 2] {
