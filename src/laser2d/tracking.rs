@@ -712,15 +712,14 @@ mod tests {
         s
     }
 
+    /// A 180° scanner of 2 cm / 0.005 rad beams, range 30 m, mounted at the robot's origin.
+    fn static_scanner_config() -> PeopleTrackerConfig {
+        PeopleTrackerConfig::for_scanner(0.02, 0.005, 30.0, std::f64::consts::FRAC_PI_2, [0.0, 0.0])
+    }
+
     #[test]
     fn a_walking_person_gets_one_label_and_the_right_velocity() {
-        let cfg = PeopleTrackerConfig::for_scanner(
-            0.02,
-            0.005,
-            30.0,
-            std::f64::consts::FRAC_PI_2,
-            [0.0, 0.0],
-        );
+        let cfg = static_scanner_config();
         let mut tracker = PeopleTracker::new(cfg).unwrap();
         let mut last = Vec::new();
         let mut labels = std::collections::BTreeSet::new();
@@ -750,13 +749,7 @@ mod tests {
 
     #[test]
     fn set_particles_sizes_new_and_resampled_tracks() {
-        let mut cfg = PeopleTrackerConfig::for_scanner(
-            0.02,
-            0.005,
-            30.0,
-            std::f64::consts::FRAC_PI_2,
-            [0.0, 0.0],
-        );
+        let mut cfg = static_scanner_config();
         cfg.set_particles(64);
         let mut tracker = PeopleTracker::new(cfg).unwrap();
         for k in 0..6 {
@@ -769,7 +762,7 @@ mod tests {
             assert_eq!(tracks.is_empty(), k == 0, "step {k}");
             assert!(tracks.iter().all(|t| t.particles.len() == 64), "step {k}");
         }
-        let mut none = PeopleTrackerConfig::for_scanner(0.02, 0.005, 30.0, 1.5, [0.0, 0.0]);
+        let mut none = static_scanner_config();
         none.set_particles(0);
         assert!(PeopleTracker::new(none).is_err());
     }
@@ -803,13 +796,7 @@ mod tests {
     }
 
     fn moving_front_end_config() -> PeopleTrackerConfig {
-        let mut cfg = PeopleTrackerConfig::for_scanner(
-            0.02,
-            0.005,
-            30.0,
-            std::f64::consts::FRAC_PI_2,
-            [0.0, 0.0],
-        );
+        let mut cfg = static_scanner_config();
         crate::laser2d::front_end::adapt_tracker_config(
             &mut cfg,
             crate::laser2d::front_end::FrontEnd::Moving,
