@@ -126,12 +126,17 @@ impl<D> ResolutionDetection<D> {
             particles.component(2),
             particles.weights(),
         );
-        let total: f64 = w.iter().sum();
+        // The three sums in one pass, each in particle order from −0.0 as `Iterator::sum`.
+        let (mut total, mut sx, mut sy) = (-0.0f64, -0.0f64, -0.0f64);
+        for ((&w, &x), &y) in w.iter().zip(xs).zip(ys) {
+            total += w;
+            sx += w * x;
+            sy += w * y;
+        }
         if total.is_nan() || total <= 0.0 {
             return Vec::new();
         }
-        let mx = w.iter().zip(xs).map(|(w, x)| w * x).sum::<f64>() / total;
-        let my = w.iter().zip(ys).map(|(w, y)| w * y).sum::<f64>() / total;
+        let (mx, my) = (sx / total, sy / total);
         self.others_near_point(mx, my)
     }
 
