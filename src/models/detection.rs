@@ -205,7 +205,8 @@ impl FieldOfViewDetection {
     /// points.
     #[inline(always)]
     pub(crate) fn contains_local(&self, lx: f64, d2: f64, cos_half: f64) -> bool {
-        let in_range = !(d2 > self.max_range * self.max_range);
+        // as `contains_from`: a NaN distance is not out of range
+        let in_range = (d2 <= self.max_range * self.max_range) | d2.is_nan();
         let in_angle = (self.half_angle >= std::f64::consts::PI) | (lx >= d2.sqrt() * cos_half);
         in_range & in_angle
     }
