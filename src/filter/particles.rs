@@ -215,14 +215,37 @@ impl ParticleSet {
 
     /// Weighted mean of every component into `out`.
     pub fn mean_into(&self, out: &mut [f64]) {
-        for (c, o) in out.iter_mut().enumerate().take(self.dim) {
-            *o = self
-                .component(c)
-                .iter()
-                .zip(&self.weights)
-                .map(|(x, w)| x * w)
-                .sum();
+        let dims = self.dim.min(out.len());
+        for (c, o) in (0..dims).step_by(4).zip(out.chunks_mut(4)) {
+            let k = (dims - c).min(4);
+            self.fused_sums(c, k, &mut o[..k], |x, w, _| x * w, &[0.0; 4]);
         }
+    }
+
+    /// Σᵢ term(xᵢ, wᵢ, shift[j]) of the `k` ≤ 4 components `first..first + k` into `out`:
+    /// one pass over the particles with one running sum per component, each added in particle
+    /// order from −0.0 as `Iterator::sum` does, so the numbers equal separate sums while the
+    /// additions of different components overlap.
+    #[inline(always)]
+    fn fused_sums(
+        &self,
+        first: usize,
+        k: usize,
+        out: &mut [f64],
+        term: impl Fn(f64, f64, f64) -> f64,
+        shift: &[f64; 4],
+    ) {
+        let w = &self.weights;
+        let c = |j: usize| self.component(first + j.min(k - 1));
+        let (a, b, d, e) = (c(0), c(1), c(2), c(3));
+        let mut s = [-0.0f64; 4];
+        for ((((&w, &x0), &x1), &x2), &x3) in w.iter().zip(a).zip(b).zip(d).zip(e) {
+            s[0] += term(x0, w, shift[0]);
+            s[1] += term(x1, w, shift[1]);
+            s[2] += term(x2, w, shift[2]);
+            s[3] += term(x3, w, shift[3]);
+        }
+        out[..k].copy_from_slice(&s[..k]);
     }
 
     /// Weighted mean as a new vector.
@@ -240,18 +263,14 @@ impl ParticleSet {
     /// Weighted mean and standard deviation of every component, the mean computed once.
     pub fn mean_and_std_dev(&self) -> (Vec<f64>, Vec<f64>) {
         let mean = self.mean();
-        let std = (0..self.dim)
-            .map(|c| {
-                let m = mean[c];
-                let var: f64 = self
-                    .component(c)
-                    .iter()
-                    .zip(&self.weights)
-                    .map(|(x, w)| w * (x - m) * (x - m))
-                    .sum();
-                var.max(0.0).sqrt()
-            })
-            .collect();
+        let mut std = vec![0.0; self.dim];
+        for (c, o) in (0..self.dim).step_by(4).zip(std.chunks_mut(4)) {
+            let k = (self.dim - c).min(4);
+            let mut shift = [0.0; 4];
+            shift[..k].copy_from_slice(&mean[c..c + k]);
+            self.fused_sums(c, k, o, |x, w, m| w * (x - m) * (x - m), &shift);
+        }
+        std.iter_mut().for_each(|v| *v = v.max(0.0).sqrt());
         (mean, std)
     }
 
@@ -404,6 +423,36 @@ mod tests {
     }
 
     proptest! {
+        /// The fused passes give bit for bit the component-by-component sums.
+        #[test]
+        fn fused_mean_and_spread_equal_separate_sums(
+            dim in 1usize..8,
+            values in proptest::collection::vec(-1e3f64..1e3, 0..600),
+            seed in 0u64..1000,
+        ) {
+            let len = values.len() / dim;
+            let rows: Vec<Vec<f64>> =
+                (0..len).map(|i| values[i * dim..(i + 1) * dim].to_vec()).collect();
+            let mut rng = crate::rng::seeded(seed);
+            let weights: Vec<f64> = (0..len).map(|_| rng.random::<f64>() + 1e-3).collect();
+            let Some(set) = ParticleSet::from_rows(&rows, &weights) else {
+                return Ok(());
+            };
+            let (mean, std) = set.mean_and_std_dev();
+            for c in 0..dim {
+                let w = set.weights();
+                let m: f64 = set.component(c).iter().zip(w).map(|(x, w)| x * w).sum();
+                let var: f64 = set
+                    .component(c)
+                    .iter()
+                    .zip(w)
+                    .map(|(x, w)| w * (x - m) * (x - m))
+                    .sum();
+                prop_assert_eq!(mean[c].to_bits(), m.to_bits());
+                prop_assert_eq!(std[c].to_bits(), var.max(0.0).sqrt().to_bits());
+            }
+        }
+
         #[test]
         fn weights_stay_normalised(logs in proptest::collection::vec(-1e4f64..1e4, 1..64), n in 1usize..200, seed in 0u64..1000) {
             let mut rng = seeded(seed);

@@ -81,38 +81,8 @@ impl WindowExtremes {
     }
 }
 
-/// ⌈x⌉, exact: the integer conversion is much cheaper than the library call on targets
-/// without a rounding instruction.
-#[inline]
-fn ceil_exact(x: f64) -> f64 {
-    if x.abs() < 4.5e15 {
-        let t = x as i64 as f64;
-        if t < x {
-            t + 1.0
-        } else {
-            t
-        }
-    } else {
-        x.ceil()
-    }
-}
-
-/// ⌊x⌋, exact (see [`ceil_exact`]).
-#[inline]
-fn floor_exact(x: f64) -> f64 {
-    if x.abs() < 4.5e15 {
-        let t = x as i64 as f64;
-        if t > x {
-            t - 1.0
-        } else {
-            t
-        }
-    } else {
-        x.floor()
-    }
-}
-
-/// x rounded half away from zero, exact (see [`ceil_exact`]).
+/// x rounded half away from zero, exact: the integer conversion is much cheaper than the
+/// library call on targets without a rounding instruction.
 #[inline]
 fn round_exact(x: f64) -> f64 {
     if x.abs() < 4.5e15 {
@@ -179,10 +149,16 @@ impl BeamView {
     /// scan. (0, 0) when the window misses the scan.
     #[inline]
     pub fn blocked(&self, bearing: f64, half_width: f64, limit: f64) -> (usize, usize) {
-        let n = self.ranges.len();
-        if n == 0 {
-            return (0, 0);
-        }
+        let (first, last) = self.window_ends(bearing, half_width);
+        self.count_blocked(first, last, bearing, limit)
+    }
+
+    /// The unclipped first and last beam index of the window `bearing ± half_width`, ⌈lo⌉ and
+    /// ⌊hi⌋ as whole floats (first > last when no beam direction falls inside it). Free of
+    /// branches and calls, so a loop over many windows runs on vector lanes; the rest of
+    /// [`BeamView::blocked`] is [`BeamView::count_blocked`].
+    #[inline(always)]
+    pub(super) fn window_ends(&self, bearing: f64, half_width: f64) -> (f64, f64) {
         let inc = if self.angle_increment == 0.0 {
             1.0
         } else {
@@ -191,8 +167,30 @@ impl BeamView {
         let a = (bearing - half_width - self.angle_min) / inc;
         let b = (bearing + half_width - self.angle_min) / inc;
         let (lo, hi) = if a <= b { (a, b) } else { (b, a) };
-        let (mut first, mut last) = (ceil_exact(lo), floor_exact(hi));
+        (ceil_lane(lo), floor_lane(hi))
+    }
+
+    /// The second half of [`BeamView::blocked`], from the window ends that
+    /// [`BeamView::window_ends`] gives for `bearing`.
+    #[inline]
+    pub(super) fn count_blocked(
+        &self,
+        first: f64,
+        last: f64,
+        bearing: f64,
+        limit: f64,
+    ) -> (usize, usize) {
+        let n = self.ranges.len();
+        if n == 0 {
+            return (0, 0);
+        }
+        let (mut first, mut last) = (first, last);
         if first > last {
+            let inc = if self.angle_increment == 0.0 {
+                1.0
+            } else {
+                self.angle_increment
+            };
             let c = round_exact((bearing - self.angle_min) / inc);
             first = c;
             last = c;
@@ -218,6 +216,30 @@ impl BeamView {
         let blocked = window.iter().map(|&r| usize::from(r < limit)).sum();
         (blocked, total)
     }
+}
+
+/// Beyond this magnitude window ends are clamped before rounding: they lie far outside any
+/// scan either way, and below it adding [`ROUND_SHIFT`] rounds exactly.
+const LANE_CLAMP: f64 = 1.0e15;
+/// 1.5 · 2^52: x + this − this is x rounded to the nearest integer (ties to even) for
+/// |x| ≤ 2^51.
+const ROUND_SHIFT: f64 = 6_755_399_441_055_744.0;
+
+/// ⌈x⌉ without branches or calls (x clamped to ±[`LANE_CLAMP`] first; NaN stays NaN): the
+/// nearest integer r, plus one when r < x.
+#[inline(always)]
+fn ceil_lane(x: f64) -> f64 {
+    let x = x.clamp(-LANE_CLAMP, LANE_CLAMP);
+    let r = (x + ROUND_SHIFT) - ROUND_SHIFT;
+    r + if r < x { 1.0 } else { 0.0 }
+}
+
+/// ⌊x⌋ without branches or calls (see [`ceil_lane`]).
+#[inline(always)]
+fn floor_lane(x: f64) -> f64 {
+    let x = x.clamp(-LANE_CLAMP, LANE_CLAMP);
+    let r = (x + ROUND_SHIFT) - ROUND_SHIFT;
+    r - if r > x { 1.0 } else { 0.0 }
 }
 
 #[cfg(test)]
@@ -274,6 +296,13 @@ pub(crate) mod tests {
 
     proptest::proptest! {
         #[test]
+        fn lane_rounding_matches_the_library(x in -1e15f64..1e15, k in -60i32..60) {
+            let v = x * 2f64.powi(k.min(0));
+            proptest::prop_assert_eq!(ceil_lane(v), v.ceil());
+            proptest::prop_assert_eq!(floor_lane(v), v.floor());
+        }
+
+        #[test]
         fn window_rounding_matches_the_library(
             ranges in proptest::collection::vec(0.5f64..12.0, 1..400),
             bearing in -2.0f64..2.0,
@@ -293,10 +322,34 @@ pub(crate) mod tests {
         for x in [
             0.0, -0.0, 0.5, -0.5, 1.5, 2.5, -2.5, 3.0, -3.0, 1e-300, -7.999, 7.999, 1e17,
         ] {
-            assert_eq!(ceil_exact(x), x.ceil(), "{x}");
-            assert_eq!(floor_exact(x), x.floor(), "{x}");
             assert_eq!(round_exact(x), x.round(), "{x}");
         }
-        assert!(ceil_exact(f64::NAN).is_nan() && floor_exact(f64::INFINITY).is_infinite());
+        for x in [
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.5,
+            2.5,
+            -2.5,
+            3.0,
+            -3.0,
+            1e-300,
+            -7.999,
+            7.999,
+            4.5e14,
+            -4.5e14,
+            0.499_999_999_999_999_94,
+            -0.499_999_999_999_999_94,
+            1e15,
+            -1e15,
+        ] {
+            assert_eq!(ceil_lane(x), x.ceil(), "{x}");
+            assert_eq!(floor_lane(x), x.floor(), "{x}");
+        }
+        assert!(ceil_lane(f64::NAN).is_nan() && floor_lane(f64::NAN).is_nan());
+        // far outside any scan the ends are clamped
+        assert_eq!(ceil_lane(1e17), LANE_CLAMP);
+        assert_eq!(floor_lane(f64::NEG_INFINITY), -LANE_CLAMP);
     }
 }

@@ -199,6 +199,24 @@ impl FieldOfViewDetection {
     }
 }
 
+impl FieldOfViewDetection {
+    /// [`Self::contains_from`] on sensor-frame coordinates: `lx` and `d2` = l_x² + l_y², with
+    /// `cos_half` = cos(half angle). The same answer, without branches, for loops over many
+    /// points.
+    #[inline(always)]
+    pub(crate) fn contains_local(&self, lx: f64, d2: f64, cos_half: f64) -> bool {
+        // as `contains_from`: a NaN distance is not out of range
+        let in_range = (d2 <= self.max_range * self.max_range) | d2.is_nan();
+        let in_angle = (self.half_angle >= std::f64::consts::PI) | (lx >= d2.sqrt() * cos_half);
+        in_range & in_angle
+    }
+
+    /// cos(half angle), for [`Self::contains_local`].
+    pub(crate) fn cos_half_angle(&self) -> f64 {
+        self.half_angle.cos()
+    }
+}
+
 impl DetectionModel for FieldOfViewDetection {
     fn detection_probability(&self, particles: &ParticleSet, ctx: &StepContext, out: &mut [f64]) {
         if particles.dim() < 3 {
