@@ -526,9 +526,7 @@ impl LmbFilter {
                 if detectable && !z.is_empty() {
                     let (mean, std) = p.mean_and_std_dev();
                     let summary = TrackSummary { mean, std };
-                    gated = (0..z.len())
-                        .filter(|&j| m.measurement.gate(z.get(j), &summary, ctx))
-                        .collect();
+                    m.measurement.gate_all(z, &summary, ctx, &mut gated);
                 }
                 let zs: Vec<&[f64]> = gated.iter().map(|&j| z.get(j)).collect();
                 let mut scaled_g = vec![vec![0.0; n]; zs.len()];

@@ -127,6 +127,19 @@ pub trait MeasurementModel: Send + Sync {
         let _ = (z, track, ctx);
         true
     }
+    /// The indices of the measurements `zs` that pass [`MeasurementModel::gate`] for `track`,
+    /// in order, into `out` (cleared first). The default tests each; models whose gate has
+    /// per-track work (the track's predicted measurement) override it to do that once.
+    fn gate_all(
+        &self,
+        zs: &crate::filter::Measurements,
+        track: &TrackSummary,
+        ctx: &StepContext,
+        out: &mut Vec<usize>,
+    ) {
+        out.clear();
+        out.extend((0..zs.len()).filter(|&j| self.gate(zs.get(j), track, ctx)));
+    }
 }
 
 /// The detection probability p_D(x).
@@ -214,6 +227,15 @@ impl<T: MeasurementModel + ?Sized> MeasurementModel for Box<T> {
     }
     fn gate(&self, z: &[f64], track: &TrackSummary, ctx: &StepContext) -> bool {
         (**self).gate(z, track, ctx)
+    }
+    fn gate_all(
+        &self,
+        zs: &crate::filter::Measurements,
+        track: &TrackSummary,
+        ctx: &StepContext,
+        out: &mut Vec<usize>,
+    ) {
+        (**self).gate_all(zs, track, ctx, out)
     }
 }
 

@@ -31,7 +31,7 @@
 use super::atan::{atan2, atan2_slices};
 use super::{MeasurementModel, StepContext, TrackSummary};
 use crate::error::{Error, Result};
-use crate::filter::ParticleSet;
+use crate::filter::{Measurements, ParticleSet};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// Default gate half-width, in standard deviations (see [`RangeBearing::gate`]).
@@ -309,6 +309,74 @@ impl RangeBearing {
     }
 }
 
+/// The gate of one track in measurement space (see [`RangeBearing`]'s `gate`): the
+/// predicted measurement of the track's mean and the admitted half-widths, computed once per
+/// track.
+#[derive(Clone, Copy, Debug)]
+struct GateWindow {
+    /// Admit everything (a summary without positions, or NaN in it).
+    all: bool,
+    rho: f64,
+    theta: f64,
+    range_half_width: f64,
+    /// Half-width in bearing; infinite when the cloud reaches the sensor.
+    bearing_half_width: f64,
+}
+
+impl GateWindow {
+    fn admits(&self, z: &[f64]) -> bool {
+        let [zr, zb] = match z {
+            [r, b] if r.is_finite() && b.is_finite() => [*r, *b],
+            _ => return false,
+        };
+        self.all
+            || ((zr - self.rho).abs() <= self.range_half_width
+                && wrap_angle(zb - self.theta).abs() <= self.bearing_half_width)
+    }
+}
+
+impl RangeBearing {
+    /// The gate window of `track`: `z` is admitted when it falls around the predicted
+    /// measurement of the track's mean position, in measurement space: |z_ρ − ρ̂| ≤ k·(σ_ρ + s) and
+    /// |z_θ − θ̂| ≤ k·σ_θ + asin(min(1, k·s / ρ̂)), where k is the gate width and
+    /// s = √(s_x² + s_y²) the track's position spread. A particle cloud of radius k·s at range ρ̂
+    /// subtends at most that bearing interval, so the window is conservative; a track whose
+    /// cloud reaches the sensor admits every bearing.
+    fn gate_window(&self, track: &TrackSummary, ctx: &StepContext) -> GateWindow {
+        let mut w = GateWindow {
+            all: true,
+            rho: 0.0,
+            theta: 0.0,
+            range_half_width: f64::INFINITY,
+            bearing_half_width: f64::INFINITY,
+        };
+        if track.mean.len() < 3 || track.std.len() < 3 {
+            return w;
+        }
+        let s = self.sensor(ctx);
+        let (rho, theta) = self.measure(&s, track.mean[0], track.mean[2]);
+        let spread = track.std[0].hypot(track.std[2]);
+        // NaN in the summary: admit rather than silently drop.
+        if !(rho.is_finite() && spread.is_finite()) {
+            return w;
+        }
+        let k = self.gate_sigmas;
+        let reach = if rho > 0.0 {
+            (k * spread / rho).min(1.0)
+        } else {
+            1.0
+        };
+        w.all = false;
+        w.rho = rho;
+        w.theta = theta;
+        w.range_half_width = k * (self.sigma_range + spread);
+        if reach < 1.0 {
+            w.bearing_half_width = k * self.sigma_bearing + reach.asin();
+        }
+        w
+    }
+}
+
 impl MeasurementModel for RangeBearing {
     fn measurement_dim(&self) -> usize {
         2
@@ -347,34 +415,22 @@ impl MeasurementModel for RangeBearing {
         }
     }
 
-    /// Admits `z` when it falls in a window around the predicted measurement of the track's
-    /// mean position, in measurement space: |z_ρ − ρ̂| ≤ k·(σ_ρ + s) and
-    /// |z_θ − θ̂| ≤ k·σ_θ + asin(min(1, k·s / ρ̂)), where k is the gate width and
-    /// s = √(s_x² + s_y²) the track's position spread. A particle cloud of radius k·s at range ρ̂
-    /// subtends at most that bearing interval, so the window is conservative; a track whose
-    /// cloud reaches the sensor admits every bearing.
+    /// Admits `z` inside the track's gate window (`gate_window`), which is conservative for
+    /// the whole particle cloud.
     fn gate(&self, z: &[f64], track: &TrackSummary, ctx: &StepContext) -> bool {
-        let [zr, zb] = match z {
-            [r, b] if r.is_finite() && b.is_finite() => [*r, *b],
-            _ => return false,
-        };
-        if track.mean.len() < 3 || track.std.len() < 3 {
-            return true;
-        }
-        let s = self.sensor(ctx);
-        let (rho, theta) = self.measure(&s, track.mean[0], track.mean[2]);
-        let spread = track.std[0].hypot(track.std[2]);
-        let k = self.gate_sigmas;
-        let range_ok = (zr - rho).abs() <= k * (self.sigma_range + spread);
-        let reach = if rho > 0.0 {
-            (k * spread / rho).min(1.0)
-        } else {
-            1.0
-        };
-        let bearing_ok =
-            reach >= 1.0 || wrap_angle(zb - theta).abs() <= k * self.sigma_bearing + reach.asin();
-        // NaN in the summary: admit rather than silently drop.
-        !(rho.is_finite() && spread.is_finite()) || (range_ok && bearing_ok)
+        self.gate_window(track, ctx).admits(z)
+    }
+
+    fn gate_all(
+        &self,
+        zs: &Measurements,
+        track: &TrackSummary,
+        ctx: &StepContext,
+        out: &mut Vec<usize>,
+    ) {
+        let window = self.gate_window(track, ctx);
+        out.clear();
+        out.extend((0..zs.len()).filter(|&j| window.admits(zs.get(j))));
     }
 
     fn log_likelihood_batch(
@@ -535,6 +591,59 @@ mod tests {
                 let [cx, cy] = m.to_cartesian(z, &c);
                 assert!((cx - x).abs() < 1e-9 && (cy - y).abs() < 1e-9, "{conv:?}");
             }
+        }
+    }
+
+    proptest::proptest! {
+        /// Gating all measurements of a track at once admits exactly those the gate of one
+        /// measurement admits: tracks near and far, tight and spread, with NaN or short
+        /// summaries, from a moved and turned platform.
+        #[test]
+        fn gate_all_admits_what_gate_admits(
+            mean in (-15.0f64..15.0, -15.0f64..15.0),
+            spread in (0.0f64..3.0, 0.0f64..3.0),
+            zs in proptest::collection::vec((0.0f64..20.0, -3.5f64..3.5), 0..12),
+            pose in (-2.0f64..2.0, -2.0f64..2.0, -3.0f64..3.0),
+            broken in 0u8..4,
+        ) {
+            let m = RangeBearing::new(0.2, 0.035).unwrap().with_offset(0.3, 0.1).unwrap();
+            let mut c = StepContext::new(1, 0.1, 0.1);
+            c.platform = Some(Isometry3::new(
+                Vector3::new(pose.0, pose.1, 0.0),
+                Vector3::new(0.0, 0.0, pose.2),
+            ));
+            let mut track = TrackSummary {
+                mean: vec![mean.0, 0.0, mean.1, 0.0],
+                std: vec![spread.0, 0.1, spread.1, 0.1],
+            };
+            match broken {
+                1 => track.mean[0] = f64::NAN,
+                2 => track.std.truncate(2),
+                _ => {}
+            }
+            let rows: Vec<[f64; 2]> = zs.iter().map(|&(r, b)| [r, b]).collect();
+            let z = Measurements::from_rows(2, &rows).unwrap();
+            let mut all = vec![99];
+            m.gate_all(&z, &track, &c, &mut all);
+            let one: Vec<usize> = (0..z.len()).filter(|&j| m.gate(z.get(j), &track, &c)).collect();
+            // The rule as documented, from the library's atan2.
+            let rule = |z: &[f64]| {
+                if track.mean.len() < 3 || track.std.len() < 3 {
+                    return true;
+                }
+                let h = m.predict_measurement(&track.mean, &c);
+                let s = track.std[0].hypot(track.std[2]);
+                if !(h[0].is_finite() && s.is_finite()) {
+                    return true;
+                }
+                let k = m.gate_sigmas();
+                let reach = if h[0] > 0.0 { (k * s / h[0]).min(1.0) } else { 1.0 };
+                (z[0] - h[0]).abs() <= k * (0.2 + s)
+                    && (reach >= 1.0 || wrap_angle(z[1] - h[1]).abs() <= k * 0.035 + reach.asin())
+            };
+            let by_rule: Vec<usize> = (0..z.len()).filter(|&j| rule(z.get(j))).collect();
+            proptest::prop_assert_eq!(&all, &one);
+            proptest::prop_assert_eq!(&all, &by_rule);
         }
     }
 

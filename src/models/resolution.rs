@@ -313,19 +313,35 @@ impl<D: Send + Sync> MeasurementModel for ResolutionLikelihood<D> {
     }
 
     fn gate(&self, z: &[f64], track: &TrackSummary, ctx: &StepContext) -> bool {
+        self.gating_model(track).gate(z, track, ctx)
+    }
+
+    fn gate_all(
+        &self,
+        zs: &crate::filter::Measurements,
+        track: &TrackSummary,
+        ctx: &StepContext,
+        out: &mut Vec<usize>,
+    ) {
+        self.gating_model(track).gate_all(zs, track, ctx, out)
+    }
+}
+
+impl<D> ResolutionLikelihood<D> {
+    /// The model whose gate applies to `track`: the wide one when the track's mean lies next
+    /// to another track.
+    fn gating_model(&self, track: &TrackSummary) -> &RangeBearing {
         let near = track.mean.len() >= 3
             && self
                 .resolution
                 .any_other_near_point(track.mean[0], track.mean[2]);
         if near {
-            self.wide.gate(z, track, ctx)
+            &self.wide
         } else {
-            self.narrow.gate(z, track, ctx)
+            &self.narrow
         }
     }
-}
 
-impl<D> ResolutionLikelihood<D> {
     /// Replaces, in every row, the narrow log-likelihood of each particle next to another
     /// track by the wide one (the neighbours are looked up once for all rows).
     fn widen<R: AsMut<[f64]>>(&self, particles: &ParticleSet, rows: &mut [R]) {
