@@ -1,10 +1,15 @@
 //! Criterion benchmark of the people-tracking pipeline on 361-beam scans: grouping the returns
 //! into person candidates alone, and grouping plus the LMB filter (500 particles per track)
 //! over a whole simulated run of scenario one (240 scans, five walkers, a moving robot) and
-//! over a crowd of twenty walkers (up to 20 tracks at 500 particles, 80 scans). Throughput is
+//! over a crowd of twenty walkers (up to 20 tracks at 500 particles, 80 scans); and the moving
+//! front end alone (background map, ICP against the local map, shape classes) in the lobby of
+//! scenario two, where walls and pillars give ICP something to hold on to. Throughput is
 //! reported per scan, so criterion's "elem/s" reads as scans per second.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use smc_lmb::laser2d::front_end::{
+    adapt_tracker_config, default_detector_config, FrontEnd, PersonFrontEnd,
+};
 use smc_lmb::laser2d::{PeopleTracker, PeopleTrackerConfig};
 use smc_lmb::sim::{PeopleScenario, PersonLeg, PersonSpec, RobotLeg};
 use std::time::Duration;
@@ -103,6 +108,40 @@ fn laser2d_pipeline(c: &mut Criterion) {
             })
         },
     );
+    g.finish();
+
+    // Segmentation + background + ICP + grouping in a structured scene, without tracking.
+    let lobby = PeopleScenario::two();
+    let lobby_run = lobby.generate(1).expect("lobby");
+    let s = &lobby.scanner;
+    let mut lobby_cfg = PeopleTrackerConfig::for_scanner(
+        s.sigma_range,
+        s.sigma_bearing,
+        s.range_max,
+        s.fov / 2.0,
+        lobby.mount,
+    );
+    adapt_tracker_config(&mut lobby_cfg, FrontEnd::Moving);
+    let detector = default_detector_config(&lobby_cfg, lobby_run.scans[0].angle_increment);
+    let mut g = c.benchmark_group("laser2d_pipeline");
+    g.sample_size(10).measurement_time(Duration::from_secs(10));
+    g.throughput(Throughput::Elements(lobby_run.scans.len() as u64));
+    g.bench_function("moving_front_end/361_beams_lobby", |b| {
+        b.iter(|| {
+            let mut fe = PersonFrontEnd::new(FrontEnd::Moving, &lobby_cfg, Some(detector))
+                .expect("front end");
+            lobby_run
+                .scans
+                .iter()
+                .map(|scan| {
+                    fe.measure(scan, scan.odometry)
+                        .expect("measure")
+                        .measurements
+                        .len()
+                })
+                .sum::<usize>()
+        })
+    });
     g.finish();
 }
 
