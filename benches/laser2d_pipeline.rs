@@ -47,17 +47,22 @@ fn crowd_of_twenty() -> PeopleScenario {
     s
 }
 
-fn laser2d_pipeline(c: &mut Criterion) {
-    let scenario = PeopleScenario::one();
-    let run = scenario.generate(1).expect("scenario one");
+/// The people tracker's configuration for the scanner of `scenario`.
+fn tracker_config(scenario: &PeopleScenario) -> PeopleTrackerConfig {
     let s = &scenario.scanner;
-    let cfg = PeopleTrackerConfig::for_scanner(
+    PeopleTrackerConfig::for_scanner(
         s.sigma_range,
         s.sigma_bearing,
         s.range_max,
         s.fov / 2.0,
         scenario.mount,
-    );
+    )
+}
+
+fn laser2d_pipeline(c: &mut Criterion) {
+    let scenario = PeopleScenario::one();
+    let run = scenario.generate(1).expect("scenario one");
+    let cfg = tracker_config(&scenario);
     let mut g = c.benchmark_group("laser2d_pipeline");
     g.sample_size(10).measurement_time(Duration::from_secs(5));
     g.throughput(Throughput::Elements(run.scans.len() as u64));
@@ -84,14 +89,7 @@ fn laser2d_pipeline(c: &mut Criterion) {
     // The case: up to 20 tracks at 500 particles on 361-beam scans.
     let crowd = crowd_of_twenty();
     let crowd_run = crowd.generate(1).expect("crowd of twenty");
-    let s = &crowd.scanner;
-    let crowd_cfg = PeopleTrackerConfig::for_scanner(
-        s.sigma_range,
-        s.sigma_bearing,
-        s.range_max,
-        s.fov / 2.0,
-        crowd.mount,
-    );
+    let crowd_cfg = tracker_config(&crowd);
     let mut g = c.benchmark_group("laser2d_pipeline");
     g.sample_size(10).measurement_time(Duration::from_secs(10));
     g.throughput(Throughput::Elements(crowd_run.scans.len() as u64));
@@ -113,14 +111,7 @@ fn laser2d_pipeline(c: &mut Criterion) {
     // Segmentation + background + ICP + grouping in a structured scene, without tracking.
     let lobby = PeopleScenario::two();
     let lobby_run = lobby.generate(1).expect("lobby");
-    let s = &lobby.scanner;
-    let mut lobby_cfg = PeopleTrackerConfig::for_scanner(
-        s.sigma_range,
-        s.sigma_bearing,
-        s.range_max,
-        s.fov / 2.0,
-        lobby.mount,
-    );
+    let mut lobby_cfg = tracker_config(&lobby);
     adapt_tracker_config(&mut lobby_cfg, FrontEnd::Moving);
     let detector = default_detector_config(&lobby_cfg, lobby_run.scans[0].angle_increment);
     let mut g = c.benchmark_group("laser2d_pipeline");
