@@ -440,6 +440,23 @@ mod tests {
         m
     }
 
+    /// The model (people of 0.2 m, margin 0.6 m) on a 361-beam half-circle scan of 30 m
+    /// returns, with pieces of wall (first beam, beams, range) in front.
+    fn behind_walls(blockers: &[(usize, usize, f64)], min_returns: u32) -> OcclusionDetection {
+        let fov = FieldOfViewDetection::new(0.9, 0.1, 30.0, FRAC_PI_2).unwrap();
+        let m = OcclusionDetection::new(fov, 0.2, 0.6)
+            .unwrap()
+            .with_min_returns(min_returns);
+        let mut ranges = vec![30.0; 361];
+        for &(first, len, r) in blockers {
+            ranges[first..(first + len).min(361)]
+                .iter_mut()
+                .for_each(|v| *v = r);
+        }
+        m.set_view(BeamView::new(-FRAC_PI_2, PI / 360.0, &ranges).unwrap());
+        m
+    }
+
     proptest::proptest! {
         /// The cloud-wide beam summary never changes a particle's p_D: clouds of people
         /// (0.2 m) at 1–15 m, partly behind pieces of wall at random ranges, with and without the
@@ -453,15 +470,7 @@ mod tests {
             pose in (-1.0f64..1.0, -1.0f64..1.0, -0.3f64..0.3),
             min_returns in 0u32..3,
         ) {
-            let fov = FieldOfViewDetection::new(0.9, 0.1, 30.0, FRAC_PI_2).unwrap();
-            let m = OcclusionDetection::new(fov, 0.2, 0.6)
-                .unwrap()
-                .with_min_returns(min_returns);
-            let mut ranges = vec![30.0; 361];
-            for (first, len, r) in blockers {
-                ranges[first..(first + len).min(361)].iter_mut().for_each(|v| *v = r);
-            }
-            m.set_view(BeamView::new(-FRAC_PI_2, PI / 360.0, &ranges).unwrap());
+            let m = behind_walls(&blockers, min_returns);
             let mut ctx = StepContext::new(0, 0.0, 0.1);
             ctx.platform = Some(Isometry3::new(
                 Vector3::new(pose.0, pose.1, 0.0),
@@ -491,15 +500,7 @@ mod tests {
             points in proptest::collection::vec((-2.0f64..32.0, -16.0f64..16.0), 1..150),
             min_returns in 0u32..3,
         ) {
-            let fov = FieldOfViewDetection::new(0.9, 0.1, 30.0, FRAC_PI_2).unwrap();
-            let m = OcclusionDetection::new(fov, 0.2, 0.6)
-                .unwrap()
-                .with_min_returns(min_returns);
-            let mut ranges = vec![30.0; 361];
-            for (first, len, r) in blockers {
-                ranges[first..(first + len).min(361)].iter_mut().for_each(|v| *v = r);
-            }
-            m.set_view(BeamView::new(-FRAC_PI_2, PI / 360.0, &ranges).unwrap());
+            let m = behind_walls(&blockers, min_returns);
             let view = m.view.read().unwrap().clone();
             let ctx = StepContext::new(0, 0.0, 0.1);
             let rows: Vec<Vec<f64>> = points.iter().map(|p| vec![p.0, 0.0, p.1, 0.0]).collect();
@@ -508,7 +509,7 @@ mod tests {
             m.detection_probability(&set, &ctx, &mut out);
             let spacing = PI / 360.0;
             for (&(x, y), &o) in points.iter().zip(&out) {
-                let want = if !fov.contains_from(x, y, 0.0, 0.0, 1.0, 0.0) {
+                let want = if !m.field_of_view().contains_from(x, y, 0.0, 0.0, 1.0, 0.0) {
                     0.1
                 } else {
                     let d = (x * x + y * y).sqrt();
