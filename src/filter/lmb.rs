@@ -14,7 +14,7 @@ use super::birth::{BirthEvidence, BirthModel};
 use super::estimate::map_estimates;
 use super::groups::partition;
 use super::track::{Estimate, Track};
-use super::{Jitter, Label, Measurements};
+use super::{Jitter, Label, Measurements, ParticleSet};
 use crate::error::{Error, Result};
 use crate::models::exp::exp_in_place;
 use crate::models::{
@@ -282,7 +282,7 @@ pub struct LmbFilter {
     /// Whether to keep the predicted particle sets of each step (consistency checks).
     keep_predicted: bool,
     /// The predicted particle sets of the last step (births as drawn), when kept.
-    predicted: Vec<(Label, crate::filter::ParticleSet)>,
+    predicted: Vec<(Label, ParticleSet)>,
 }
 
 impl std::fmt::Debug for LmbFilter {
@@ -344,7 +344,7 @@ impl LmbFilter {
 
     /// The predicted particle set of track `label` in the last step (the density the update
     /// started from; for a track born in that step, its birth draw), when kept.
-    pub fn predicted(&self, label: Label) -> Option<&crate::filter::ParticleSet> {
+    pub fn predicted(&self, label: Label) -> Option<&ParticleSet> {
         self.predicted
             .iter()
             .find(|(l, _)| *l == label)
