@@ -214,25 +214,6 @@ pub fn centre_noise(sigma_range: f64, sigma_bearing: f64) -> (f64, f64) {
     (sigma_range.max(0.05), sigma_bearing.max(0.005))
 }
 
-/// Σ wᵢ·vᵢ of components 0..4 in one pass, each sum in particle order from −0.0 (the numbers
-/// of four separate `Iterator::sum`s).
-fn weighted_means(w: &[f64], p: &crate::filter::ParticleSet) -> [f64; 4] {
-    let mut s = [-0.0f64; 4];
-    let (c0, c1, c2, c3) = (
-        p.component(0),
-        p.component(1),
-        p.component(2),
-        p.component(3),
-    );
-    for ((((&w, &a), &b), &c), &d) in w.iter().zip(c0).zip(c1).zip(c2).zip(c3) {
-        s[0] += w * a;
-        s[1] += w * b;
-        s[2] += w * c;
-        s[3] += w * d;
-    }
-    s
-}
-
 /// One person in one scan's output.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PersonEstimate {
@@ -498,7 +479,9 @@ impl PeopleTracker {
         let confirmed = self.filter.tracks().iter().map(|t| {
             let p = &t.particles;
             let w = p.weights();
-            let [x, vx, y, vy] = weighted_means(w, p);
+            let mut mean = [0.0; 4];
+            p.mean_into(&mut mean);
+            let [x, vx, y, vy] = mean;
             let var: f64 = w
                 .iter()
                 .zip(p.component(0).iter().zip(p.component(2)))
