@@ -8,10 +8,10 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use smc_lmb::filter::birth::BirthEvidence;
+use smc_lmb::filter::StepContext;
 use smc_lmb::filter::{
     BirthModel, BirthTrack, Frame, LmbConfig, LmbFilter, Measurements, StaticBirth,
 };
-use smc_lmb::models::StepContext;
 use smc_lmb::models::{ConstantDetection, ConstantVelocity, PositionMeasurement, UniformClutter};
 use smc_lmb::rng::seeded;
 use smc_lmb::sim::Scenario;

@@ -7,10 +7,10 @@
 //! reported per scan, so criterion's "elem/s" reads as scans per second.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use smc_lmb::laser2d::front_end::{
+use smc_lmb::pipeline::people_tracking::front_end::{
     adapt_tracker_config, default_detector_config, FrontEnd, PersonFrontEnd,
 };
-use smc_lmb::laser2d::{PeopleTracker, PeopleTrackerConfig};
+use smc_lmb::pipeline::people_tracking::{PeopleTracker, PeopleTrackerConfig};
 use smc_lmb::sim::{PeopleScenario, PersonLeg, PersonSpec, RobotLeg};
 use std::time::Duration;
 

@@ -16,10 +16,9 @@ use rand_distr::{Distribution, StandardNormal};
 use smc_lmb::filter::{
     AdaptiveBirth, Frame, LmbConfig, LmbFilter, Measurements, ParticleSet, PositionBirthSampler,
 };
+use smc_lmb::filter::{StepContext, TransitionModel};
 use smc_lmb::metrics::ospa;
-use smc_lmb::models::{
-    ConstantDetection, PositionMeasurement, StepContext, TransitionModel, UniformClutter,
-};
+use smc_lmb::models::{ConstantDetection, PositionMeasurement, UniformClutter};
 use smc_lmb::rng::seeded;
 use smc_lmb::FilterRng;
 

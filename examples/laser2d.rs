@@ -28,16 +28,16 @@
 
 use anyhow::{Context, Result};
 use clap::Parser;
-use smc_lmb::laser2d::evaluate::{
+use smc_lmb::laser2d::moving::{MovingDetectorConfig, MovingRule};
+use smc_lmb::models::RangeBearing;
+use smc_lmb::pipeline::people_tracking::evaluate::{
     evaluate_run_with, summarise, EvalConfig, PoseSource, RunMetrics, ScoreFrame, Summary,
 };
-use smc_lmb::laser2d::front_end::{
+use smc_lmb::pipeline::people_tracking::front_end::{
     adapt_tracker_config, default_detector_config, FrontEnd, MovingEvidence, PersonFrontEnd,
     MOVING_CLUTTER_RATE, MOVING_DETECTION_PROBABILITY,
 };
-use smc_lmb::laser2d::moving::{MovingDetectorConfig, MovingRule};
-use smc_lmb::laser2d::{centre_noise, PeopleTracker, PeopleTrackerConfig};
-use smc_lmb::models::RangeBearing;
+use smc_lmb::pipeline::people_tracking::{centre_noise, PeopleTracker, PeopleTrackerConfig};
 use smc_lmb::sim::PeopleScenario;
 use smc_lmb::trackers::{
     GnnConfig, GnnTracker, JpdaImmConfig, JpdaImmTracker, MlRansacConfig, MlRansacTracker,
@@ -380,11 +380,11 @@ fn print_table(args: &Args, names: &[&str], summaries: &[Summary]) {
 mod recording {
     use super::Args;
     use anyhow::{Context, Result};
-    use smc_lmb::laser2d::{
-        config_for_scans, read_bag, read_carmen, track_scans_with, write_people_json, BagOptions,
-        CarmenOptions, PeopleRun, Scan, TimeOrder,
+    use smc_lmb::laser2d::{read_bag, read_carmen, BagOptions, CarmenOptions, Scan, TimeOrder};
+    use smc_lmb::pipeline::people_tracking::{
+        config_for_scans, track_scans_with, write_people_json, PeopleRun,
     };
-    use smc_lmb::plot::{write_people_plot, PeoplePlotOptions};
+    use smc_lmb::pipeline::people_tracking::{write_people_plot, PeoplePlotOptions};
     use std::path::Path;
     use std::time::Instant;
 

@@ -37,10 +37,10 @@ use crate::error::{ensure_finite, Error, Result};
 use crate::filter::{
     AdaptiveBirth, AssociationMethod, BirthTerm, LmbConfig, LmbFilter, ParticleSet, StaticBirth,
 };
+use crate::filter::{ConstantSurvival, StepContext};
 use crate::models::{
-    BearingConvention, ConstantDetection, ConstantSurvival, ConstantVelocity, CoordinatedTurn,
-    FieldOfViewDetection, GaussianRangeDetection, PositionMeasurement, RangeBearing, StepContext,
-    UniformClutter,
+    BearingConvention, ConstantDetection, ConstantVelocity, CoordinatedTurn, FieldOfViewDetection,
+    GaussianRangeDetection, PositionMeasurement, RangeBearing, UniformClutter,
 };
 use crate::rng::FilterRng;
 use rand_distr::{Distribution, StandardNormal};
@@ -100,7 +100,7 @@ pub enum TransitionConfig {
 
 impl TransitionConfig {
     /// Checks the values and builds the model.
-    pub fn model(&self) -> Result<Box<dyn crate::models::TransitionModel>> {
+    pub fn model(&self) -> Result<Box<dyn crate::filter::TransitionModel>> {
         Ok(match *self {
             TransitionConfig::ConstantVelocity { dims, sigma_accel } => {
                 Box::new(ConstantVelocity::new(dims, sigma_accel)?)

@@ -13,6 +13,7 @@ pub mod kitti;
 pub mod laser2d;
 pub mod metrics;
 pub mod models;
+pub(crate) mod numerics;
 pub mod pipeline;
 pub mod plot;
 pub mod rng;

@@ -5,8 +5,9 @@
 
 use nalgebra::{Point3, Vector3};
 use smc_lmb::cloud::{read_kitti_bin, read_kitti_bin_with, write_kitti_bin, NonFinite, PointCloud};
+use smc_lmb::geometry::wrap_angle;
 use smc_lmb::kitti::calib::orthonormality_error;
-use smc_lmb::kitti::poses::{oxts_world_poses, wrap_angle, Mercator};
+use smc_lmb::kitti::poses::{oxts_world_poses, Mercator};
 use smc_lmb::kitti::{
     read_oxts_dir, read_timestamps, read_tracklets, write_oxts_dir, Issue, OdometrySequence,
     OxtsPacket, RawDrive,

@@ -8,9 +8,10 @@
 use proptest::prelude::*;
 use smc_lmb::laser2d::csv::{CSV_HEADER, CSV_MAGIC};
 use smc_lmb::laser2d::{
-    bag_topics, config_for_scans, read_bag, read_carmen, read_scan_csv, track_scans, BagOptions,
-    CarmenOptions, CarmenReader, OnMalformed, Scan, TimeOrder,
+    bag_topics, read_bag, read_carmen, read_scan_csv, BagOptions, CarmenOptions, CarmenReader,
+    OnMalformed, Scan, TimeOrder,
 };
+use smc_lmb::pipeline::people_tracking::{config_for_scans, track_scans};
 use smc_lmb::Error;
 use std::io::Write;
 use std::path::Path;
@@ -406,11 +407,11 @@ fn scans_with_bad_headers_are_refused_by_validate() {
         ..ok.clone()
     });
     bad.push(Scan {
-        odometry: Some(smc_lmb::laser2d::Pose2::new(0.0, f64::NAN, 0.0)),
+        odometry: Some(smc_lmb::geometry::Pose2::new(0.0, f64::NAN, 0.0)),
         ..ok.clone()
     });
     bad.push(Scan {
-        laser_pose: Some(smc_lmb::laser2d::Pose2::new(f64::INFINITY, 0.0, 0.0)),
+        laser_pose: Some(smc_lmb::geometry::Pose2::new(f64::INFINITY, 0.0, 0.0)),
         ..ok.clone()
     });
     for s in &bad {

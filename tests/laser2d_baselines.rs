@@ -2,9 +2,11 @@
 //! simulated scenario (five people crossing in front of a driving robot), fed the same
 //! range-bearing measurements and scored by the same harness.
 
-use smc_lmb::laser2d::evaluate::{evaluate_run, EvalConfig, PoseSource, RunMetrics};
-use smc_lmb::laser2d::PeopleTrackerConfig;
 use smc_lmb::models::RangeBearing;
+use smc_lmb::pipeline::people_tracking::evaluate::{
+    evaluate_run, EvalConfig, PoseSource, RunMetrics,
+};
+use smc_lmb::pipeline::people_tracking::PeopleTrackerConfig;
 use smc_lmb::rng::seeded;
 use smc_lmb::sim::{People2dRun, PeopleScenario};
 use smc_lmb::trackers::{
@@ -110,7 +112,7 @@ fn people_tracker_behind_the_same_interface_beats_the_baselines() {
     let (_, _, detector, sensor) = setup();
     let mut cfg = detector.clone();
     cfg.filter.seed = 1;
-    let m = score(&mut smc_lmb::laser2d::PeopleTracker::new(cfg).unwrap());
+    let m = score(&mut smc_lmb::pipeline::people_tracking::PeopleTracker::new(cfg).unwrap());
     check("people", &m, 0.3, 0.6, 3);
     let g = score(&mut GnnTracker::new(GnnConfig::new(sensor)).unwrap());
     let mut rc = MlRansacConfig::new(sensor);
@@ -138,7 +140,7 @@ fn people_tracker_innovations_agree_with_the_gnn() {
     let (_, _, detector, sensor) = setup();
     let mut cfg = detector.clone();
     cfg.filter.seed = 1;
-    let mut lmb = smc_lmb::laser2d::PeopleTracker::new(cfg).unwrap();
+    let mut lmb = smc_lmb::pipeline::people_tracking::PeopleTracker::new(cfg).unwrap();
     lmb.record_innovations(true);
     let m = score(&mut lmb);
     let g = score(&mut GnnTracker::new(GnnConfig::new(sensor)).unwrap());
@@ -170,7 +172,7 @@ fn people_tracker_keeps_every_label_in_most_runs() {
         let run = scenario.generate(seed).unwrap();
         let mut cfg = detector.clone();
         cfg.filter.seed = seed;
-        let mut tracker = smc_lmb::laser2d::PeopleTracker::new(cfg).unwrap();
+        let mut tracker = smc_lmb::pipeline::people_tracking::PeopleTracker::new(cfg).unwrap();
         let m = evaluate_run(&mut tracker, &run, &detector, &EvalConfig::default()).unwrap();
         assert!(m.mean_ospa < 0.3, "seed {seed}: mean OSPA {}", m.mean_ospa);
         kept.push(m.all_labels_kept);

@@ -3,11 +3,11 @@
 //! GNN and ML-RANSAC baselines on the same measurements, scored by the same harness (odometry
 //! pose, robot frame), as `examples/laser2d.rs --scenario two` does.
 
-use smc_lmb::laser2d::evaluate::{evaluate_run, EvalConfig, RunMetrics};
-use smc_lmb::laser2d::front_end::{adapt_tracker_config, FrontEnd};
-use smc_lmb::laser2d::tracking::centre_noise;
-use smc_lmb::laser2d::{PeopleTracker, PeopleTrackerConfig};
 use smc_lmb::models::RangeBearing;
+use smc_lmb::pipeline::people_tracking::evaluate::{evaluate_run, EvalConfig, RunMetrics};
+use smc_lmb::pipeline::people_tracking::front_end::{adapt_tracker_config, FrontEnd};
+use smc_lmb::pipeline::people_tracking::tracker::centre_noise;
+use smc_lmb::pipeline::people_tracking::{PeopleTracker, PeopleTrackerConfig};
 use smc_lmb::sim::PeopleScenario;
 use smc_lmb::trackers::{GnnConfig, GnnTracker, MlRansacConfig, MlRansacTracker, PointTracker};
 

@@ -2,8 +2,8 @@
 //! is removed and people are found (scenario two, a lobby), and ICP keeps the pose from
 //! drifting with the odometry (scenario one).
 
+use smc_lmb::geometry::Pose2;
 use smc_lmb::laser2d::moving::{MovingDetectorConfig, MovingObjectDetector};
-use smc_lmb::laser2d::Pose2;
 use smc_lmb::sim::people2d::{People2dRun, PeopleScenario};
 
 /// Scans before the background and the votes have settled.
@@ -203,7 +203,7 @@ fn stage_recall(
             .candidates
             .iter()
             .map(|&b| {
-                smc_lmb::laser2d::rigid::transform_point(d.sensor_pose, scan.point(b).unwrap())
+                smc_lmb::geometry::pose2::transform_point(d.sensor_pose, scan.point(b).unwrap())
             })
             .collect();
         // Clusters past each stage: past size, past local minimum, past persistence, moving.
@@ -279,9 +279,9 @@ fn slice(run: &People2dRun, scans: usize) -> People2dRun {
 
 #[test]
 fn in_the_lobby_the_lmb_tracks_far_better_on_the_moving_front_end() {
-    use smc_lmb::laser2d::evaluate::{evaluate_run, EvalConfig};
-    use smc_lmb::laser2d::front_end::{adapt_tracker_config, FrontEnd};
-    use smc_lmb::laser2d::{PeopleTracker, PeopleTrackerConfig};
+    use smc_lmb::pipeline::people_tracking::evaluate::{evaluate_run, EvalConfig};
+    use smc_lmb::pipeline::people_tracking::front_end::{adapt_tracker_config, FrontEnd};
+    use smc_lmb::pipeline::people_tracking::{PeopleTracker, PeopleTrackerConfig};
     let scenario = PeopleScenario::two();
     // The first 20 s (160 scans): on every segment the LMB follows a crowd of wall and
     // pillar pieces and is slow, so the whole run would be too long for a test.

@@ -3,11 +3,11 @@
 //! a stationary scanner (from `../shared/data/laser2d/`, skipped with a note when absent) is
 //! tracked whole and checked against what `docs/laser2d_recordings.md` reports.
 
-use smc_lmb::laser2d::{
-    config_for_scans, read_bag, read_carmen, track_scans, write_people_json, BagOptions,
-    CarmenOptions, PeopleRun, TimeOrder,
+use smc_lmb::laser2d::{read_bag, read_carmen, BagOptions, CarmenOptions, TimeOrder};
+use smc_lmb::pipeline::people_tracking::{
+    config_for_scans, track_scans, write_people_json, PeopleRun,
 };
-use smc_lmb::plot::{write_people_plot, PeoplePlotOptions};
+use smc_lmb::pipeline::people_tracking::{write_people_plot, PeoplePlotOptions};
 use std::path::Path;
 
 #[test]

@@ -9,7 +9,7 @@
 
 use super::{Measurements, ParticleSet};
 use crate::error::{ensure_finite, Error, Result};
-use crate::models::StepContext;
+use crate::filter::StepContext;
 use crate::rng::FilterRng;
 
 /// A proposed new track, before it gets its label.

@@ -16,11 +16,11 @@ use super::groups::partition;
 use super::track::{Estimate, Track};
 use super::{Jitter, Label, Measurements, ParticleSet};
 use crate::error::{Error, Result};
-use crate::models::exp::exp_in_place;
-use crate::models::{
+use crate::filter::{
     ClutterModel, ConstantSurvival, DetectionModel, MeasurementModel, StepContext, SurvivalModel,
     TrackSummary, TransitionModel,
 };
+use crate::numerics::exp::exp_in_place;
 use crate::rng::{stream, FilterRng};
 use nalgebra::Isometry3;
 use rand::Rng;

@@ -4,6 +4,13 @@
 //! update → resample → prune → estimate. Sensors feed it [`Measurements`] in a [`Frame`]; it
 //! never knows where they came from. Tracks ([`Track`]) carry a [`Label`], an existence
 //! probability and a [`ParticleSet`].
+//!
+//! The filter's contract with its models lives here too: the plug-in traits of [`model`]
+//! ([`TransitionModel`], [`SurvivalModel`], [`MeasurementModel`], [`DetectionModel`],
+//! [`ClutterModel`]), [`BirthModel`] and [`Associator`]. The built-in models implementing them
+//! are in [`crate::models`] (and next to the applications that need their own).
+//!
+//! Not for: sensors, detectors or models of particular objects.
 
 pub mod association;
 pub mod birth;
@@ -12,7 +19,9 @@ pub mod groups;
 pub mod label;
 pub mod lmb;
 pub mod measurements;
+pub mod model;
 pub mod particles;
+pub mod survival;
 pub mod track;
 
 pub use association::{AssociationMethod, Associator};
@@ -23,5 +32,10 @@ pub use birth::{
 pub use label::Label;
 pub use lmb::{Frame, LmbConfig, LmbFilter, LmbFilterBuilder, MostProbableMeasurement};
 pub use measurements::Measurements;
+pub use model::{
+    ClutterModel, DetectionModel, MeasurementModel, StepContext, SurvivalModel, TrackSummary,
+    TransitionModel,
+};
 pub use particles::{Jitter, ParticleSet};
+pub use survival::ConstantSurvival;
 pub use track::{Estimate, Track};

@@ -24,6 +24,7 @@
 
 use super::oxts::OxtsPacket;
 use crate::error::{Error, Result};
+use crate::geometry::wrap_angle;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use std::f64::consts::PI;
 
@@ -154,16 +155,6 @@ pub fn velodyne_poses(
         .map(|p| velodyne_pose_from_imu(p, t_velo_imu))
         .collect();
     relative_to_first(&world_velo)
-}
-
-/// Wraps an angle into (−π, π].
-pub fn wrap_angle(a: f64) -> f64 {
-    let w = a.rem_euclid(2.0 * PI);
-    if w > PI {
-        w - 2.0 * PI
-    } else {
-        w
-    }
 }
 
 /// Planar state of the vehicle (the OXTS unit) for the extended constant-turn model, state

@@ -40,9 +40,10 @@
 //! All state is structure-of-arrays per beam, double-buffered for the propagation; after the
 //! first scan nothing is allocated.
 
-use super::rigid::{inverse, transform_point};
-use super::scan::{Pose2, Scan};
+use super::scan::Scan;
 use crate::error::{ensure_positive, Error, Result};
+use crate::geometry::pose2::{inverse, transform_point};
+use crate::geometry::Pose2;
 
 /// How many past background ranges each beam keeps for its spread.
 pub const HISTORY_LEN: usize = 10;
@@ -226,7 +227,7 @@ impl BackgroundMap {
                 continue;
             }
             let phi = self.angle_min + l as f64 * self.angle_increment - motion.theta;
-            let wrapped = crate::models::wrap_angle(phi - self.angle_min) + self.angle_min;
+            let wrapped = crate::geometry::wrap_angle(phi - self.angle_min) + self.angle_min;
             if let Some(j) = beam_of(wrapped).or_else(|| beam_of(phi)) {
                 if self.next_range[j].is_nan() {
                     self.next_range[j] = f32::INFINITY;

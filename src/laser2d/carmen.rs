@@ -48,8 +48,9 @@
 //! `FLASER` scans); dropping the fewest drops 787 for its 631 steps back. Different types are
 //! not compared with one another.
 
-use super::scan::{OdometryRecord, Pose2, Scan};
+use super::scan::{OdometryRecord, Scan};
 use crate::error::{Error, Result};
+use crate::geometry::Pose2;
 use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};

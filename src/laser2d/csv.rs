@@ -23,8 +23,9 @@
 //! [`Scan::laser_pose`] is not stored. Numbers are written in Rust's shortest round-trip
 //! notation, so a written file reads back to identical values.
 
-use super::scan::{Pose2, Scan};
+use super::scan::Scan;
 use crate::error::{Error, Result};
+use crate::geometry::Pose2;
 use std::fmt::Write as _;
 use std::io::{BufRead, BufReader};
 use std::path::Path;

@@ -17,9 +17,9 @@
 //! Not for: choosing which scans to match (the moving-object detector does that), global
 //! registration from a poor initial guess, or point-to-line refinement.
 
-use super::rigid::{compose, transform_point};
-use super::scan::Pose2;
 use crate::error::{Error, Result};
+use crate::geometry::pose2::{compose, transform_point};
+use crate::geometry::Pose2;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
 /// ICP parameters.
@@ -330,8 +330,8 @@ pub fn align(
 
 #[cfg(test)]
 mod tests {
-    use super::super::rigid::{identity, inverse};
     use super::*;
+    use crate::geometry::pose2::{identity, inverse};
     use proptest::prelude::*;
 
     /// Points every `step` metres (the first `offset` metres in) along the walls of an L-shaped room: the 8 × 6 m box with the

@@ -59,9 +59,10 @@ use super::fuzzy_art::{FuzzyArt, FuzzyArtConfig};
 use super::icp::{Icp, IcpConfig, IcpFit};
 use super::local_map::LocalMap;
 pub use super::moving_rule::{ClusterEvidence, ClusterStage, MovingRule};
-use super::rigid::{between, compose, inverse, transform_point};
-use super::scan::{Pose2, Scan};
+use super::scan::Scan;
 use crate::error::{ensure_positive, Error, Result};
+use crate::geometry::pose2::{between, compose, inverse, transform_point};
+use crate::geometry::Pose2;
 
 /// Parameters of the detector; defaults follow seed 003 where it gives values.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -699,7 +700,7 @@ mod tests {
                     r = r.min(5.0 / dir[1].abs());
                 }
                 if let Some(c) = person {
-                    if let Some(d) = crate::sim::people2d::ray_circle([0.0, 0.0], dir, c, 0.2) {
+                    if let Some(d) = crate::geometry::ray_circle([0.0, 0.0], dir, c, 0.2) {
                         r = r.min(d);
                     }
                 }

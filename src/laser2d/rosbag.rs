@@ -30,8 +30,9 @@
 //! (a scan stamped before the one preceding it is returned as it is, and the people tracker
 //! then stops with an error naming that scan).
 
-use super::scan::{attach_odometry, OdometryRecord, Pose2, Scan};
+use super::scan::{attach_odometry, OdometryRecord, Scan};
 use crate::error::{Error, Result};
+use crate::geometry::Pose2;
 use ::rosbag::{ChunkRecord, IndexRecord, MessageRecord, RosBag};
 use std::collections::HashMap;
 use std::io::Read;

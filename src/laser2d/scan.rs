@@ -16,29 +16,7 @@
 //! breakpoint segmentation breaks segments at them.
 
 use crate::error::{Error, Result};
-
-/// A planar pose: position `(x, y)` in metres and heading `theta` in radians.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Pose2 {
-    /// x coordinate (m).
-    pub x: f64,
-    /// y coordinate (m).
-    pub y: f64,
-    /// Heading (rad), counter-clockwise from the x axis.
-    pub theta: f64,
-}
-
-impl Pose2 {
-    /// A pose from its three components.
-    pub fn new(x: f64, y: f64, theta: f64) -> Self {
-        Pose2 { x, y, theta }
-    }
-
-    /// True when all three components are finite.
-    pub fn is_finite(&self) -> bool {
-        self.x.is_finite() && self.y.is_finite() && self.theta.is_finite()
-    }
-}
+use crate::geometry::Pose2;
 
 /// One odometry reading: a time-stamped platform pose and its velocities.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -199,6 +177,12 @@ impl Scan {
         let r = self.range(i)?;
         let (s, c) = self.bearing(i).sin_cos();
         Some([r * c, r * s])
+    }
+
+    /// The range of every beam into `out` (cleared first), `+∞` for a no-return beam.
+    pub fn ranges_into(&self, out: &mut Vec<f64>) {
+        out.clear();
+        out.extend((0..self.len()).map(|i| self.range(i).unwrap_or(f64::INFINITY)));
     }
 
     /// All returns as `(beam index, [x, y])` in the sensor frame, in beam order; "no return"

@@ -1,8 +1,8 @@
 //! Bounds of a particle cloud's planar position (components 0 and 2), for per-track shortcuts
 //! that must give exactly the per-particle answer: when a model's answer cannot change
 //! anywhere inside the bounds, it is set for the whole track at once, and work per particle is
-//! skipped (see [`super::OcclusionDetection`], [`super::ResolutionDetection`],
-//! [`super::FieldOfViewSurvival`]).
+//! skipped (see [`crate::pipeline::people_tracking::models::OcclusionDetection`], [`crate::pipeline::people_tracking::models::ResolutionDetection`],
+//! [`crate::pipeline::people_tracking::models::FieldOfViewSurvival`]).
 //!
 //! The bounds are conservative: every particle lies inside them, and the derived ranges and
 //! bearings are widened by a few units in the last place, so a shortcut that trusts them never

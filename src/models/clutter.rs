@@ -5,8 +5,8 @@
 //! gets the same intensity — so that no measurement is ever impossible for the filter.
 //! Not for: clutter that varies over the measurement space.
 
-use super::{ClutterModel, StepContext};
 use crate::error::{Error, Result};
+use crate::filter::{ClutterModel, StepContext};
 
 /// Uniform clutter with mean count `rate` per scan over a region of volume `volume`.
 #[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]

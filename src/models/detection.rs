@@ -6,10 +6,10 @@
 //! components get p_D = 0. Not for: occlusion (see [`super::occlusion`]) or appearance-based
 //! detectability.
 
-use super::survival::clamp_probability;
-use super::{DetectionModel, StepContext};
 use crate::error::{ensure_positive, ensure_probability, Result};
+use crate::filter::survival::clamp_probability;
 use crate::filter::ParticleSet;
+use crate::filter::{DetectionModel, StepContext};
 
 /// p_D(x) = `self.0` everywhere.
 ///

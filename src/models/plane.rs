@@ -45,9 +45,10 @@
 //!
 //! Not for: segmenting planes out of point clouds, plane patches (vertices, areas) or metrics.
 
-use super::{ExtendedConstantTurn, MeasurementModel, StepContext, TrackSummary, TransitionModel};
+use super::ExtendedConstantTurn;
 use crate::error::{Error, Result};
 use crate::filter::ParticleSet;
+use crate::filter::{MeasurementModel, StepContext, TrackSummary, TransitionModel};
 use crate::rng::FilterRng;
 use nalgebra::{Isometry3, Matrix3, Vector3};
 use rand_distr::{Distribution, StandardNormal};

@@ -1,7 +1,8 @@
 //! End-to-end processing chains that combine readers, detectors, models and metrics, e.g.
 //! segmenting walls in consecutive LiDAR frames, predicting them forward and scoring the
 //! prediction ([`plane_prediction`]); tracking walls and clusters through a whole drive
-//! ([`drive_tracking`]) and scoring the tracks against ground truth ([`drive_evaluation`]).
+//! ([`drive_tracking`]) and scoring the tracks against ground truth ([`drive_evaluation`]);
+//! tracking people in planar laser scans and scoring the trackers ([`people_tracking`]).
 //!
 //! Not for: the filter itself (see [`crate::filter`]) or command-line parsing.
 
@@ -16,4 +17,6 @@ pub mod drive_tracking;
 pub use drive_tracking::{track_drive, DriveTracker, DriveTracks, TrackingConfig};
 
 pub mod drive_evaluation;
+
+pub mod people_tracking;
 pub use drive_evaluation::{evaluate_clusters, evaluate_walls, ClusterEvaluation, WallEvaluation};

@@ -1,15 +1,13 @@
 //! Bird's-eye plots: poly-lines, segments and dots on a metric x–y plane at equal scale,
 //! written as SVG or PNG (chosen by the file extension) with `plotters`. A light 10 m grid
-//! stands in for axes; there is no text, so no font is needed. [`people`] draws a people run
-//! over its laser scans, with titles, legend and metre ticks in the pixel font of [`text`].
+//! stands in for axes; there is no text, so no font is needed. [`text`] is a 5×7 pixel font for
+//! the plots that need titles, legends and ticks (the people plot of
+//! [`crate::pipeline::people_tracking`]).
 //!
 //! Not for: deciding what to draw (the pipelines build a [`BirdsEyePlot`]) or interactive
 //! viewing.
 
-pub mod people;
 pub mod text;
-
-pub use self::people::{write_people_plot, PeoplePlotCounts, PeoplePlotOptions};
 
 use crate::error::{Error, Result};
 use plotters::prelude::*;

@@ -60,8 +60,9 @@
 //! [`PeopleScenario::one`] and [`PeopleScenario::two`].
 
 use crate::error::{Error, Result};
-use crate::laser2d::{Pose2, Scan};
-use crate::models::wrap_angle;
+use crate::geometry::Pose2;
+use crate::geometry::{ray_circle, wrap_angle};
+use crate::laser2d::Scan;
 use crate::rng::{stream, FilterRng};
 use rand_distr::{Distribution, StandardNormal};
 use std::collections::HashSet;
@@ -437,27 +438,6 @@ pub fn sensor_pose(robot: Pose2, mount: [f64; 2]) -> Pose2 {
         robot.y + mount[0] * s + mount[1] * c,
         robot.theta,
     )
-}
-
-/// Distance along the ray `origin + t·dir` (`dir` of unit length) to the first crossing of
-/// the circle, for `t > 0`; a ray starting inside the circle hits its far side.
-pub fn ray_circle(origin: [f64; 2], dir: [f64; 2], center: [f64; 2], radius: f64) -> Option<f64> {
-    let f = [origin[0] - center[0], origin[1] - center[1]];
-    let b = f[0] * dir[0] + f[1] * dir[1];
-    let c = f[0] * f[0] + f[1] * f[1] - radius * radius;
-    let disc = b * b - c;
-    if disc < 0.0 {
-        return None;
-    }
-    let s = disc.sqrt();
-    let (t1, t2) = (-b - s, -b + s);
-    if t1 > 0.0 {
-        Some(t1)
-    } else if t2 > 0.0 {
-        Some(t2)
-    } else {
-        None
-    }
 }
 
 /// Distance along the ray `origin + t·dir` (`dir` of unit length) to the segment `p`–`q`,

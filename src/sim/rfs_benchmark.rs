@@ -22,10 +22,14 @@ use crate::error::{
     ensure_finite, ensure_non_negative, ensure_positive, ensure_probability, Error, Result,
 };
 use crate::filter::{AssociationMethod, BirthTerm, LmbConfig, LmbFilter, StaticBirth};
+use crate::filter::{
+    ClutterModel, ConstantSurvival, DetectionModel, MeasurementModel, StepContext, SurvivalModel,
+    TransitionModel,
+};
+use crate::geometry::wrap_angle;
 use crate::models::{
-    wrap_angle, BearingConvention, ClutterModel, ConstantDetection, ConstantSurvival,
-    ConstantVelocity, CoordinatedTurn, DetectionModel, GaussianRangeDetection, MeasurementModel,
-    PositionMeasurement, RangeBearing, StepContext, SurvivalModel, TransitionModel, UniformClutter,
+    BearingConvention, ConstantDetection, ConstantVelocity, CoordinatedTurn,
+    GaussianRangeDetection, PositionMeasurement, RangeBearing, UniformClutter,
 };
 use crate::rng::{stream, FilterRng};
 use rand::seq::SliceRandom;

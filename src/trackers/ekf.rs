@@ -17,7 +17,9 @@
 //!
 //! Not for: data association or track management (see the trackers beside this module).
 
-use crate::models::{wrap_angle, BearingConvention, RangeBearing, StepContext};
+use crate::filter::StepContext;
+use crate::geometry::wrap_angle;
+use crate::models::{BearingConvention, RangeBearing};
 use nalgebra::{Matrix2, Matrix4, SMatrix, SVector, Vector2, Vector4};
 
 /// Closer than this (m) to the sensor a point has no usable bearing Jacobian.

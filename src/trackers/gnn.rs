@@ -16,8 +16,9 @@ use super::ekf::{position_error, update, Gaussian, Linearisation};
 use super::lifecycle::{LabelMaker, Lifecycle, LifecycleConfig};
 use super::{ensure_range_bearing, Innovation, PointTracker};
 use crate::error::Result;
+use crate::filter::StepContext;
 use crate::filter::{Estimate, Label, Measurements};
-use crate::models::{RangeBearing, StepContext};
+use crate::models::RangeBearing;
 
 /// χ²₂ quantile at 0.99: the default gate on d².
 pub const GATE_99: f64 = 9.2103;
@@ -192,7 +193,7 @@ impl PointTracker for GnnTracker {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::laser2d::Pose2;
+    use crate::geometry::Pose2;
     use crate::trackers::StepClock;
     use std::collections::BTreeSet;
 

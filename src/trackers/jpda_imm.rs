@@ -32,8 +32,9 @@ use super::imm::{ImmConfig, ImmDensity};
 use super::lifecycle::{LabelMaker, Lifecycle, LifecycleConfig};
 use super::{ensure_range_bearing, Innovation, PointTracker};
 use crate::error::{Error, Result};
+use crate::filter::StepContext;
 use crate::filter::{Estimate, Label, Measurements};
-use crate::models::{RangeBearing, StepContext};
+use crate::models::RangeBearing;
 use nalgebra::{Matrix2, SMatrix, Vector2};
 
 /// JPDA-IMM tuning.

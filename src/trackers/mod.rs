@@ -18,8 +18,8 @@
 //! * [`jpda_imm`]: joint probabilistic data association over IMM tracks.
 //! * [`LmbTracker`]: the LMB filter behind [`PointTracker`].
 //!
-//! Not for: segmentation (see [`crate::laser2d::person_measurements`]) or scoring (see
-//! [`crate::laser2d::evaluate`]).
+//! Not for: segmentation (see [`crate::pipeline::people_tracking::person_measurements`]) or scoring (see
+//! [`crate::pipeline::people_tracking::evaluate`]).
 
 pub mod ekf;
 pub mod gnn;
@@ -29,11 +29,12 @@ pub mod lifecycle;
 pub mod ml_ransac;
 
 use crate::error::Result;
+use crate::filter::StepContext;
 use crate::filter::{Estimate, Frame, Label, LmbFilter, Measurements};
-use crate::laser2d::Pose2;
-use crate::models::StepContext;
+use crate::geometry::platform_isometry;
+use crate::geometry::Pose2;
 use crate::rng::FilterRng;
-use nalgebra::{Isometry3, Vector3};
+use nalgebra::Isometry3;
 
 pub use ekf::Gaussian;
 pub use gnn::{GnnConfig, GnnTracker};
@@ -54,6 +55,19 @@ pub struct Innovation {
     pub nis: f64,
 }
 
+/// The beams of one planar scan as a tracker sees them, whatever sensor or file they came
+/// from: beam `i` points at bearing `angle_min + i·angle_increment` (radians, sensor frame,
+/// counter-clockwise from x) and ended at `ranges[i]` metres, `+∞` where nothing returned.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BeamRanges<'a> {
+    /// Bearing of the first beam (rad).
+    pub angle_min: f64,
+    /// Bearing step between consecutive beams (rad).
+    pub angle_increment: f64,
+    /// Range of every beam (m), `+∞` for no return.
+    pub ranges: &'a [f64],
+}
+
 /// A multi-object tracker fed one scan's measurements at a time.
 pub trait PointTracker {
     /// A short name (`lmb`, `gnn`, `ml_ransac`, `jpda_imm`).
@@ -63,11 +77,11 @@ pub trait PointTracker {
     /// and the platform pose. Returns the confirmed tracks.
     fn step(&mut self, z: &Measurements, ctx: &StepContext) -> Result<Vec<Estimate>>;
 
-    /// Sees the scan the next step's measurements come from, before [`PointTracker::step`]
-    /// (trackers whose detection model looks at the scan, e.g. for occlusions, keep what they
-    /// need; the default ignores it).
-    fn observe_scan(&mut self, scan: &crate::laser2d::Scan) {
-        let _ = scan;
+    /// Sees the beams of the scan the next step's measurements come from, before
+    /// [`PointTracker::step`] (trackers whose detection model looks at the scan, e.g. for
+    /// occlusions, keep what they need; the default ignores it).
+    fn observe_beams(&mut self, beams: BeamRanges<'_>) {
+        let _ = beams;
     }
 
     /// Innovations of the tracks updated in the last step (empty when the tracker does not
@@ -75,14 +89,6 @@ pub trait PointTracker {
     fn innovations(&self) -> &[Innovation] {
         &[]
     }
-}
-
-/// The platform pose of a planar odometry pose, as the filter's [`StepContext`] holds it.
-pub fn platform_isometry(pose: Pose2) -> Isometry3<f64> {
-    Isometry3::new(
-        Vector3::new(pose.x, pose.y, 0.0),
-        Vector3::new(0.0, 0.0, pose.theta),
-    )
 }
 
 /// Builds the step contexts of a sequence of scans: step index, time, time since the

@@ -1,6 +1,6 @@
 //! One LiDAR frame → the detections the tracker sees: building-wall planes (from
 //! [`extract_planes`]) and Euclidean clusters of the points on neither the ground nor a wall,
-//! turned into mixed measurements ([`crate::models::mixed`]).
+//! turned into mixed measurements ([`crate::pipeline::drive_tracking::mixed`]).
 //!
 //! The ground is not tracked: it is always under the vehicle, so tracking it adds nothing a
 //! per-frame fit does not give; its plane is used to drop the points near the road surface
@@ -17,7 +17,9 @@ use crate::cloud::PointCloud;
 use crate::error::Result;
 use crate::filter::Measurements;
 use crate::geometry::PlanePatch;
-use crate::models::mixed::{cluster_measurement, plane_measurement, MEASUREMENT_DIM};
+use crate::pipeline::drive_tracking::mixed::{
+    cluster_measurement, plane_measurement, MEASUREMENT_DIM,
+};
 use crate::rng::FilterRng;
 use std::time::Instant;
 

@@ -1,5 +1,6 @@
 //! Tracking a whole KITTI raw drive with one LMB filter in which building walls and object
-//! clusters are both labelled objects (the mixed state of [`crate::models::mixed`]).
+//! clusters are both labelled objects (the mixed state and models of [`mixed`], written for
+//! this pipeline alone).
 //!
 //! Per frame: read the Velodyne `.bin`, segment the ground and walls, cluster the points on
 //! neither ([`detect`]), turn walls and cluster centroids into mixed measurements and step the
@@ -19,6 +20,7 @@
 
 pub mod detect;
 pub mod export;
+pub mod mixed;
 pub mod output;
 pub mod tracker;
 

@@ -17,12 +17,12 @@ use super::{EgoModel, TrackingConfig};
 use crate::error::Result;
 use crate::filter::{AdaptiveBirth, Estimate, Frame, Label, LmbFilter};
 use crate::geometry::Plane;
-use crate::models::mixed::{
+use crate::models::plane::{canonical_plane, plane_residual};
+use crate::models::{ExtendedConstantTurn, PlaneMeasurement};
+use crate::pipeline::drive_tracking::mixed::{
     MixedBirthSampler, MixedClutter, MixedDetection, MixedMeasurement, MixedTransition, ObjectKind,
     VehicleStateHandle, KIND,
 };
-use crate::models::plane::{canonical_plane, plane_residual};
-use crate::models::{ExtendedConstantTurn, PlaneMeasurement};
 use crate::rng::{seeded, FilterRng};
 use nalgebra::{Isometry3, Point3, Vector3};
 use std::collections::HashMap;
@@ -105,7 +105,7 @@ impl DriveTracker {
                 c.clutter_rate,
                 c.clutter_volume,
             )?)
-            .survival(crate::models::ConstantSurvival(config.birth.survival))
+            .survival(crate::filter::ConstantSurvival(config.birth.survival))
             .birth(birth)
             .config(config.filter.clone())
             .build()?;

@@ -185,7 +185,7 @@ impl Interval {
 }
 
 fn wrap(a: f64) -> f64 {
-    crate::kitti::poses::wrap_angle(a)
+    crate::geometry::wrap_angle(a)
 }
 
 /// Corners of a shape's convex hull (walls 4, boxes 8, cylinders the 8 of the enclosing box).

@@ -35,8 +35,9 @@ pub use world::{ObjectKind, Street};
 pub use writer::{write_drive, WrittenDrive, TRUTH_FILE};
 
 use crate::error::{ensure_non_negative, ensure_positive, Error, Result};
+use crate::geometry::wrap_angle;
 use crate::kitti::calib::{rigid_calib_from, CalibFile};
-use crate::kitti::poses::{oxts_rotation, velodyne_pose_from_imu, wrap_angle, Mercator};
+use crate::kitti::poses::{oxts_rotation, velodyne_pose_from_imu, Mercator};
 use crate::kitti::{OxtsPacket, Timestamp};
 use crate::rng::{mix64, stream};
 use nalgebra::{Isometry3, Point3, Translation3};

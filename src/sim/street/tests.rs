@@ -71,7 +71,7 @@ fn objects_keep_clear_of_the_ego_and_move_as_configured() {
             // The heading is along the velocity.
             if v > 0.0 {
                 let heading = s.velocity[1].atan2(s.velocity[0]);
-                assert!(crate::kitti::poses::wrap_angle(heading - s.yaw).abs() < 1e-9);
+                assert!(crate::geometry::wrap_angle(heading - s.yaw).abs() < 1e-9);
             }
         }
         // Consecutive states move by velocity × frame period.

@@ -477,7 +477,7 @@ fn place_objects(
                 || (row.speed == 0.0 && rng.random_range(0..2) == 0 && kind != ObjectKind::Car);
             let heading = seg.dir[1].atan2(seg.dir[0]);
             object.yaw = if backwards {
-                crate::kitti::poses::wrap_angle(heading + std::f64::consts::PI)
+                crate::geometry::wrap_angle(heading + std::f64::consts::PI)
             } else {
                 heading
             };

@@ -16,8 +16,9 @@
 //! Not for: deciding which measurement a track generated (that is the filter's association)
 //! or Gaussian tracks (the baselines compute theirs from their own covariances).
 
+use crate::filter::StepContext;
 use crate::filter::{Label, ParticleSet};
-use crate::models::{RangeBearing, StepContext};
+use crate::models::RangeBearing;
 use crate::trackers::Innovation;
 
 /// The innovation of measurement `z` = [range, bearing] for the predicted cloud `predicted`

@@ -6,13 +6,14 @@
 //! the sensor frame). A track's line is cut where it went unseen for a while. SVG or PNG by
 //! extension, written atomically.
 //!
-//! Not for: running the tracker (see [`crate::laser2d::people_run`]) or plots of other
-//! pipelines (see [`super::BirdsEyePlot`]).
+//! Not for: running the tracker (see [`super::run`]) or plots of other
+//! pipelines (see [`crate::plot::BirdsEyePlot`]).
 
-use super::text::{draw_text, text_width, HEIGHT};
+use super::PeopleRun;
 use crate::error::{Error, Result};
 use crate::filter::Label;
-use crate::laser2d::{PeopleRun, Scan};
+use crate::laser2d::Scan;
+use crate::plot::text::{draw_text, text_width, HEIGHT};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -181,7 +182,7 @@ pub fn write_people_plot(
     let inner = f64::from(width - LEFT - RIGHT);
     let height =
         (inner * (hi.1 - lo.1) / (hi.0 - lo.0)).clamp(200.0, 3.0 * inner) as u32 + TOP + BOTTOM;
-    super::write_image(path, (width, height), &Framed { scene, lo, hi })?;
+    crate::plot::write_image(path, (width, height), &Framed { scene, lo, hi })?;
     Ok(counts)
 }
 
@@ -201,7 +202,7 @@ struct Framed<'a> {
     hi: (f64, f64),
 }
 
-impl super::Draw for Framed<'_> {
+impl crate::plot::Draw for Framed<'_> {
     fn draw_on<DB: DrawingBackend>(
         &self,
         root: DrawingArea<DB, Shift>,
@@ -491,7 +492,8 @@ impl Scene<'_> {
 mod tests {
     use super::*;
 
-    use crate::laser2d::{PersonEstimate, PersonTrack, Pose2, ScanPeople};
+    use crate::geometry::Pose2;
+    use crate::pipeline::people_tracking::{PersonEstimate, PersonTrack, ScanPeople};
 
     /// Ten scans of a wall 5 m ahead; a walker (label (0, 0)) crossing at 1 m/s, unseen in
     /// scans 3–8; a standing person (label (1, 0)) seen throughout.

@@ -45,13 +45,13 @@
 //!
 //! [`LmbFilter`]: crate::filter::LmbFilter
 
-use super::{
-    ClutterModel, ConstantVelocity, DetectionModel, ExtendedConstantTurn, MeasurementModel,
-    PlaneMeasurement, PlaneTransition, StepContext, TrackSummary, TransitionModel,
-};
 use crate::error::{ensure_positive, ensure_probability, Error, Result};
 use crate::filter::{BirthSampler, ParticleSet};
+use crate::filter::{
+    ClutterModel, DetectionModel, MeasurementModel, StepContext, TrackSummary, TransitionModel,
+};
 use crate::models::plane::{canonical_plane, EgoSource};
+use crate::models::{ConstantVelocity, ExtendedConstantTurn, PlaneMeasurement, PlaneTransition};
 use crate::rng::FilterRng;
 use rand_distr::{Distribution, StandardNormal};
 use std::sync::{Arc, RwLock};

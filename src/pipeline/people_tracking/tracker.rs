@@ -2,20 +2,22 @@
 //! (adaptive breakpoints), segments of person size become range-bearing measurements of the
 //! person's centre, and the filter — constant velocity (seed 000, eqs. 6–8), range-bearing from
 //! a sensor mounted at (a, b) on the robot's odometry pose (eqs. 10–11), an occlusion-aware
-//! detection probability ([`crate::models::OcclusionDetection`] against the current scan),
+//! detection probability ([`super::models::OcclusionDetection`] against the current scan),
 //! survival that forgets people who left the field of view, and measurement-driven birth that
-//! is suppressed next to confirmed tracks ([`super::people_birth`]) — follows them with labels.
+//! is suppressed next to confirmed tracks ([`super::birth`]) — follows them with labels.
 //! Each scan's output marks every person as static or dynamic ([`super::motion_state`]) and
 //! says how visible the scanner should find them.
 //!
 //! Not for: deciding which segments belong to moving objects on a cluttered map (background
 //! attenuation and shape learning), or the baseline trackers.
 
+use super::birth::PeopleBirth;
 use super::innovation::particle_innovation;
+use super::models::{
+    Detectability, DetectabilityDetection, DetectabilityTransition, FieldOfViewSurvival,
+    ManoeuvringVelocity, OcclusionDetection, ResolutionDetection, ResolutionLikelihood,
+};
 use super::motion_state::{probability_moving, MotionClassifier, MotionConfig};
-use super::people_birth::PeopleBirth;
-use super::person_groups::{person_groups, PersonGrouping};
-use super::{BreakpointConfig, Scan};
 use crate::config::{
     BirthConfig, ClutterConfig, DetectionConfig, MeasurementConfig, RunConfig, TransitionConfig,
 };
@@ -23,14 +25,12 @@ use crate::error::{Error, Result};
 use crate::filter::{
     AssociationMethod, Estimate, Frame, Label, LmbConfig, LmbFilter, Measurements,
 };
-use crate::models::{
-    BearingConvention, ConstantVelocity, Detectability, DetectabilityDetection,
-    DetectabilityTransition, DetectionModel, FieldOfViewDetection, FieldOfViewSurvival,
-    ManoeuvringVelocity, OcclusionDetection, RangeBearing, ResolutionDetection,
-    ResolutionLikelihood, StepContext, TransitionModel,
-};
+use crate::filter::{DetectionModel, StepContext, TransitionModel};
+use crate::laser2d::person_groups::{person_groups, PersonGrouping};
+use crate::laser2d::{BreakpointConfig, Scan};
+use crate::models::{BearingConvention, ConstantVelocity, FieldOfViewDetection, RangeBearing};
 use crate::rng::{seeded, FilterRng};
-use crate::trackers::Innovation;
+use crate::trackers::{BeamRanges, Innovation, PointTracker};
 use nalgebra::{Isometry3, Vector3};
 
 /// What counts as a person and how they are tracked.
@@ -66,7 +66,7 @@ pub struct PeopleTrackerConfig {
     /// 98 % → 96 % of 50 runs keeping every label). 0 turns it off.
     pub birth_suppress_spread: f64,
     /// A person within this distance (m) of another confirmed track is often not resolved
-    /// as a separate measurement ([`crate::models::ResolutionDetection`]). Default 1.5 m.
+    /// as a separate measurement ([`super::models::ResolutionDetection`]). Default 1.5 m.
     pub resolution_distance: f64,
     /// Beyond `resolution_distance` the effect fades out linearly over this distance (m).
     /// Default 0.5 m.
@@ -75,10 +75,10 @@ pub struct PeopleTrackerConfig {
     pub unresolved_share: f64,
     /// Near another track the measurement noise is scaled by this: a merged measurement of
     /// two people lies anywhere between them and should pull each track less
-    /// ([`crate::models::ResolutionLikelihood`]). Default 2; 1 turns it off.
+    /// ([`super::models::ResolutionLikelihood`]). Default 2; 1 turns it off.
     pub unresolved_noise_scale: f64,
     /// Share of particles per scan whose acceleration is drawn with `manoeuvre_sigma` instead
-    /// of the filter's calm σ ([`crate::models::ManoeuvringVelocity`]): people who turn
+    /// of the filter's calm σ ([`super::models::ManoeuvringVelocity`]): people who turn
     /// round or stop. Default 0.05. People who walk straight barely need it (scenario one, 50
     /// runs: 96 % keep every label, 100 % without); people who turn round do (the lobby,
     /// seeds 1–8, moving front end: OSPA(2) 1.235 against 1.435 without). 0 turns it off.
@@ -87,7 +87,7 @@ pub struct PeopleTrackerConfig {
     /// within 0.25 s.
     pub manoeuvre_sigma: f64,
     /// Misses that come in runs: when set, each person carries a detectable/undetectable mode
-    /// as a fifth state component ([`crate::models::detectability`]) and `filter.detection`'s
+    /// as a fifth state component ([`super::models::detectability`]) and `filter.detection`'s
     /// p_D applies to detectable people only. Default `None` (misses independent per scan).
     pub detectability: Option<Detectability>,
     /// A track becomes a person once its existence has reached this (and stays one while it
@@ -613,14 +613,18 @@ impl PeopleTracker {
 }
 
 /// The people tracker behind the common tracker interface, so that it runs on exactly the
-/// measurements the baselines get ([`crate::laser2d::evaluate`]).
-impl crate::trackers::PointTracker for PeopleTracker {
+/// measurements the baselines get ([`super::evaluate`]).
+impl PointTracker for PeopleTracker {
     fn name(&self) -> &str {
         "lmb"
     }
 
-    fn observe_scan(&mut self, scan: &Scan) {
-        self.observe(scan);
+    fn observe_beams(&mut self, beams: BeamRanges<'_>) {
+        self.detection.update_view(
+            beams.angle_min,
+            beams.angle_increment,
+            beams.ranges.iter().copied(),
+        );
     }
 
     fn step(&mut self, z: &Measurements, ctx: &StepContext) -> Result<Vec<Estimate>> {
@@ -649,7 +653,7 @@ pub fn person_grouping(config: &PeopleTrackerConfig) -> PersonGrouping {
     }
 }
 
-/// The point groups of `scan` that look like people (see [`super::person_groups`]), each as
+/// The point groups of `scan` that look like people (see [`crate::laser2d::person_groups`]), each as
 /// its points in the sensor frame.
 pub fn person_segments(config: &PeopleTrackerConfig, scan: &Scan) -> Result<Vec<Vec<[f64; 2]>>> {
     Ok(person_groups(scan, &person_grouping(config))?
@@ -672,7 +676,7 @@ pub fn person_measurements(config: &PeopleTrackerConfig, scan: &Scan) -> Result<
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::laser2d::Pose2;
+    use crate::geometry::Pose2;
 
     /// A person (disc of radius 0.2 m) walking across in front of a static scanner, rendered
     /// exactly into 361 beams over 180°.
@@ -788,9 +792,9 @@ mod tests {
 
     fn moving_front_end_config() -> PeopleTrackerConfig {
         let mut cfg = static_scanner_config();
-        crate::laser2d::front_end::adapt_tracker_config(
+        crate::pipeline::people_tracking::front_end::adapt_tracker_config(
             &mut cfg,
-            crate::laser2d::front_end::FrontEnd::Moving,
+            crate::pipeline::people_tracking::front_end::FrontEnd::Moving,
         );
         cfg
     }
@@ -857,7 +861,7 @@ mod tests {
         let mut independent = moving_front_end_config();
         independent.detectability = None;
         if let DetectionConfig::FieldOfView { p_inside, .. } = &mut independent.filter.detection {
-            *p_inside = crate::laser2d::front_end::MOVING_DETECTION_PROBABILITY;
+            *p_inside = crate::pipeline::people_tracking::front_end::MOVING_DETECTION_PROBABILITY;
         }
         let (labels, _) = walk(independent, 64, y, 24..40);
         assert!(labels_of(&labels).len() >= 2, "{labels:?}");

@@ -13,11 +13,12 @@
 //! and a σ large enough to follow it blurs every crossing; with the mixture the few manoeuvring
 //! particles catch the turned person and take over the track's weight.
 //!
-//! Not for: sustained turns at a known rate ([`super::CoordinatedTurn`]).
+//! Not for: sustained turns at a known rate ([`crate::models::CoordinatedTurn`]).
 
-use super::{ConstantVelocity, StepContext, TransitionModel};
 use crate::error::{ensure_probability, Error, Result};
 use crate::filter::ParticleSet;
+use crate::filter::{StepContext, TransitionModel};
+use crate::models::ConstantVelocity;
 use crate::rng::FilterRng;
 use rand::RngExt;
 use rand_distr::{Distribution, StandardNormal};

@@ -10,15 +10,16 @@
 //! detector's ICP-corrected pose instead of the raw odometry, so that odometry drift does not
 //! make furniture look like walking people.
 //!
-//! Not for: reading the recordings (see [`super::carmen`], [`super::rosbag`]), plotting, or
+//! Not for: reading the recordings (see [`crate::laser2d::carmen`], [`crate::laser2d::rosbag`]), plotting, or
 //! scoring against ground truth.
 
 use super::front_end::{adapt_tracker_config, default_detector_config, FrontEnd, PersonFrontEnd};
-use super::tracking::{PeopleTracker, PeopleTrackerConfig, PersonEstimate};
-use super::{Pose2, Scan};
+use super::tracker::{PeopleTracker, PeopleTrackerConfig, PersonEstimate};
 use crate::error::{Error, Result};
 use crate::filter::Label;
-use crate::trackers::platform_isometry;
+use crate::geometry::platform_isometry;
+use crate::geometry::Pose2;
+use crate::laser2d::Scan;
 use std::collections::BTreeMap;
 use std::path::Path;
 

@@ -3,9 +3,9 @@
 //! p_S(x) = p for every x. Not for: survival that depends on where an object is (write a
 //! [`SurvivalModel`] of your own for that).
 
-use super::{StepContext, SurvivalModel};
 use crate::error::{Error, Result};
 use crate::filter::ParticleSet;
+use crate::filter::{StepContext, SurvivalModel};
 
 /// p_S(x) = `self.0` everywhere.
 ///

@@ -5,11 +5,11 @@
 //! Not for: occlusion inside the field of view (an occluded object is still there; see
 //! [`super::occlusion`] for its detection probability).
 
-use super::cloud_bounds::CloudBox;
-use super::detection::FieldOfViewDetection;
-use super::{StepContext, SurvivalModel};
 use crate::error::{ensure_probability, Result};
 use crate::filter::ParticleSet;
+use crate::filter::{StepContext, SurvivalModel};
+use crate::models::cloud_bounds::CloudBox;
+use crate::models::detection::FieldOfViewDetection;
 
 /// p_S(x) = `inside` when x lies in the sector of `fov` at the step, `outside` elsewhere
 /// (the sector's own detection probabilities are not used).

@@ -20,8 +20,9 @@
 
 use crate::error::{ensure_positive, ensure_probability, Result};
 use crate::filter::birth::BirthEvidence;
+use crate::filter::StepContext;
 use crate::filter::{BirthModel, BirthTrack, ParticleSet};
-use crate::models::{RangeBearing, StepContext};
+use crate::models::RangeBearing;
 use crate::rng::FilterRng;
 use rand_distr::{Distribution, StandardNormal};
 use std::sync::{Arc, RwLock};
@@ -56,7 +57,7 @@ pub struct PeopleBirth {
     /// unseen has spread out, and the person it lost is still most likely its own.
     pub suppress_spread: f64,
     /// Births carry a fifth state component, the detectability mode
-    /// ([`crate::models::detectability`]), set to detectable (the person was just detected).
+    /// ([`super::models::detectability`]), set to detectable (the person was just detected).
     pub with_detectability: bool,
     confirmed: Suppressors,
 }

@@ -16,9 +16,9 @@
 //! Not for: manoeuvring objects (see [`crate::models::CoordinatedTurn`]) or ego-motion
 //! compensation.
 
-use super::{StepContext, TransitionModel};
 use crate::error::{Error, Result};
 use crate::filter::ParticleSet;
+use crate::filter::{StepContext, TransitionModel};
 use crate::rng::FilterRng;
 use nalgebra::DMatrix;
 use rand_distr::{Distribution, StandardNormal};

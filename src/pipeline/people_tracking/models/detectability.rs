@@ -28,9 +28,9 @@
 //! Not for: geometric visibility (field of view, occlusion: [`super::OcclusionDetection`]) or
 //! objects that are missed because they stand next to another ([`super::ResolutionDetection`]).
 
-use super::{DetectionModel, StepContext, TransitionModel};
 use crate::error::{ensure_probability, Error, Result};
 use crate::filter::ParticleSet;
+use crate::filter::{DetectionModel, StepContext, TransitionModel};
 use crate::rng::FilterRng;
 use rand::RngExt;
 

@@ -1,11 +1,35 @@
-//! Planar rigid motions on [`Pose2`]: composing, inverting, relating two poses and moving
-//! points. A pose `a` is read as the map `p ↦ R(a.θ)·p + (a.x, a.y)` from its own frame into
+//! Planar poses ([`Pose2`]) and rigid motions on them: composing, inverting, relating two
+//! poses, moving points, and the SE(3) form a filter's step context holds. A pose `a` is read as the map `p ↦ R(a.θ)·p + (a.x, a.y)` from its own frame into
 //! the frame it is expressed in.
 //!
-//! Not for: estimating motions (see the ICP module) or uncertainty propagation.
+//! Not for: estimating motions (see the ICP module of [`crate::laser2d`]) or uncertainty
+//! propagation.
 
-use super::scan::Pose2;
-use crate::models::wrap_angle;
+use super::wrap_angle;
+use nalgebra::{Isometry3, Vector3};
+
+/// A planar pose: position `(x, y)` in metres and heading `theta` in radians.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pose2 {
+    /// x coordinate (m).
+    pub x: f64,
+    /// y coordinate (m).
+    pub y: f64,
+    /// Heading (rad), counter-clockwise from the x axis.
+    pub theta: f64,
+}
+
+impl Pose2 {
+    /// A pose from its three components.
+    pub fn new(x: f64, y: f64, theta: f64) -> Self {
+        Pose2 { x, y, theta }
+    }
+
+    /// True when all three components are finite.
+    pub fn is_finite(&self) -> bool {
+        self.x.is_finite() && self.y.is_finite() && self.theta.is_finite()
+    }
+}
 
 /// `a ∘ b`: first `b`, then `a` (the pose `b`, given in `a`'s frame, expressed in the frame
 /// of `a`). Heading wrapped to (−π, π].
@@ -42,6 +66,14 @@ pub fn transform_point(pose: Pose2, p: [f64; 2]) -> [f64; 2] {
 /// The identity pose.
 pub fn identity() -> Pose2 {
     Pose2::new(0.0, 0.0, 0.0)
+}
+
+/// The platform pose of a planar odometry pose, as the filter's [`StepContext`] holds it.
+pub fn platform_isometry(pose: Pose2) -> Isometry3<f64> {
+    Isometry3::new(
+        Vector3::new(pose.x, pose.y, 0.0),
+        Vector3::new(0.0, 0.0, pose.theta),
+    )
 }
 
 #[cfg(test)]

@@ -1,11 +1,11 @@
 //! The people trackers' front end: turns one scan into the range-bearing measurements of the
 //! people's centres that every tracker (the LMB and the baselines) is handed.
 //!
-//! * [`FrontEnd::Segments`]: every person-sized group of returns ([`super::person_groups()`]),
+//! * [`FrontEnd::Segments`]: every person-sized group of returns ([`crate::laser2d::person_groups()`]),
 //!   whatever it belongs to. Right in an open space; in a room every piece of wall, pillar or
 //!   furniture of person size becomes a "person".
 //! * [`FrontEnd::Moving`]: the same person groups, kept only when the moving-object detector
-//!   ([`super::moving`]) marks at least [`PersonFrontEnd::min_moving_share`] of a group's
+//!   ([`crate::laser2d::moving`]) marks at least [`PersonFrontEnd::min_moving_share`] of a group's
 //!   returns as belonging to a moving target. The detector decides which returns are moving
 //!   (by default [`MovingRule::Attenuation`] with the Fuzzy ART veto off: returns the
 //!   propagated background and the static local map do not explain, in clusters of at least
@@ -19,15 +19,18 @@
 //!
 //! Not for: tracking, scoring, or deciding what is moving (the detector and its rule do).
 
-use super::moving::{ClusterStage, MovingDetections, MovingDetectorConfig, MovingObjectDetector};
-use super::moving_rule::MovingRule;
-use super::person_groups::{person_groups, PersonGroup};
-use super::tracking::{person_grouping, PeopleTrackerConfig};
-use super::{Pose2, Scan};
+use super::models::Detectability;
+use super::tracker::{person_grouping, PeopleTrackerConfig};
 use crate::config::MeasurementConfig;
 use crate::error::{Error, Result};
 use crate::filter::Measurements;
-use crate::models::Detectability;
+use crate::geometry::Pose2;
+use crate::laser2d::moving::{
+    ClusterStage, MovingDetections, MovingDetectorConfig, MovingObjectDetector,
+};
+use crate::laser2d::moving_rule::MovingRule;
+use crate::laser2d::person_groups::{person_groups, PersonGroup};
+use crate::laser2d::Scan;
 use serde::Serialize;
 
 /// Which returns become person measurements.

@@ -29,9 +29,9 @@
 //!
 //! Not for: three-dimensional motion or turn-rate models with a speed component.
 
-use super::{StepContext, TransitionModel};
 use crate::error::{Error, Result};
 use crate::filter::ParticleSet;
+use crate::filter::{StepContext, TransitionModel};
 use crate::rng::FilterRng;
 use nalgebra::DMatrix;
 use rand_distr::{Distribution, StandardNormal};

@@ -29,10 +29,11 @@
 //! Not for: occlusion by nearer objects ([`super::OcclusionDetection`]) or merged-measurement
 //! likelihoods (the merged measurement is treated as the measurement of one of the objects).
 
-use super::cloud_bounds::CloudBox;
-use super::{DetectionModel, MeasurementModel, RangeBearing, StepContext, TrackSummary};
 use crate::error::{ensure_probability, Error, Result};
 use crate::filter::ParticleSet;
+use crate::filter::{DetectionModel, MeasurementModel, StepContext, TrackSummary};
+use crate::models::cloud_bounds::CloudBox;
+use crate::models::RangeBearing;
 use std::sync::{Arc, RwLock};
 
 /// p_D of an inner model, lowered near other tracks (module documentation).

@@ -34,11 +34,12 @@
 //! threshold.
 //!
 //! Not for: the motion of tracked objects other than the ego vehicle (use
-//! [`CoordinatedTurn`] or [`super::ConstantVelocity`]), or three-dimensional motion.
+//! [`CoordinatedTurn`] or [`crate::models::ConstantVelocity`]), or three-dimensional motion.
 
-use super::{CoordinatedTurn, StepContext, TransitionModel};
 use crate::error::{Error, Result};
 use crate::filter::ParticleSet;
+use crate::filter::{StepContext, TransitionModel};
+use crate::models::CoordinatedTurn;
 use crate::rng::FilterRng;
 use nalgebra::{DMatrix, Isometry3, Vector3};
 use rand_distr::{Distribution, StandardNormal};

@@ -28,23 +28,15 @@
 //! Not for: three-dimensional (elevation) measurements or sensors that rotate independently of
 //! the platform.
 
-use super::atan::{atan2, atan2_slices};
-use super::{MeasurementModel, StepContext, TrackSummary};
 use crate::error::{Error, Result};
+use crate::filter::{MeasurementModel, StepContext, TrackSummary};
 use crate::filter::{Measurements, ParticleSet};
+use crate::geometry::wrap_angle;
+use crate::numerics::atan::{atan2, atan2_slices};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// Default gate half-width, in standard deviations (see [`RangeBearing::gate`]).
 pub const DEFAULT_GATE_SIGMAS: f64 = 5.0;
-
-/// Wraps an angle to (−π, π].
-pub fn wrap_angle(a: f64) -> f64 {
-    if a > -PI && a <= PI {
-        a
-    } else {
-        a - TAU * ((a - PI) / TAU).ceil()
-    }
-}
 
 /// Where the bearing is measured from.
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]

@@ -28,12 +28,12 @@
 //! Without a view set, no beam is blocked and the model equals the field-of-view model.
 
 pub use super::beam_view::BeamView;
-use super::cloud_bounds::{CloudBox, PolarBounds};
-use super::detection::FieldOfViewDetection;
-use super::exp::exp_in_place;
-use super::{DetectionModel, StepContext};
 use crate::error::{ensure_positive, Error, Result};
 use crate::filter::ParticleSet;
+use crate::filter::{DetectionModel, StepContext};
+use crate::models::cloud_bounds::{CloudBox, PolarBounds};
+use crate::models::detection::FieldOfViewDetection;
+use crate::numerics::exp::exp_in_place;
 use std::sync::{Arc, RwLock};
 
 /// p_D from the field of view and the occlusion by nearer returns of the current scan (see the
@@ -431,7 +431,7 @@ mod tests {
     use nalgebra::{Isometry3, Vector3};
     use std::f64::consts::{FRAC_PI_2, PI};
 
-    use crate::models::beam_view::tests::view;
+    use super::super::beam_view::tests::view;
 
     fn model() -> OcclusionDetection {
         let fov = FieldOfViewDetection::new(0.9, 0.0, 30.0, FRAC_PI_2).unwrap();

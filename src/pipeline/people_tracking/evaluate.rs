@@ -29,13 +29,14 @@
 //! Not for: real recordings without ground truth.
 
 use super::front_end::{default_detector_config, FrontEnd, PersonFrontEnd};
-use super::{PeopleTrackerConfig, Pose2};
+use super::PeopleTrackerConfig;
 use crate::error::{Error, Result};
 use crate::filter::Label;
+use crate::geometry::Pose2;
 use crate::metrics::gospa::gated_pairing;
 use crate::metrics::{average_nis, ospa, ospa2, tracks_from_frames, LabelConsistency, NisCheck};
 use crate::sim::People2dRun;
-use crate::trackers::{PointTracker, StepClock};
+use crate::trackers::{BeamRanges, PointTracker, StepClock};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -170,6 +171,7 @@ pub fn evaluate_run_with(
     let (mut truth_frames, mut est_frames) = (Vec::new(), Vec::new());
     let mut ospa_sum = 0.0;
     let mut seconds = 0.0;
+    let mut beam_ranges = Vec::new();
     let (mut sq, mut count) = (0.0, 0usize);
     let mut nis = Vec::new();
     let mut windows = (0, 0);
@@ -195,7 +197,12 @@ pub fn evaluate_run_with(
             _ => None,
         };
         let ctx = clock.tick(scan.time, pose)?;
-        tracker.observe_scan(scan);
+        scan.ranges_into(&mut beam_ranges);
+        tracker.observe_beams(BeamRanges {
+            angle_min: scan.angle_min,
+            angle_increment: scan.angle_increment,
+            ranges: &beam_ranges,
+        });
         let est = tracker.step(&out.measurements, &ctx)?;
         seconds += t0.elapsed().as_secs_f64();
         for inn in tracker.innovations() {

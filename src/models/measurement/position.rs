@@ -11,9 +11,9 @@
 //! track's mean and standard deviation and k = `gate_sigmas` (5 by default).
 //! Not for: measurements in sensor coordinates (see [`crate::models::RangeBearing`]).
 
-use super::{MeasurementModel, StepContext, TrackSummary};
 use crate::error::{Error, Result};
 use crate::filter::ParticleSet;
+use crate::filter::{MeasurementModel, StepContext, TrackSummary};
 
 /// Default gate half-width, in combined standard deviations per axis.
 pub const DEFAULT_GATE_SIGMAS: f64 = 5.0;

@@ -1,0 +1,224 @@
+//! The filter's contract with its models: how objects move ([`TransitionModel`],
+//! [`SurvivalModel`]), how they are seen ([`MeasurementModel`], [`DetectionModel`]) and what
+//! else is seen ([`ClutterModel`]), with what the models may know about a step
+//! ([`StepContext`]) and about a track when gating ([`TrackSummary`]). Each trait has one verb
+//! and works on a whole [`ParticleSet`] at a time, so a user's own model is a small struct and
+//! the per-call cost of dynamic dispatch is paid once per track, not once per particle. A boxed
+//! model is a model too, so models chosen at run time go wherever a model is expected.
+//!
+//! # State layout of the built-in models
+//!
+//! Position and velocity are interleaved per axis, as in the standard RFS benchmarks:
+//!
+//! | model | state |
+//! |---|---|
+//! | planar constant velocity ([`crate::models::ConstantVelocity`] with 2 axes) | `[x, ẋ, y, ẏ]` |
+//! | spatial constant velocity ([`crate::models::ConstantVelocity`] with 3 axes) | `[x, ẋ, y, ẏ, z, ż]` |
+//! | coordinated turn ([`crate::models::CoordinatedTurn`]) | `[x, ẋ, y, ẏ, ω]` |
+//!
+//! So the position of every built-in state is found in components 0, 2 (and 4 in 3-D); the
+//! built-in measurement and detection models read it from there and ignore the rest. A user's
+//! model may use any layout, as long as its transition, measurement and detection models agree.
+//!
+//! Not for: the built-in models (see [`crate::models`]) or the recursion that calls them (see
+//! [`super::lmb`]).
+
+use super::{Measurements, ParticleSet};
+use crate::rng::FilterRng;
+use nalgebra::Isometry3;
+
+/// What the models may know about the current step.
+///
+/// `platform` is the pose of the sensing platform (robot, vehicle) in the world frame at this
+/// step; `previous_platform` the pose at the previous step. Planar platforms use a rotation
+/// about z. Both are `None` for a static sensor at the world origin.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct StepContext {
+    /// Filter step index (0 for the first frame).
+    pub step: u32,
+    /// Time stamp of this step, seconds.
+    pub time: f64,
+    /// Time since the previous step, seconds.
+    pub dt: f64,
+    /// Platform pose at this step (world frame).
+    pub platform: Option<Isometry3<f64>>,
+    /// Platform pose at the previous step (world frame).
+    pub previous_platform: Option<Isometry3<f64>>,
+}
+
+impl StepContext {
+    /// A context for a static sensor.
+    pub fn new(step: u32, time: f64, dt: f64) -> Self {
+        StepContext {
+            step,
+            time,
+            dt,
+            platform: None,
+            previous_platform: None,
+        }
+    }
+
+    /// Planar platform pose (x, y, heading) at this step; the origin when none is set.
+    pub fn platform_xy_heading(&self) -> (f64, f64, f64) {
+        match &self.platform {
+            None => (0.0, 0.0, 0.0),
+            Some(p) => {
+                let t = p.translation.vector;
+                let (_, _, yaw) = p.rotation.euler_angles();
+                (t.x, t.y, yaw)
+            }
+        }
+    }
+}
+
+/// Per-track summary handed to gates: weighted mean and per-component standard deviation of
+/// the predicted particle set.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TrackSummary {
+    /// Weighted mean state.
+    pub mean: Vec<f64>,
+    /// Weighted standard deviation of each state component.
+    pub std: Vec<f64>,
+}
+
+/// Moves a whole particle set one step forward (Markov transition density f(x' | x)).
+///
+/// Implementations sample the process noise themselves, from `rng`, so that a user's model
+/// can be any simulator: linear, nonlinear, or driven by the ego motion in `ctx`.
+pub trait TransitionModel: Send + Sync {
+    /// Dimension of the state vector this model moves.
+    fn state_dim(&self) -> usize;
+    /// Replaces every particle by a draw from f(· | particle).
+    fn predict(&self, particles: &mut ParticleSet, ctx: &StepContext, rng: &mut FilterRng);
+}
+
+/// Probability p_S(x) that an object survives from the previous step to this one.
+pub trait SurvivalModel: Send + Sync {
+    /// Writes p_S of every particle into `out` (values in [0, 1]).
+    fn survival_probability(&self, particles: &ParticleSet, ctx: &StepContext, out: &mut [f64]);
+}
+
+/// The single-object likelihood g(z | x).
+pub trait MeasurementModel: Send + Sync {
+    /// Dimension of one measurement vector.
+    fn measurement_dim(&self) -> usize;
+    /// Writes log g(z | xᵢ) of every particle into `out`. Must be finite or −∞, never NaN.
+    fn log_likelihood(
+        &self,
+        z: &[f64],
+        particles: &ParticleSet,
+        ctx: &StepContext,
+        out: &mut [f64],
+    );
+    /// log g(z | xᵢ) for several measurements at once: `out[j]` (one slot per particle) gets
+    /// the row of `zs[j]`. The default calls [`MeasurementModel::log_likelihood`] for each;
+    /// models whose predicted measurement h(xᵢ) is costly override it to compute h once.
+    fn log_likelihood_batch(
+        &self,
+        zs: &[&[f64]],
+        particles: &ParticleSet,
+        ctx: &StepContext,
+        out: &mut [Vec<f64>],
+    ) {
+        for (z, o) in zs.iter().zip(out.iter_mut()) {
+            self.log_likelihood(z, particles, ctx, o);
+        }
+    }
+    /// A cheap test whether `z` could come from a track summarised by `track`; pairs that fail
+    /// are never evaluated by [`MeasurementModel::log_likelihood`]. The default admits all.
+    fn gate(&self, z: &[f64], track: &TrackSummary, ctx: &StepContext) -> bool {
+        let _ = (z, track, ctx);
+        true
+    }
+    /// The indices of the measurements `zs` that pass [`MeasurementModel::gate`] for `track`,
+    /// in order, into `out` (cleared first). The default tests each; models whose gate has
+    /// per-track work (the track's predicted measurement) override it to do that once.
+    fn gate_all(
+        &self,
+        zs: &Measurements,
+        track: &TrackSummary,
+        ctx: &StepContext,
+        out: &mut Vec<usize>,
+    ) {
+        out.clear();
+        out.extend((0..zs.len()).filter(|&j| self.gate(zs.get(j), track, ctx)));
+    }
+}
+
+/// The detection probability p_D(x).
+pub trait DetectionModel: Send + Sync {
+    /// Writes p_D of every particle into `out` (values in [0, 1]).
+    fn detection_probability(&self, particles: &ParticleSet, ctx: &StepContext, out: &mut [f64]);
+}
+
+/// The clutter intensity κ(z) = λ_c · c(z): expected number of false measurements times their
+/// spatial density.
+pub trait ClutterModel: Send + Sync {
+    /// log κ(z).
+    fn log_intensity(&self, z: &[f64], ctx: &StepContext) -> f64;
+}
+
+// A boxed model is a model: lets trait objects (e.g. chosen at run time) go wherever a model
+// is expected.
+impl<T: TransitionModel + ?Sized> TransitionModel for Box<T> {
+    fn state_dim(&self) -> usize {
+        (**self).state_dim()
+    }
+    fn predict(&self, particles: &mut ParticleSet, ctx: &StepContext, rng: &mut FilterRng) {
+        (**self).predict(particles, ctx, rng)
+    }
+}
+
+impl<T: SurvivalModel + ?Sized> SurvivalModel for Box<T> {
+    fn survival_probability(&self, particles: &ParticleSet, ctx: &StepContext, out: &mut [f64]) {
+        (**self).survival_probability(particles, ctx, out)
+    }
+}
+
+impl<T: MeasurementModel + ?Sized> MeasurementModel for Box<T> {
+    fn measurement_dim(&self) -> usize {
+        (**self).measurement_dim()
+    }
+    fn log_likelihood(
+        &self,
+        z: &[f64],
+        particles: &ParticleSet,
+        ctx: &StepContext,
+        out: &mut [f64],
+    ) {
+        (**self).log_likelihood(z, particles, ctx, out)
+    }
+    fn log_likelihood_batch(
+        &self,
+        zs: &[&[f64]],
+        particles: &ParticleSet,
+        ctx: &StepContext,
+        out: &mut [Vec<f64>],
+    ) {
+        (**self).log_likelihood_batch(zs, particles, ctx, out)
+    }
+    fn gate(&self, z: &[f64], track: &TrackSummary, ctx: &StepContext) -> bool {
+        (**self).gate(z, track, ctx)
+    }
+    fn gate_all(
+        &self,
+        zs: &Measurements,
+        track: &TrackSummary,
+        ctx: &StepContext,
+        out: &mut Vec<usize>,
+    ) {
+        (**self).gate_all(zs, track, ctx, out)
+    }
+}
+
+impl<T: DetectionModel + ?Sized> DetectionModel for Box<T> {
+    fn detection_probability(&self, particles: &ParticleSet, ctx: &StepContext, out: &mut [f64]) {
+        (**self).detection_probability(particles, ctx, out)
+    }
+}
+
+impl<T: ClutterModel + ?Sized> ClutterModel for Box<T> {
+    fn log_intensity(&self, z: &[f64], ctx: &StepContext) -> f64 {
+        (**self).log_intensity(z, ctx)
+    }
+}

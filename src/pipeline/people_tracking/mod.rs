@@ -1,0 +1,34 @@
+//! People tracking from planar laser scans, the role [`super::drive_tracking`] plays for
+//! 3-D drives: a scan becomes range-bearing measurements of people's centres ([`front_end`]:
+//! every person-sized segment, or only those the moving-object detector of
+//! [`crate::laser2d::moving`] marks as moving), the particle LMB filter tracks them
+//! ([`tracker`], with its birth model [`birth`] and the people models of [`models`]), tracks
+//! are classed static or dynamic ([`motion_state`]), a whole recording becomes a
+//! [`PeopleRun`] ([`run`]) drawn by [`plot`], and any tracker — the LMB or a baseline of
+//! [`crate::trackers`] — is scored on a simulated run ([`evaluate`], with the innovations of
+//! [`innovation`] for the consistency checks).
+//!
+//! Not for: reading or segmenting scans (see [`crate::laser2d`]) or the baseline trackers
+//! themselves (see [`crate::trackers`]).
+
+pub mod birth;
+pub mod evaluate;
+pub mod front_end;
+pub mod innovation;
+pub mod models;
+pub mod motion_state;
+pub mod plot;
+pub mod run;
+pub mod tracker;
+
+pub use birth::PeopleBirth;
+pub use motion_state::{probability_moving, MotionClassifier, MotionConfig};
+pub use plot::{write_people_plot, PeoplePlotCounts, PeoplePlotOptions};
+pub use run::{
+    config_for_scans, track_scans, track_scans_with, write_people_json, PeopleRun, PersonTrack,
+    ScanPeople,
+};
+pub use tracker::{
+    centre_noise, person_measurements, person_segments, PeopleTracker, PeopleTrackerConfig,
+    PersonEstimate,
+};
