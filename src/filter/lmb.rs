@@ -398,7 +398,8 @@ impl LmbFilter {
                 });
             }
         }
-        let (assigned, resampled) = self.update(&likelihoods, &marginals, z.len(), seed);
+        let assigned = self.update(&likelihoods, &marginals, z.len());
+        let resampled = self.resample(seed);
         self.unmoved_detection.clear();
         for ((t, l), moved) in self.tracks.iter().zip(likelihoods).zip(resampled) {
             if !moved {
@@ -656,24 +657,37 @@ impl LmbFilter {
             .collect()
     }
 
-    /// The GLMB → LMB update of existence and particle weights, then resampling. Returns, for
-    /// every measurement, the probability that some track generated it, and for every track
-    /// whether it was resampled.
+    /// The GLMB → LMB update of existence and particle weights, per track. Returns, for every
+    /// measurement, the probability that some track generated it.
     fn update(
         &mut self,
         lik: &[TrackLikelihoods],
         marg: &[TrackMarginals],
         n_meas: usize,
-        seed: u64,
-    ) -> (Vec<f64>, Vec<bool>) {
-        let cfg = &self.config;
-        let resampled = self
-            .tracks
+    ) -> Vec<f64> {
+        self.tracks
             .par_iter_mut()
             .zip(lik.par_iter())
             .zip(marg.par_iter())
-            .map(|((t, l), mg)| {
-                update_track(t, l, mg);
+            .for_each(|((t, l), mg)| update_track(t, l, mg));
+        let mut assigned = vec![0.0; n_meas];
+        for (l, mg) in lik.iter().zip(marg) {
+            for &(k, p) in &mg.detect {
+                assigned[l.gated[k]] += p;
+            }
+        }
+        assigned.iter_mut().for_each(|a| *a = a.min(1.0));
+        assigned
+    }
+
+    /// Resampling, per track: back to `particles` particles (with jitter) when the count
+    /// differs or the effective sample size is below `resample_threshold · particles`. Returns
+    /// for every track whether it was resampled.
+    fn resample(&mut self, seed: u64) -> Vec<bool> {
+        let cfg = &self.config;
+        self.tracks
+            .par_iter_mut()
+            .map(|t| {
                 let n = t.particles.len();
                 let resample = n != cfg.particles
                     || t.particles.effective_sample_size()
@@ -684,15 +698,7 @@ impl LmbFilter {
                 }
                 resample
             })
-            .collect();
-        let mut assigned = vec![0.0; n_meas];
-        for (l, mg) in lik.iter().zip(marg) {
-            for &(k, p) in &mg.detect {
-                assigned[l.gated[k]] += p;
-            }
-        }
-        assigned.iter_mut().for_each(|a| *a = a.min(1.0));
-        (assigned, resampled)
+            .collect()
     }
 
     /// Removes tracks below the existence threshold and keeps at most `max_tracks`.
