@@ -4,10 +4,12 @@
 //!
 //! predict → birth → gate → likelihoods → associate → update → resample → prune → estimate.
 //!
-//! Each stage is one function below. Work per track and per association group runs in parallel
-//! with rayon; every track draws from its own random stream derived from the step seed and its
-//! label, so results are bit-identical whatever the number of threads. Not for: models
-//! (see [`crate::models`]), association algorithms (see [`super::association`]).
+//! Each stage is one function below (gating is part of `likelihoods`), and what a step keeps
+//! for inspection afterwards is recorded by one more (`record_diagnostics`). Work per track and
+//! per association group runs in parallel with rayon; every track draws from its own random
+//! stream derived from the step seed and its label, so results are bit-identical whatever the
+//! number of threads. Not for: models (see [`crate::models`]), association algorithms (see
+//! [`super::association`]).
 
 use super::association::{AssociationMethod, AssociationProblem, Associator, Marginals};
 use super::birth::{BirthEvidence, BirthModel};
@@ -363,61 +365,32 @@ impl LmbFilter {
     }
 
     /// Runs one frame and returns the MAP multi-object estimate.
+    ///
+    /// One call per stage of the recursion; the step seed is the only draw from `rng`, and each
+    /// random stage derives its own streams from it.
     pub fn step(&mut self, frame: &Frame, rng: &mut FilterRng) -> Result<Vec<Estimate>> {
         let ctx = self.context(frame)?;
         let z = &frame.measurements;
-        if !z.is_empty() && z.dim() != self.models.measurement.measurement_dim() {
-            return Err(Error::invalid(
-                format!("measurements of step {}", self.step),
-                format!(
-                    "have dimension {}, the measurement model expects {}",
-                    z.dim(),
-                    self.models.measurement.measurement_dim()
-                ),
-            ));
-        }
         let seed = rng.next_u64();
 
         self.predict(&ctx, seed);
         self.add_births(&ctx, seed);
-        self.predicted.clear();
-        if self.keep_predicted {
-            self.predicted
-                .extend(self.tracks.iter().map(|t| (t.label, t.particles.clone())));
-        }
+        let predicted = self.predicted_copies();
         let likelihoods = self.likelihoods(z, &ctx);
         let marginals = self.associate(z, &ctx, &likelihoods, seed);
-        self.most_probable.clear();
-        for ((t, l), mg) in self.tracks.iter().zip(&likelihoods).zip(&marginals) {
-            let best = mg.detect.iter().max_by(|a, b| a.1.total_cmp(&b.1));
-            if let Some(&(k, probability)) = best {
-                self.most_probable.push(MostProbableMeasurement {
-                    label: t.label,
-                    measurement: l.gated[k],
-                    probability,
-                });
-            }
-        }
-        let (assigned, resampled) = self.update(&likelihoods, &marginals, z.len(), seed);
-        self.unmoved_detection.clear();
-        for ((t, l), moved) in self.tracks.iter().zip(likelihoods).zip(resampled) {
-            if !moved {
-                self.unmoved_detection.push((t.label, l.pd));
-            }
-        }
+        let assigned = self.update(&likelihoods, &marginals, z.len());
+        let resampled = self.resample(seed);
+        self.record_diagnostics(predicted, likelihoods, &marginals, &resampled);
         self.prune();
         let estimates = map_estimates(&self.tracks);
 
-        self.previous = Some(Previous {
-            context: ctx,
-            measurements: z.clone(),
-            assigned,
-        });
-        self.step += 1;
+        self.carry_over(ctx, z, assigned);
         Ok(estimates)
     }
 
-    /// The step context: time step from the previous frame, platform poses.
+    /// The step context: time step from the previous frame, platform poses. Rejects a frame
+    /// whose time or pose is not finite, whose time goes backwards, or whose measurements do
+    /// not have the measurement model's dimension.
     fn context(&self, frame: &Frame) -> Result<StepContext> {
         let what = || format!("frame of step {}", self.step);
         if !frame.time.is_finite() {
@@ -440,6 +413,17 @@ impl LmbFilter {
             return Err(Error::invalid(
                 what(),
                 format!("time goes backwards by {} s", -dt),
+            ));
+        }
+        let z = &frame.measurements;
+        if !z.is_empty() && z.dim() != self.models.measurement.measurement_dim() {
+            return Err(Error::invalid(
+                format!("measurements of step {}", self.step),
+                format!(
+                    "have dimension {}, the measurement model expects {}",
+                    z.dim(),
+                    self.models.measurement.measurement_dim()
+                ),
             ));
         }
         Ok(StepContext {
@@ -656,24 +640,37 @@ impl LmbFilter {
             .collect()
     }
 
-    /// The GLMB → LMB update of existence and particle weights, then resampling. Returns, for
-    /// every measurement, the probability that some track generated it, and for every track
-    /// whether it was resampled.
+    /// The GLMB → LMB update of existence and particle weights, per track. Returns, for every
+    /// measurement, the probability that some track generated it.
     fn update(
         &mut self,
         lik: &[TrackLikelihoods],
         marg: &[TrackMarginals],
         n_meas: usize,
-        seed: u64,
-    ) -> (Vec<f64>, Vec<bool>) {
-        let cfg = &self.config;
-        let resampled = self
-            .tracks
+    ) -> Vec<f64> {
+        self.tracks
             .par_iter_mut()
             .zip(lik.par_iter())
             .zip(marg.par_iter())
-            .map(|((t, l), mg)| {
-                update_track(t, l, mg);
+            .for_each(|((t, l), mg)| update_track(t, l, mg));
+        let mut assigned = vec![0.0; n_meas];
+        for (l, mg) in lik.iter().zip(marg) {
+            for &(k, p) in &mg.detect {
+                assigned[l.gated[k]] += p;
+            }
+        }
+        assigned.iter_mut().for_each(|a| *a = a.min(1.0));
+        assigned
+    }
+
+    /// Resampling, per track: back to `particles` particles (with jitter) when the count
+    /// differs or the effective sample size is below `resample_threshold · particles`. Returns
+    /// for every track whether it was resampled.
+    fn resample(&mut self, seed: u64) -> Vec<bool> {
+        let cfg = &self.config;
+        self.tracks
+            .par_iter_mut()
+            .map(|t| {
                 let n = t.particles.len();
                 let resample = n != cfg.particles
                     || t.particles.effective_sample_size()
@@ -684,15 +681,52 @@ impl LmbFilter {
                 }
                 resample
             })
-            .collect();
-        let mut assigned = vec![0.0; n_meas];
-        for (l, mg) in lik.iter().zip(marg) {
-            for &(k, p) in &mg.detect {
-                assigned[l.gated[k]] += p;
+            .collect()
+    }
+
+    /// A copy of every track's particle set as predicted (births as drawn), taken before the
+    /// update reweights them, for [`LmbFilter::predicted`]; empty unless
+    /// [`LmbFilter::keep_predicted`] is on.
+    fn predicted_copies(&self) -> Vec<(Label, ParticleSet)> {
+        if !self.keep_predicted {
+            return Vec::new();
+        }
+        self.tracks
+            .iter()
+            .map(|t| (t.label, t.particles.clone()))
+            .collect()
+    }
+
+    /// What the step leaves for inspection, recorded before pruning while the tracks still line
+    /// up with `lik`, `marg` and `resampled`: the predicted particle sets (when kept), each
+    /// track's most probable measurement, and the detection probabilities of the tracks whose
+    /// particles did not move in resampling.
+    fn record_diagnostics(
+        &mut self,
+        predicted: Vec<(Label, ParticleSet)>,
+        lik: Vec<TrackLikelihoods>,
+        marg: &[TrackMarginals],
+        resampled: &[bool],
+    ) {
+        self.predicted.clear();
+        self.predicted.extend(predicted);
+        self.most_probable.clear();
+        for ((t, l), mg) in self.tracks.iter().zip(&lik).zip(marg) {
+            let best = mg.detect.iter().max_by(|a, b| a.1.total_cmp(&b.1));
+            if let Some(&(k, probability)) = best {
+                self.most_probable.push(MostProbableMeasurement {
+                    label: t.label,
+                    measurement: l.gated[k],
+                    probability,
+                });
             }
         }
-        assigned.iter_mut().for_each(|a| *a = a.min(1.0));
-        (assigned, resampled)
+        self.unmoved_detection.clear();
+        for ((t, l), &moved) in self.tracks.iter().zip(lik).zip(resampled) {
+            if !moved {
+                self.unmoved_detection.push((t.label, l.pd));
+            }
+        }
     }
 
     /// Removes tracks below the existence threshold and keeps at most `max_tracks`.
@@ -709,6 +743,17 @@ impl LmbFilter {
             self.tracks.truncate(self.config.max_tracks);
             self.tracks.sort_by_key(|t| t.label);
         }
+    }
+
+    /// Keeps what the next step needs (this step's context, measurements and their
+    /// association probabilities, for the time step and adaptive birth) and counts the step.
+    fn carry_over(&mut self, ctx: StepContext, z: &Measurements, assigned: Vec<f64>) {
+        self.previous = Some(Previous {
+            context: ctx,
+            measurements: z.clone(),
+            assigned,
+        });
+        self.step += 1;
     }
 }
 

@@ -4,11 +4,9 @@
 //! and for checking the approximate methods in tests. Beyond a cap the enumeration is
 //! abandoned and Murty's ranked assignment answers instead. Not for: large groups.
 
-use super::murty;
-use super::{
-    prepare, Accumulator, AssociationProblem, Associator, LogTable, Marginals, MurtyAssociator,
-    Prepared,
-};
+use super::murty::{self, MurtyAssociator};
+use super::problem::{AssociationProblem, Associator, Marginals};
+use super::tables::{prepare, Accumulator, LogTable, Prepared};
 use crate::rng::FilterRng;
 
 /// Exact marginals by depth-first enumeration of all admissible hypotheses.

@@ -16,9 +16,8 @@
 //! Not for: exact marginals (use enough samples, or Murty or enumeration for small groups).
 
 use super::murty::best_assignment;
-use super::{
-    prepare, Accumulator, AssociationProblem, Associator, Hypothesis, LogTable, Marginals, Prepared,
-};
+use super::problem::{AssociationProblem, Associator, Hypothesis, Marginals};
+use super::tables::{prepare, Accumulator, LogTable, Prepared};
 use crate::rng::FilterRng;
 use rand::RngExt;
 use std::collections::HashSet;

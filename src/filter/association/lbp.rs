@@ -21,7 +21,8 @@
 //! Not for: exact marginals (use Murty or enumeration).
 
 use super::murty::best_assignment;
-use super::{prepare, AssociationProblem, Associator, LogTable, Marginals, Prepared};
+use super::problem::{AssociationProblem, Associator, Marginals};
+use super::tables::{prepare, LogTable, Prepared};
 use crate::rng::FilterRng;
 
 /// Marginals by loopy belief propagation.

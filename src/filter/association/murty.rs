@@ -18,9 +18,8 @@
 //! hypothesis and is partitioned in turn. Not for: approximate marginals of large groups
 //! (see the Gibbs and belief-propagation associators).
 
-use super::{
-    prepare, Accumulator, AssociationProblem, Associator, Hypothesis, LogTable, Marginals, Prepared,
-};
+use super::problem::{AssociationProblem, Associator, Hypothesis, Marginals};
+use super::tables::{prepare, Accumulator, LogTable, Prepared};
 use crate::assignment;
 use crate::rng::FilterRng;
 use std::cmp::Ordering;
