@@ -176,6 +176,7 @@ impl FieldOfViewDetection {
     /// Whether every point within the polar bounds `b` (taken from this sensor, see
     /// [`super::CloudBox::polar_from`]) is inside the sector with room to spare, so that
     /// [`FieldOfViewDetection::contains_from`] holds for each of them.
+    #[cfg_attr(not(feature = "laser2d"), allow(dead_code))]
     pub(crate) fn surely_contains(&self, b: &super::PolarBounds) -> bool {
         let inside_range = b.d_max < self.max_range * (1.0 - 1e-9);
         let inside_angle = self.half_angle >= std::f64::consts::PI
@@ -204,6 +205,7 @@ impl FieldOfViewDetection {
     /// `cos_half` = cos(half angle). The same answer, without branches, for loops over many
     /// points.
     #[inline(always)]
+    #[cfg_attr(not(feature = "laser2d"), allow(dead_code))]
     pub(crate) fn contains_local(&self, lx: f64, d2: f64, cos_half: f64) -> bool {
         // as `contains_from`: a NaN distance is not out of range
         let in_range = (d2 <= self.max_range * self.max_range) | d2.is_nan();
@@ -212,6 +214,7 @@ impl FieldOfViewDetection {
     }
 
     /// cos(half angle), for [`Self::contains_local`].
+    #[cfg_attr(not(feature = "laser2d"), allow(dead_code))]
     pub(crate) fn cos_half_angle(&self) -> f64 {
         self.half_angle.cos()
     }

@@ -6,17 +6,24 @@
 //!
 //! Not for: the filter itself (see [`crate::filter`]) or command-line parsing.
 
+#[cfg(feature = "kitti")]
 pub mod plane_prediction;
 
+#[cfg(feature = "kitti")]
 pub use plane_prediction::{
     predict_drive_pairs, predict_odometry_pairs, predict_planes_between, predict_walls,
     segment_walls, EgoMotion, PairPrediction, PlanePredictionConfig,
 };
 
+#[cfg(feature = "kitti")]
 pub mod drive_tracking;
+#[cfg(feature = "kitti")]
 pub use drive_tracking::{track_drive, DriveTracker, DriveTracks, TrackingConfig};
 
+#[cfg(feature = "kitti")]
 pub mod drive_evaluation;
 
+#[cfg(feature = "laser2d")]
 pub mod people_tracking;
+#[cfg(feature = "kitti")]
 pub use drive_evaluation::{evaluate_clusters, evaluate_walls, ClusterEvaluation, WallEvaluation};

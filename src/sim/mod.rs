@@ -14,10 +14,13 @@
 //!
 //! Not for: reading recorded data sets or scoring estimates (see [`crate::metrics`]).
 
+#[cfg(feature = "laser2d")]
 pub mod people2d;
 pub mod rfs_benchmark;
+#[cfg(feature = "kitti")]
 pub mod street;
 
+#[cfg(feature = "laser2d")]
 pub use people2d::{
     OdometryNoise, People2dRun, PeopleScenario, PersonLeg, PersonSpec, RobotLeg, RobotSpec,
     ScannerSpec,

@@ -7,22 +7,31 @@
 
 #![allow(dead_code)] // each test binary uses a subset
 
+#[cfg(feature = "kitti")]
 use nalgebra::{Isometry3, Point3};
+#[cfg(feature = "kitti")]
 use rand::RngExt;
+#[cfg(feature = "kitti")]
 use rand_distr::{Distribution, Normal};
+#[cfg(feature = "kitti")]
 use smc_lmb::cloud::{write_kitti_bin, PointCloud};
+#[cfg(feature = "kitti")]
 use smc_lmb::kitti::poses::Mercator;
+#[cfg(feature = "kitti")]
 use smc_lmb::kitti::{
     frame_file_name, write_oxts_dir, write_timestamps, OxtsPacket, RawDrive, Timestamp,
 };
+#[cfg(feature = "kitti")]
 use smc_lmb::rng::{seeded, FilterRng};
 use std::path::{Path, PathBuf};
 
+#[cfg(feature = "kitti")]
 /// The vendored real KITTI excerpt.
 pub fn vendored_kitti() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/kitti")
 }
 
+#[cfg(feature = "kitti")]
 /// `world` (world = Velodyne frame of the first frame) seen from a sensor at `pose`
 /// (sensor → world), with Gaussian noise of `noise` metres per coordinate.
 pub fn scan(
@@ -47,6 +56,7 @@ pub fn scan(
     cloud
 }
 
+#[cfg(feature = "kitti")]
 /// Writes a drive `2011_09_26_drive_NNNN_sync` under `root` with one frame per vehicle state
 /// `[X, Ẋ, Y, Ẏ, φ, φ̇]` (frames `dt` apart); frame k shows `world(k)` (world points in the
 /// Velodyne frame of frame 0) with 1 cm noise. Returns the drive folder.
@@ -109,6 +119,7 @@ pub fn write_drive(
     dir
 }
 
+#[cfg(feature = "kitti")]
 /// Points on a regular grid over the rectangle `origin + u·[0, a] + v·[0, b]`, `spacing` apart.
 pub fn grid(origin: [f64; 3], a: [f64; 3], b: [f64; 3], spacing: f64) -> Vec<Point3<f64>> {
     let la = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
@@ -131,6 +142,7 @@ pub fn grid(origin: [f64; 3], a: [f64; 3], b: [f64; 3], spacing: f64) -> Vec<Poi
     pts
 }
 
+#[cfg(feature = "kitti")]
 /// The surface of an axis-aligned box with centre `c` and size `size`, `spacing` apart.
 pub fn box_surface(c: [f64; 3], size: [f64; 3], spacing: f64) -> Vec<Point3<f64>> {
     let h = [0.5 * size[0], 0.5 * size[1], 0.5 * size[2]];

@@ -6,10 +6,13 @@
 //! [`crate::cloud::ply_io`], [`crate::plot`]).
 
 use super::detect::FrameDetections;
-use super::output::{DriveTracks, TrackedFrame};
+#[cfg(feature = "plot")]
+use super::output::DriveTracks;
+use super::output::TrackedFrame;
+#[cfg(feature = "plot")]
 use crate::cloud::label_colour;
+#[cfg(feature = "plot")]
 use crate::plot::{BirdsEyePlot, Dot, Polyline};
-use std::collections::BTreeMap;
 
 /// One track number per point of a frame's cloud of `len` points: the number of the wall or
 /// cluster track matched to the detection the point belongs to, 0 for every other point
@@ -36,10 +39,12 @@ pub fn point_labels(len: usize, detections: &FrameDetections, tracked: &TrackedF
     labels
 }
 
+#[cfg(feature = "plot")]
 /// The bird's-eye plot of a drive in world x–y: the ego path (black), each cluster track's
 /// trajectory in its label colour with a dot at its last position, and each wall track's
 /// last rectangle as a thick segment (its horizontal extent) in its label colour.
 pub fn drive_plot(tracks: &DriveTracks) -> BirdsEyePlot {
+    use std::collections::BTreeMap;
     let mut plot = BirdsEyePlot::default();
     let ego: Vec<[f64; 2]> = tracks
         .frames

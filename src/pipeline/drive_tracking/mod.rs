@@ -25,7 +25,9 @@ pub mod output;
 pub mod tracker;
 
 pub use detect::{detect_objects, ClusterDetection, FrameDetections, WallDetection};
-pub use export::{drive_plot, point_labels};
+#[cfg(feature = "plot")]
+pub use export::drive_plot;
+pub use export::point_labels;
 pub use output::{
     DriveTracks, StageTimes, TrackedCluster, TrackedFrame, TrackedPlane, TrackingSummary,
 };

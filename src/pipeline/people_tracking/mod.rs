@@ -17,12 +17,14 @@ pub mod front_end;
 pub mod innovation;
 pub mod models;
 pub mod motion_state;
+#[cfg(feature = "plot")]
 pub mod plot;
 pub mod run;
 pub mod tracker;
 
 pub use birth::PeopleBirth;
 pub use motion_state::{probability_moving, MotionClassifier, MotionConfig};
+#[cfg(feature = "plot")]
 pub use plot::{write_people_plot, PeoplePlotCounts, PeoplePlotOptions};
 pub use run::{
     config_for_scans, track_scans, track_scans_with, write_people_json, PeopleRun, PersonTrack,
