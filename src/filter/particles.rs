@@ -166,7 +166,7 @@ impl ParticleSet {
 
     /// Multiplies weight `i` by `exp(log_factor[i])` and renormalises, in the log domain.
     ///
-    /// Returns the log of Σᵢ wᵢ·exp(log_factor[i]) (the normalising constant, possibly far below
+    /// Returns the log of Σᵢ wᵢ·exp(log_factor\[i\]) (the normalising constant, possibly far below
     /// `f64::MIN_POSITIVE` without underflowing). If every factor is −∞ (or NaN) the weights
     /// are left unchanged and −∞ is returned: the set is never emptied.
     pub fn reweight_log(&mut self, log_factor: &[f64]) -> f64 {
@@ -199,7 +199,7 @@ impl ParticleSet {
     }
 
     /// Multiplies weight `i` by `factor[i]` (finite, ≥ 0) and renormalises; returns
-    /// Σᵢ wᵢ·factor[i]. When that sum is zero or not finite the weights are left unchanged.
+    /// Σᵢ wᵢ·factor\[i\]. When that sum is zero or not finite the weights are left unchanged.
     pub fn reweight(&mut self, factor: &[f64]) -> f64 {
         debug_assert_eq!(factor.len(), self.len);
         let total: f64 = self.weights.iter().zip(factor).map(|(w, f)| w * f).sum();

@@ -68,7 +68,8 @@ pub fn identity() -> Pose2 {
     Pose2::new(0.0, 0.0, 0.0)
 }
 
-/// The platform pose of a planar odometry pose, as the filter's [`StepContext`] holds it.
+/// The platform pose of a planar odometry pose, as the filter's
+/// [`StepContext`](crate::filter::StepContext) holds it.
 pub fn platform_isometry(pose: Pose2) -> Isometry3<f64> {
     Isometry3::new(
         Vector3::new(pose.x, pose.y, 0.0),

@@ -8,7 +8,7 @@
 //! * [`rosbag`]: `sensor_msgs/LaserScan` and `nav_msgs/Odometry` from ROS 1 bags.
 //! * [`csv`]: the project's own one-scan-per-line text format, read and written.
 //! * [`segment`]: the adaptive breakpoint detector (seed 000, eq. 15) and [`Segment`]s;
-//!   [`person_groups`]: the grouping of noisy returns into person-sized candidates.
+//!   [`person_groups`](mod@person_groups): the grouping of noisy returns into person-sized candidates.
 //! * [`moving`]: moving-object detection from a moving platform (seed 003), built from
 //!   [`icp`] (scan matching), [`local_map`] (averaged static points), [`background`]
 //!   (per-beam background map), [`features`] (segment shape features) and [`fuzzy_art`]

@@ -3,7 +3,8 @@
 //!
 //! All three read the position from components 0 and 2 of the state (the layout of the
 //! built-in motion models, see [`crate::models`]); particle sets with fewer than three
-//! components get p_D = 0. Not for: occlusion (see [`super::occlusion`]) or appearance-based
+//! components get p_D = 0. Not for: occlusion (see
+//! [`crate::pipeline::people_tracking::models::occlusion`]) or appearance-based
 //! detectability.
 
 use crate::error::{ensure_positive, ensure_probability, Result};

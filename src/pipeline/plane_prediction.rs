@@ -3,7 +3,7 @@
 //!
 //! For a frame pair (k, k + 1):
 //! 1. the building walls of both frames are segmented with
-//!    [`extract_planes`](crate::cloud::planes::extract_planes);
+//!    [`crate::cloud::planes::extract_planes`];
 //! 2. every wall patch of frame k is moved into the sensor frame of k + 1 with the ego motion
 //!    M = T_{k+1}⁻¹ T_k ([`relative_motion`]). With [`EgoMotion::Measured`] M comes from the
 //!    measured poses. With [`EgoMotion::Sampled`] (Algorithm 1) each Monte-Carlo run draws

@@ -4,7 +4,7 @@
 //! Per step, after the EKF prediction (line 2):
 //!
 //! 1. Individual compatibility (lines 3–4): the squared Mahalanobis distance d²(i, j) of every
-//!    measurement j to every track i; the association matrix J(i, j) = [d² < d₁].
+//!    measurement j to every track i; the association matrix J(i, j) = \[d² < d₁\].
 //! 2. First level (lines 5–6): a track with exactly one compatible measurement that is
 //!    compatible with no other track is updated with it.
 //! 3. RANSAC (line 7) on what is left: a hypothesis starts from one randomly drawn compatible

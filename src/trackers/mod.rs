@@ -6,7 +6,7 @@
 //! Every tracker is fed, step by step, the measurements of one scan (range and bearing of
 //! people's centres in the sensor frame, bearing counter-clockwise from the sensor's x axis) and
 //! a [`StepContext`] holding the time, the time since the previous step and the robot's odometry
-//! pose; the sensor's mounting offset on the robot is part of each tracker's [`RangeBearing`]
+//! pose; the sensor's mounting offset on the robot is part of each tracker's [`RangeBearing`](crate::models::RangeBearing)
 //! model. Every tracker returns labelled [`Estimate`]s with the state `[x, ẋ, y, ẏ, …]` in the
 //! world frame, and may report the innovations of its last update
 //! ([`PointTracker::innovations`]) for the RMS prediction error and NIS checks.

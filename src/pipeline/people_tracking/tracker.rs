@@ -653,7 +653,7 @@ pub fn person_grouping(config: &PeopleTrackerConfig) -> PersonGrouping {
     }
 }
 
-/// The point groups of `scan` that look like people (see [`crate::laser2d::person_groups`]), each as
+/// The point groups of `scan` that look like people (see [`crate::laser2d::person_groups()`]), each as
 /// its points in the sensor frame.
 pub fn person_segments(config: &PeopleTrackerConfig, scan: &Scan) -> Result<Vec<Vec<[f64; 2]>>> {
     Ok(person_groups(scan, &person_grouping(config))?
