@@ -5,7 +5,7 @@
 //! * [`angle`]: [`wrap_angle`], the one wrap to (−π, π].
 //! * [`pose2`]: [`Pose2`] and planar rigid motions, [`platform_isometry`] (a planar pose as the
 //!   SE(3) pose a filter step holds).
-//! * [`ray`]: [`ray_circle`].
+//! * [`ray`]: [`ray_circle`], where a ray first meets a circle.
 //! * [`plane`]: [`Plane`], [`PlanePatch`].
 //!
 //! Not for: finding planes in point clouds (see [`crate::cloud::planes`]), moving planes
