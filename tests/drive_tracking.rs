@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{box_surface, grid, vendored_kitti, write_drive};
+use common::{box_surface, grid, shared_data, vendored_kitti, write_drive};
 use nalgebra::Point3;
 use smc_lmb::cloud::{read_las, read_ply, write_las_labelled, write_ply_labelled};
 use smc_lmb::filter::Label;
@@ -303,12 +303,9 @@ fn vendored_real_frame_static_sensor_keeps_labels() {
 
 #[test]
 fn full_real_frames_when_present() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/kitti_raw/2011_09_26/2011_09_26_drive_UNKNOWN_sync");
-    if !dir.is_dir() {
-        eprintln!("shared data not found at {}; skipped", dir.display());
+    let Some(dir) = shared_data("kitti_raw/2011_09_26/2011_09_26_drive_UNKNOWN_sync") else {
         return;
-    }
+    };
     let tracks = run(&dir, 1);
     assert_eq!(tracks.frames.len(), 4);
     let s = &tracks.summary;

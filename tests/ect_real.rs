@@ -1,6 +1,8 @@
 //! The extended constant-turn model on real vehicle motion: drive 0001's OXTS states predicted
 //! one packet ahead (noiseless ECT step, seed 001 eq. 36) against the next measured state.
 
+mod common;
+
 use smc_lmb::kitti::RawDrive;
 use smc_lmb::models::ExtendedConstantTurn;
 use std::path::Path;
@@ -43,12 +45,9 @@ fn ect_predicts_the_next_oxts_state_of_the_vendored_drive() {
 
 #[test]
 fn ect_predicts_the_next_oxts_state_of_the_full_drive() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/kitti_raw/2011_09_26/2011_09_26_drive_0001_sync");
-    if !dir.exists() {
-        println!("skipped: {} not present", dir.display());
+    let Some(dir) = common::shared_data("kitti_raw/2011_09_26/2011_09_26_drive_0001_sync") else {
         return;
-    }
+    };
     let (mp, xp, mh, xh, n) = one_step_errors(&dir);
     println!("drive 0001, {n} steps: position error mean {mp:.4} m, max {xp:.4} m; heading error mean {mh:.5} rad, max {xh:.5} rad");
     assert!(mp < 0.05 && xp < 0.15, "position error mean {mp} max {xp}");

@@ -1,7 +1,9 @@
 //! Whole stories of the KITTI readers: the vendored real excerpt under `tests/data/kitti/`
-//! (always), the full shared data beside the checkout under `../shared/data/kitti_raw/` (skipped
-//! with a note when that folder is absent), hand-written fixtures, and broken inputs built in
+//! (always), the full shared data beside the checkout under `../shared/data/kitti_raw/` (when that
+//! folder is absent, a failure under `CI=true` and a skip with a note on the terminal otherwise), hand-written fixtures, and broken inputs built in
 //! temporary folders (each must be an error naming the file, never a panic).
+
+mod common;
 
 use nalgebra::{Point3, Vector3};
 use smc_lmb::cloud::{read_kitti_bin, read_kitti_bin_with, write_kitti_bin, NonFinite, PointCloud};
@@ -22,15 +24,9 @@ fn vendored_day() -> PathBuf {
     vendored().join("2011_09_26")
 }
 
-/// The full shared data, or `None` (with a printed note) when it is not beside the checkout.
+/// The full shared data (see [`common::shared_data`]).
 fn full_day() -> Option<PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/kitti_raw/2011_09_26");
-    if p.is_dir() {
-        Some(p)
-    } else {
-        println!("note: {} is absent; test skipped", p.display());
-        None
-    }
+    common::shared_data("kitti_raw/2011_09_26")
 }
 
 /// Horizontal path length of consecutive positions.

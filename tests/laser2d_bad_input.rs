@@ -3,7 +3,8 @@
 //! truncated and empty files, bags without a scan topic, time going backwards. Each case is
 //! either a clear error naming the file (and line and field where there are lines) or a
 //! documented skip — never a panic. Damaged real bags are made from
-//! `../shared/data/laser2d/` when it is present (skipped with a note otherwise).
+//! `../shared/data/laser2d/` (a missing file fails the test under `CI=true` and is skipped with a
+//! note on the terminal otherwise).
 
 use proptest::prelude::*;
 use smc_lmb::laser2d::csv::{CSV_HEADER, CSV_MAGIC};

@@ -1,14 +1,15 @@
 //! The recording path of people tracking: a vendored excerpt of the Intel Research Lab CARMEN
 //! log goes through reading, tracking and the JSON writer; the ROS bag of people walking past
-//! a stationary scanner (from `../shared/data/laser2d/`, skipped with a note when absent) is
+//! a stationary scanner (from `../shared/data/laser2d/`; absent, it fails under `CI=true`, else is skipped with a note) is
 //! tracked whole and checked against what `docs/laser2d_recordings.md` reports.
+
+mod common;
 
 use smc_lmb::laser2d::{read_bag, read_carmen, BagOptions, CarmenOptions, TimeOrder};
 use smc_lmb::pipeline::people_tracking::{
     config_for_scans, track_scans, write_people_json, PeopleRun,
 };
 use smc_lmb::pipeline::people_tracking::{write_people_plot, PeoplePlotOptions};
-use std::path::Path;
 
 #[test]
 fn intel_excerpt_runs_end_to_end_and_round_trips_as_json() {
@@ -67,12 +68,9 @@ fn intel_excerpt_runs_end_to_end_and_round_trips_as_json() {
 
 #[test]
 fn stationary_bag_tracks_walking_people_end_to_end() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/laser2d/demo_stationary_simple_environment.bag");
-    if !path.exists() {
-        println!("note: {} not found, test skipped", path.display());
+    let Some(path) = common::shared_laser2d("demo_stationary_simple_environment.bag") else {
         return;
-    }
+    };
     let scans = read_bag(&path, &BagOptions::default()).unwrap().scans;
     assert_eq!(scans.len(), 1_265);
     // the command of the documentation: default noise, 15 m, seed 1

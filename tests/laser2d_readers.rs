@@ -1,6 +1,7 @@
 //! Integration tests of the 2D laser readers (CARMEN, ROS bag, CSV) and of the segmentation on
 //! real scans. The vendored Intel excerpt always runs; the full recordings are read from
-//! `../shared/data/laser2d/` beside the checkout and skipped, with a note, when absent.
+//! `../shared/data/laser2d/` beside the checkout; when absent they fail under `CI=true` and are
+//! skipped with a note on the terminal otherwise.
 
 use smc_lmb::laser2d::{
     bag_topics, read_bag, read_carmen, read_scan_csv, segment_scan, write_scan_csv, BagOptions,

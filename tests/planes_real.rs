@@ -4,10 +4,12 @@
 //! Not for: accuracy against ground truth (KITTI has no plane labels); these tests check that
 //! the ground and building walls come out with plausible geometry.
 
+mod common;
+
 use smc_lmb::cloud::planes::{extract_planes, PlaneConfig, PlaneSegmentation, RejectReason};
 use smc_lmb::cloud::read_kitti_bin;
 use smc_lmb::rng::seeded;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 const DRIVE: &str = "kitti_raw/2011_09_26/2011_09_26_drive_UNKNOWN_sync/velodyne_points/data";
@@ -80,13 +82,9 @@ fn vendored_subsampled_frame() {
 
 #[test]
 fn full_frames() {
-    let dir: PathBuf = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data")
-        .join(DRIVE);
-    if !dir.is_dir() {
-        println!("skipped: {} not found", dir.display());
+    let Some(dir) = common::shared_data(DRIVE) else {
         return;
-    }
+    };
     for k in 0..4 {
         let (n, seg) = segment(&dir.join(format!("{k:010}.bin")));
         assert!(n > 100_000);
@@ -113,13 +111,9 @@ fn full_frames() {
 /// the vertical planes are thick bands of vegetation-like returns, RMS ≈ 0.1 m.)
 #[test]
 fn building_scale_preset_on_full_frames() {
-    let dir: PathBuf = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data")
-        .join(DRIVE);
-    if !dir.is_dir() {
-        println!("skipped: {} not found", dir.display());
+    let Some(dir) = common::shared_data(DRIVE) else {
         return;
-    }
+    };
     for k in 0..4 {
         let path = dir.join(format!("{k:010}.bin"));
         let (_, loose) = segment(&path);

@@ -169,15 +169,34 @@ pub fn vendored_laser2d(name: &str) -> PathBuf {
         .join(name)
 }
 
-/// A file of the shared 2-D laser data folder, or `None` (with a note) when it is not there.
-pub fn shared_laser2d(name: &str) -> Option<PathBuf> {
+/// A path under `../shared/data`, the real recordings beside the checkout. When it is absent
+/// a test that needs it cannot run: under `CI=true` it fails, naming what is missing (CI must
+/// exercise the real data); elsewhere it returns `None` after a line on the terminal saying the
+/// test is skipped (written to the process's stderr directly, past the test harness's capture,
+/// so that a person sees it).
+pub fn shared_data(relative: &str) -> Option<PathBuf> {
     let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/laser2d")
-        .join(name);
+        .join("../shared/data")
+        .join(relative);
     if p.exists() {
-        Some(p)
-    } else {
-        println!("note: {} not found, test skipped", p.display());
-        None
+        return Some(p);
     }
+    if std::env::var("CI").is_ok_and(|v| v == "true") {
+        panic!(
+            "CI=true but the shared data {} is missing: the tests on real recordings must run",
+            p.display()
+        );
+    }
+    use std::io::Write;
+    let _ = writeln!(
+        std::io::stderr(),
+        "SKIPPED: {} is absent, a test on real data did not run",
+        p.display()
+    );
+    None
+}
+
+/// A file of the shared 2-D laser data folder (see [`shared_data`]).
+pub fn shared_laser2d(name: &str) -> Option<PathBuf> {
+    shared_data(&format!("laser2d/{name}"))
 }
