@@ -5,8 +5,9 @@
 //! abandoned and Murty's ranked assignment answers instead. Not for: large groups.
 
 use super::murty::{self, MurtyAssociator};
+use super::problem::Accumulator;
 use super::problem::{AssociationProblem, Associator, Marginals};
-use super::tables::{prepare, Accumulator, LogTable, Prepared};
+use super::tables::{prepare, LogTable, Prepared};
 use crate::rng::FilterRng;
 
 /// Exact marginals by depth-first enumeration of all admissible hypotheses.

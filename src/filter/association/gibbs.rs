@@ -16,8 +16,9 @@
 //! Not for: exact marginals (use enough samples, or Murty or enumeration for small groups).
 
 use super::murty::best_assignment;
+use super::problem::Accumulator;
 use super::problem::{AssociationProblem, Associator, Hypothesis, Marginals};
-use super::tables::{prepare, Accumulator, LogTable, Prepared};
+use super::tables::{prepare, LogTable, Prepared};
 use crate::rng::FilterRng;
 use rand::RngExt;
 use std::collections::HashSet;

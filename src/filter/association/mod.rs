@@ -22,11 +22,12 @@
 //! The module's files:
 //!
 //! * `problem.rs` — the shared vocabulary: [`AssociationProblem`], [`Hypothesis`],
-//!   [`Marginals`] and the [`Associator`] trait;
+//!   [`Marginals`] (with the log-sum-exp accumulator of hypotheses) and the [`Associator`]
+//!   trait;
 //! * `method.rs` — [`AssociationMethod`], the configurable choice of method (serde and
 //!   `murty:500`-style parsing, defaults);
 //! * `tables.rs` — crate-internal machinery every method shares: the common preparation of a
-//!   problem, the row-shifted log-weight table and the log-sum-exp accumulator of hypotheses;
+//!   problem and the row-shifted log-weight table;
 //! * `murty.rs`, `gibbs.rs`, `lbp.rs`, `exhaustive.rs` — one algorithm each;
 //! * `testutil.rs` and `tests.rs` (tests only) — an independent brute-force reference, and the
 //!   checks that hold every method to the conventions above.

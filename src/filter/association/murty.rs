@@ -18,8 +18,9 @@
 //! hypothesis and is partitioned in turn. Not for: approximate marginals of large groups
 //! (see the Gibbs and belief-propagation associators).
 
+use super::problem::Accumulator;
 use super::problem::{AssociationProblem, Associator, Hypothesis, Marginals};
-use super::tables::{prepare, Accumulator, LogTable, Prepared};
+use super::tables::{prepare, LogTable, Prepared};
 use crate::assignment;
 use crate::rng::FilterRng;
 use std::cmp::Ordering;

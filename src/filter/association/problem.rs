@@ -8,7 +8,6 @@
 //! Not for: solving a problem (see the associator modules) or choosing a method from a
 //! configuration (see [`AssociationMethod`](super::AssociationMethod)).
 
-use super::tables::Accumulator;
 use crate::rng::FilterRng;
 
 /// One association problem (an independent group of tracks and measurements), in log weights.
@@ -174,6 +173,74 @@ impl Marginals {
     /// Panics if `i` is out of range.
     pub fn detect_row(&self, i: usize) -> &[f64] {
         &self.detect[i * self.n_meas..(i + 1) * self.n_meas]
+    }
+}
+
+/// Streaming log-sum-exp accumulation of hypothesis weights into marginals.
+pub(crate) struct Accumulator {
+    n: usize,
+    m: usize,
+    /// Largest log weight seen; the sums are relative to it.
+    max: f64,
+    miss: Vec<f64>,
+    detect: Vec<f64>,
+}
+
+impl Accumulator {
+    /// Empty accumulator.
+    pub fn new(n: usize, m: usize) -> Self {
+        Self {
+            n,
+            m,
+            max: f64::NEG_INFINITY,
+            miss: vec![0.0; n],
+            detect: vec![0.0; n.saturating_mul(m)],
+        }
+    }
+
+    /// Adds one hypothesis (entries 0 = missed, j ≥ 1 = measurement j − 1, all ≤ m).
+    pub fn add(&mut self, theta: &[usize], log_weight: f64) {
+        if log_weight.is_nan() || log_weight == f64::NEG_INFINITY {
+            return;
+        }
+        if log_weight > self.max {
+            // exp(−∞) = 0 covers both the first hypothesis and a jump to +∞.
+            let scale = (self.max - log_weight).exp();
+            self.miss.iter_mut().for_each(|v| *v *= scale);
+            self.detect.iter_mut().for_each(|v| *v *= scale);
+            self.max = log_weight;
+        }
+        let w = if log_weight == f64::INFINITY {
+            1.0
+        } else {
+            (log_weight - self.max).exp()
+        };
+        for (i, &j) in theta.iter().enumerate() {
+            if j == 0 {
+                self.miss[i] += w;
+            } else {
+                self.detect[i * self.m + j - 1] += w;
+            }
+        }
+    }
+
+    /// Normalised marginals; [`Marginals::all_missed`] if nothing was added.
+    pub fn finish(mut self) -> Marginals {
+        if self.max == f64::NEG_INFINITY {
+            return Marginals::all_missed(self.n, self.m);
+        }
+        for i in 0..self.n {
+            let row = &mut self.detect[i * self.m..(i + 1) * self.m];
+            let total = self.miss[i] + row.iter().sum::<f64>();
+            self.miss[i] /= total;
+            row.iter_mut().for_each(|v| *v /= total);
+        }
+        Marginals {
+            n_tracks: self.n,
+            n_meas: self.m,
+            miss: self.miss,
+            detect: self.detect,
+        }
     }
 }
 

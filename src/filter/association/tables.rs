@@ -1,7 +1,8 @@
 //! The machinery the association methods share, crate-internal: the common preparation of
 //! a problem ([`prepare`]: trivial, malformed and infeasible problems answered at once, the
-//! rest turned into a [`LogTable`] of row-shifted log weights) and the streaming log-sum-exp
-//! [`Accumulator`] that turns enumerated or sampled hypotheses into [`Marginals`].
+//! rest turned into a [`LogTable`] of row-shifted log weights), answered with the
+//! [`Marginals`] of [`super::problem`] (whose accumulator sums enumerated or sampled
+//! hypotheses).
 //!
 //! Not for: public API (nothing here is exported) or any one method's search (see the
 //! associator modules).
@@ -124,73 +125,5 @@ fn single_track(table: &LogTable) -> Marginals {
         n_meas: table.m,
         miss: vec![row[0].exp() / total],
         detect: row[1..].iter().map(|v| v.exp() / total).collect(),
-    }
-}
-
-/// Streaming log-sum-exp accumulation of hypothesis weights into marginals.
-pub(crate) struct Accumulator {
-    n: usize,
-    m: usize,
-    /// Largest log weight seen; the sums are relative to it.
-    max: f64,
-    miss: Vec<f64>,
-    detect: Vec<f64>,
-}
-
-impl Accumulator {
-    /// Empty accumulator.
-    pub fn new(n: usize, m: usize) -> Self {
-        Self {
-            n,
-            m,
-            max: f64::NEG_INFINITY,
-            miss: vec![0.0; n],
-            detect: vec![0.0; n.saturating_mul(m)],
-        }
-    }
-
-    /// Adds one hypothesis (entries 0 = missed, j ≥ 1 = measurement j − 1, all ≤ m).
-    pub fn add(&mut self, theta: &[usize], log_weight: f64) {
-        if log_weight.is_nan() || log_weight == f64::NEG_INFINITY {
-            return;
-        }
-        if log_weight > self.max {
-            // exp(−∞) = 0 covers both the first hypothesis and a jump to +∞.
-            let scale = (self.max - log_weight).exp();
-            self.miss.iter_mut().for_each(|v| *v *= scale);
-            self.detect.iter_mut().for_each(|v| *v *= scale);
-            self.max = log_weight;
-        }
-        let w = if log_weight == f64::INFINITY {
-            1.0
-        } else {
-            (log_weight - self.max).exp()
-        };
-        for (i, &j) in theta.iter().enumerate() {
-            if j == 0 {
-                self.miss[i] += w;
-            } else {
-                self.detect[i * self.m + j - 1] += w;
-            }
-        }
-    }
-
-    /// Normalised marginals; [`Marginals::all_missed`] if nothing was added.
-    pub fn finish(mut self) -> Marginals {
-        if self.max == f64::NEG_INFINITY {
-            return Marginals::all_missed(self.n, self.m);
-        }
-        for i in 0..self.n {
-            let row = &mut self.detect[i * self.m..(i + 1) * self.m];
-            let total = self.miss[i] + row.iter().sum::<f64>();
-            self.miss[i] /= total;
-            row.iter_mut().for_each(|v| *v /= total);
-        }
-        Marginals {
-            n_tracks: self.n,
-            n_meas: self.m,
-            miss: self.miss,
-            detect: self.detect,
-        }
     }
 }
