@@ -49,13 +49,28 @@ fn linear_scenario_matches_published_lmb_accuracy() {
     }
 }
 
+/// The reference MATLAB particle LMB's three runs on the nonlinear scenario
+/// (`vo_scenarios.md`): 30.7, 39.0 and 35.7 m mean OSPA, 35.13 m on average.
+const REFERENCE_PARTICLE_LMB_MEAN_OSPA: f64 = (30.7 + 39.0 + 35.7) / 3.0;
+
 #[test]
 fn nonlinear_scenario_beats_the_reference_particle_lmb() {
-    let d = mean_ospa(
-        &Scenario::nonlinear(),
-        4,
-        1000,
-        AssociationMethod::default(),
+    // Our mean over four independent runs against the reference's mean over its three: a
+    // single run spreads over 26–35 m, so one run alone would say little.
+    let runs: Vec<f64> = (1..=4)
+        .map(|seed| {
+            mean_ospa(
+                &Scenario::nonlinear(),
+                seed,
+                1000,
+                AssociationMethod::default(),
+            )
+        })
+        .collect();
+    let mean = runs.iter().sum::<f64>() / runs.len() as f64;
+    eprintln!("nonlinear: mean OSPA {mean:.2} m over runs {runs:.2?}");
+    assert!(
+        mean < REFERENCE_PARTICLE_LMB_MEAN_OSPA,
+        "mean OSPA {mean:.2} m over runs {runs:.2?}, reference {REFERENCE_PARTICLE_LMB_MEAN_OSPA:.2} m"
     );
-    assert!(d < 36.0, "mean OSPA {d:.2} m");
 }
