@@ -28,11 +28,19 @@ use nalgebra::Isometry3;
 use rand::Rng;
 use rayon::prelude::*;
 
+/// The most particles per track [`LmbConfig::validate`] accepts: ten million (a 6-component
+/// state then takes about half a gigabyte per track). Larger values are refused up front
+/// rather than failing an allocation in the middle of a run.
+pub const MAX_PARTICLES: usize = 10_000_000;
+
+/// The most tracks [`LmbConfig::validate`] accepts in `max_tracks`: one million.
+pub const MAX_TRACKS: usize = 1_000_000;
+
 /// Tuning of the recursion. Every field has a documented default.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct LmbConfig {
-    /// Particles per track after resampling. Default 1000.
+    /// Particles per track after resampling, 1 to [`MAX_PARTICLES`]. Default 1000.
     pub particles: usize,
     /// Resample a track when its effective sample size falls below this fraction of
     /// `particles` (1.0 resamples after every update that changed the weights). Default 0.5.
@@ -41,7 +49,8 @@ pub struct LmbConfig {
     pub jitter: Jitter,
     /// Tracks whose existence probability falls below this are removed. Default 1e-3.
     pub prune_threshold: f64,
-    /// At most this many tracks (those with the highest existence) are kept. Default 100.
+    /// At most this many tracks (those with the highest existence) are kept, 1 to
+    /// [`MAX_TRACKS`]. Default 100.
     pub max_tracks: usize,
 }
 
@@ -66,6 +75,12 @@ impl LmbConfig {
                 "must be positive",
             ));
         }
+        if self.particles > MAX_PARTICLES {
+            return Err(Error::invalid(
+                "config field `particles`",
+                format!("{} is above the limit of {MAX_PARTICLES}", self.particles),
+            ));
+        }
         if !(0.0..=1.0).contains(&self.resample_threshold) {
             return Err(Error::invalid(
                 "config field `resample_threshold`",
@@ -82,6 +97,12 @@ impl LmbConfig {
             return Err(Error::invalid(
                 "config field `max_tracks`",
                 "must be positive",
+            ));
+        }
+        if self.max_tracks > MAX_TRACKS {
+            return Err(Error::invalid(
+                "config field `max_tracks`",
+                format!("{} is above the limit of {MAX_TRACKS}", self.max_tracks),
             ));
         }
         match self.jitter {
@@ -817,4 +838,46 @@ fn update_track(t: &mut Track, l: &TrackLikelihoods, mg: &TrackMarginals) {
             .for_each(|((f, d), s)| *f += d * s);
     }
     t.particles.reweight(&factor);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn config_limits_are_enforced_and_named() {
+        assert!(LmbConfig::default().validate().is_ok());
+        let at_limits = LmbConfig {
+            particles: MAX_PARTICLES,
+            max_tracks: MAX_TRACKS,
+            ..LmbConfig::default()
+        };
+        assert!(at_limits.validate().is_ok());
+        for (config, field) in [
+            (
+                LmbConfig {
+                    particles: 1_000_000_000_000,
+                    ..LmbConfig::default()
+                },
+                "particles",
+            ),
+            (
+                LmbConfig {
+                    particles: 0,
+                    ..LmbConfig::default()
+                },
+                "particles",
+            ),
+            (
+                LmbConfig {
+                    max_tracks: MAX_TRACKS + 1,
+                    ..LmbConfig::default()
+                },
+                "max_tracks",
+            ),
+        ] {
+            let e = config.validate().unwrap_err().to_string();
+            assert!(e.contains(field), "{e}");
+        }
+    }
 }

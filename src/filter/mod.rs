@@ -30,7 +30,10 @@ pub use birth::{
     StaticBirth,
 };
 pub use label::Label;
-pub use lmb::{Frame, LmbConfig, LmbFilter, LmbFilterBuilder, MostProbableMeasurement};
+pub use lmb::{
+    Frame, LmbConfig, LmbFilter, LmbFilterBuilder, MostProbableMeasurement, MAX_PARTICLES,
+    MAX_TRACKS,
+};
 pub use measurements::Measurements;
 pub use model::{
     ClutterModel, DetectionModel, MeasurementModel, StepContext, SurvivalModel, TrackSummary,
