@@ -179,10 +179,15 @@ impl Scan {
         Some([r * c, r * s])
     }
 
-    /// The range of every beam into `out` (cleared first), `+∞` for a no-return beam.
+    /// The range of every beam in beam order, `+∞` for a no-return beam.
+    pub fn beam_ranges(&self) -> impl Iterator<Item = f64> + '_ {
+        (0..self.len()).map(|i| self.range(i).unwrap_or(f64::INFINITY))
+    }
+
+    /// [`Scan::beam_ranges`] into `out` (cleared first).
     pub fn ranges_into(&self, out: &mut Vec<f64>) {
         out.clear();
-        out.extend((0..self.len()).map(|i| self.range(i).unwrap_or(f64::INFINITY)));
+        out.extend(self.beam_ranges());
     }
 
     /// All returns as `(beam index, [x, y])` in the sensor frame, in beam order; "no return"

@@ -459,11 +459,8 @@ impl PeopleTracker {
 
     /// Hands the scan's ranges to the occlusion-aware detection model for the next step.
     pub fn observe(&mut self, scan: &Scan) {
-        self.detection.update_view(
-            scan.angle_min,
-            scan.angle_increment,
-            (0..scan.len()).map(|i| scan.range(i).unwrap_or(f64::INFINITY)),
-        );
+        self.detection
+            .update_view(scan.angle_min, scan.angle_increment, scan.beam_ranges());
     }
 
     /// One step on measurements made elsewhere (range-bearing rows of the people's centres),
