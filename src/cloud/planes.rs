@@ -25,8 +25,11 @@
 //! Once a near-horizontal plane below the sensor has been extracted, later rounds look for
 //! walls only: hypotheses are drawn from points more than `ground_clearance` above that plane
 //! and only those within `max_wall_tilt` of vertical are kept (a real road is not one flat
-//! plane, and its residual slabs would otherwise win every round). Points near the ground stay
-//! available as inliers of later planes.
+//! plane, and its residual slabs would otherwise win every round). Their inliers, too, are
+//! taken only from the points above that clearance: the foot of a wall on the road is seen
+//! on the sensor's side only, and as inliers those road points would lean the fitted wall
+//! towards the sensor by an amount that changes from scan to scan. Points near the ground
+//! that no plane takes stay in `remaining`.
 //!
 //! Each extracted plane is then classified. Near-horizontal planes below the sensor are
 //! ground candidates (the one with most inliers becomes the ground and is not split). Other
@@ -34,9 +37,12 @@
 //! `PlaneConfig::grid_cell` in the plane's own coordinates, 8-connectivity), each piece is
 //! refitted and kept as a wall when its normal is within `max_wall_tilt` of horizontal and its
 //! patch is building-scale (`min_wall_area`, `min_wall_length`, `min_wall_height`) and, when
-//! [`PlaneConfig::wall_quality`] is set, it passes that facade test (top above the sensor,
-//! small RMS; see [`WallQuality`] and the preset [`PlaneConfig::building_scale`]). Everything
-//! else is reported in [`PlaneSegmentation::rejected`] with a [`RejectReason`].
+//! [`PlaneConfig::wall_quality`] is set (the default), it passes that facade test (top above
+//! the sensor, small RMS, plumb relative to the ground; see [`WallQuality`]). A wall's patch
+//! is its upright bounding rectangle ([`PlanePatch::upright_from_points`]: sides horizontal
+//! and up the wall), so a ragged visible outline does not turn the rectangle from scan to
+//! scan. Everything else is reported in [`PlaneSegmentation::rejected`] with a
+//! [`RejectReason`].
 //!
 //! # Determinism
 //! Results depend only on the cloud, the configuration and the RNG state, never on the
@@ -60,7 +66,7 @@ use crate::cloud::PointCloud;
 use crate::error::{Error, Result};
 use crate::geometry::{Plane, PlanePatch};
 use crate::rng::FilterRng;
-use pieces::{connected_pieces, hull_candidates, rms};
+use pieces::{connected_pieces, hull_candidates, point64, rms};
 use ransac::{fit_chunked, one_round, PlaneF32};
 
 /// One segmented plane piece.
@@ -82,12 +88,15 @@ pub enum RejectReason {
     /// A near-horizontal plane that is not below the sensor by `min_ground_depth`.
     HorizontalNotGround,
     /// A building-scale vertical piece that fails [`PlaneConfig::wall_quality`]: its top is
-    /// too low or its points too far from the plane for a facade.
+    /// too low, its points too far from the plane or its plane too far from plumb for a
+    /// facade.
     NotBuildingScale {
         /// Height of the patch's top above the sensor's horizontal plane (m).
         top: f64,
         /// RMS point-to-plane distance of the piece (m).
         rms: f64,
+        /// Angle between the piece's plane and the local vertical (rad).
+        lean: f64,
     },
     /// Neither near-horizontal nor near-vertical; `tilt` is the normal's angle from vertical.
     Oblique {
@@ -197,7 +206,10 @@ pub fn extract_planes(
         if pool.len() < config.min_points {
             break;
         }
-        let Some((plane, inliers)) = one_round(&pts, &active, &pool, min_tilt, config, rng) else {
+        // Wall inliers come from the same points as the hypotheses: a wall's foot on the road
+        // would otherwise pull its fit towards the ground on the visible side only.
+        let candidates = if first_ground.is_some() { &pool } else { &active };
+        let Some((plane, inliers)) = one_round(&pts, candidates, &pool, min_tilt, config, rng) else {
             break;
         };
         if first_ground.is_none() && ground_like(&plane) {
@@ -219,9 +231,17 @@ pub fn extract_planes(
         .max_by(|a, b| a.1 .1.len().cmp(&b.1 .1.len()).then(b.0.cmp(&a.0)))
         .map(|(i, _)| i);
 
+    // The local vertical: the ground's normal when there is a ground, else the sensor's z.
+    let up = ground_idx
+        .map(|g| extracted[g].0.normal)
+        .unwrap_or_else(nalgebra::Vector3::z);
     let mut assigned = vec![false; pts.len()];
     let patch_of = |plane: &Plane, idx: &[u32]| -> Result<PlanePatch> {
         PlanePatch::from_points(*plane, &hull_candidates(plane, idx, &pts))
+    };
+    let upright_patch_of = |plane: &Plane, idx: &[u32]| -> Result<PlanePatch> {
+        let points: Vec<_> = idx.iter().map(|&i| point64(pts[i as usize])).collect();
+        PlanePatch::upright_from_points(*plane, &points)
     };
     let to_orig = |idx: &[u32]| -> Vec<u32> {
         let mut v: Vec<u32> = idx.iter().map(|&i| orig[i as usize]).collect();
@@ -284,7 +304,7 @@ pub fn extract_planes(
                 continue;
             }
             let piece_plane = fit_chunked(&pts, &piece).unwrap_or(*plane);
-            let patch = patch_of(&piece_plane, &piece)?;
+            let patch = upright_patch_of(&piece_plane, &piece)?;
             let tilt = piece_plane.tilt();
             let (length, height) = patch.extent;
             if tilt < std::f64::consts::FRAC_PI_2 - config.max_wall_tilt {
@@ -315,12 +335,15 @@ pub fn extract_planes(
                     .iter()
                     .map(|v| v.z)
                     .fold(f64::NEG_INFINITY, f64::max);
-                let fails = |q: &WallQuality| top < q.min_top_above_sensor || rms > q.max_rms;
+                let lean = piece_plane.normal.dot(&up).abs().min(1.0).asin();
+                let fails = |q: &WallQuality| {
+                    top < q.min_top_above_sensor || rms > q.max_rms || lean > q.max_lean
+                };
                 if config.wall_quality.as_ref().is_some_and(fails) {
                     out.rejected.push(RejectedPlane {
                         plane: piece_plane,
                         points: piece.len(),
-                        reason: RejectReason::NotBuildingScale { top, rms },
+                        reason: RejectReason::NotBuildingScale { top, rms, lean },
                         patch: Some(patch),
                     });
                     continue;
@@ -516,12 +539,12 @@ mod tests {
             );
         }
         let near_hedge = |p: &PlanePatch| (p.centre() - Point3::new(0.0, 12.0, -0.43)).norm() < 2.0;
-        let loose = extract_planes(&cloud, &PlaneConfig::default(), &mut seeded(5)).unwrap();
+        let loose = extract_planes(&cloud, &PlaneConfig::any_vertical(), &mut seeded(5)).unwrap();
         let hedge = loose
             .walls
             .iter()
             .find(|w| near_hedge(&w.patch))
-            .expect("the default keeps the hedge as a wall");
+            .expect("without the facade test the hedge is a wall");
         assert!(hedge.rms > 0.08, "{}", hedge.rms);
         let strict =
             extract_planes(&cloud, &PlaneConfig::building_scale(), &mut seeded(5)).unwrap();
@@ -533,7 +556,7 @@ mod tests {
         // not recognise vegetation.) Every wall left is flat and rises above the sensor, and
         // the two facades (0.02 m noise, tops 4.27 m and 3.27 m above the sensor) are kept.
         for w in &strict.walls {
-            assert!(w.rms <= 0.06, "{}", w.rms);
+            assert!(w.rms <= 0.08, "{}", w.rms);
             assert!(w.patch.vertices.iter().any(|v| v.z >= 0.0));
         }
         for (axis, offset) in [(Vector3::x(), 10.0), (Vector3::y(), 8.0)] {

@@ -266,6 +266,45 @@ impl PlanePatch {
         })
     }
 
+    /// The bounding rectangle, on a wall-like `plane`, of `points` projected into it, with its
+    /// sides along the plane's horizontal direction `u` and up-slope direction `v` of
+    /// [`Plane::basis`] instead of the minimum-area orientation. For walls this keeps the
+    /// rectangle upright however ragged the visible outline is (a partly occluded facade, a
+    /// stepped roof line), so the same wall seen twice gives the same corners; its area is at
+    /// least that of [`PlanePatch::from_points`]. Vertices as there (`v0` bottom start,
+    /// `v1` bottom end, `v2` top end, `v3` top start). Fails on an empty or non-finite point
+    /// set.
+    pub fn upright_from_points(plane: Plane, points: &[Point3<f64>]) -> Result<Self> {
+        if points.is_empty() {
+            return Err(Error::invalid("plane patch", "no points"));
+        }
+        let (u, v) = plane.basis();
+        let origin = plane.project(&points[0]);
+        let (mut u_lo, mut u_hi, mut v_lo, mut v_hi) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+        for p in points {
+            let q = p - origin;
+            let (x, y) = (q.dot(&u), q.dot(&v));
+            if !x.is_finite() || !y.is_finite() {
+                return Err(Error::invalid("plane patch", "non-finite point"));
+            }
+            u_lo = u_lo.min(x);
+            u_hi = u_hi.max(x);
+            v_lo = v_lo.min(y);
+            v_hi = v_hi.max(y);
+        }
+        let (length, height) = (u_hi - u_lo, v_hi - v_lo);
+        let v0 = origin + u * u_lo + v * v_lo;
+        let v1 = v0 + u * length;
+        let v2 = v1 + v * height;
+        let v3 = v0 + v * height;
+        Ok(PlanePatch {
+            plane,
+            vertices: [v0, v1, v2, v3],
+            area: length * height,
+            extent: (length, height),
+        })
+    }
+
     /// Centroid of the four vertices (the rectangle's centre).
     pub fn centre(&self) -> Point3<f64> {
         let s = self
@@ -465,6 +504,41 @@ mod tests {
             }
         }
         pts
+    }
+
+    #[test]
+    fn upright_patch_of_a_slanted_outline_keeps_horizontal_sides() {
+        // A parallelogram on the wall y = 5: bottom edge x in [0, 10] at z = 0, top edge
+        // x in [4, 14] at z = 3 (a stepped or partly occluded facade). The upright rectangle
+        // is x in [0, 14], z in [0, 3], never smaller than the minimum-area one.
+        let mut pts = Vec::new();
+        for i in 0..=20 {
+            for j in 0..=6 {
+                let (s, t) = (i as f64 / 20.0, j as f64 / 6.0);
+                pts.push(Point3::new(10.0 * s + 4.0 * t, 5.0, 3.0 * t));
+            }
+        }
+        let plane = Plane::from_points(&pts).unwrap();
+        let patch = PlanePatch::upright_from_points(plane, &pts).unwrap();
+        assert_abs_diff_eq!(patch.extent.0, 14.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(patch.extent.1, 3.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(patch.area, 42.0, epsilon = 1e-9);
+        let mut xs: Vec<f64> = patch.vertices.iter().map(|v| v.x).collect();
+        xs.sort_by(f64::total_cmp);
+        assert_abs_diff_eq!(xs[0], 0.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(xs[3], 14.0, epsilon = 1e-9);
+        // v0 → v1 along the bottom (horizontal), v0 → v3 straight up.
+        let (bottom, up) = (
+            patch.vertices[1] - patch.vertices[0],
+            patch.vertices[3] - patch.vertices[0],
+        );
+        assert_abs_diff_eq!(bottom.z, 0.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(up.x, 0.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(up.z, 3.0, epsilon = 1e-9);
+        assert!(PlanePatch::from_points(plane, &pts).unwrap().area <= 42.0 + 1e-9);
+        assert!(PlanePatch::upright_from_points(plane, &[]).is_err());
+        let bad = [Point3::new(f64::NAN, 5.0, 0.0)];
+        assert!(PlanePatch::upright_from_points(plane, &bad).is_err());
     }
 
     #[test]

@@ -52,20 +52,25 @@ pub struct PlaneConfig {
     /// Grid cells with fewer points than this take no part in the pieces (their points stay
     /// unassigned); keeps stray clutter points on the infinite plane from stretching a patch.
     pub min_cell_points: usize,
-    /// Walls: optional facade test on top of the size limits (`None`: every building-scale
-    /// vertical piece is a wall). See [`WallQuality`] and [`PlaneConfig::building_scale`].
+    /// Walls: facade test on top of the size limits (default [`WallQuality::BUILDING`];
+    /// `None`: every building-scale vertical piece is a wall).
     pub wall_quality: Option<WallQuality>,
 }
 
-/// A facade test for wall pieces that already pass the size limits, for sensors whose lowest
-/// obstacles (parked cars, hedges, fences) are otherwise kept as walls.
+/// A facade test for wall pieces that already pass the size limits, so that parked cars,
+/// hedges, fences and vegetation are not kept as walls.
 ///
 /// Reasoning: on a Velodyne HDL-64E (KITTI: vertical field of view about +2° to −24.8°,
 /// mounted 1.73 m above the road) a wall is seen only up to `1.73 m + r·tan 2°` at range `r`,
 /// so the visible height of a building at 10-30 m is just 2-3 m and height alone cannot tell
-/// it from a hedge. Two things can: a building rises above the sensor (cars and most hedges
-/// and fences do not), and a facade is flat, while vegetation fills the whole inlier band
-/// (a uniform band of half-width `τ` has an RMS of `τ/√3`, 0.115 m at the 0.2 m ceiling).
+/// it from a hedge. Three things can:
+/// - a building rises above the sensor (cars and most hedges and fences do not);
+/// - a facade is flat, while vegetation fills the whole inlier band (a uniform band of
+///   half-width `τ` has an RMS of `τ/√3`, 0.115 m at the 0.2 m threshold ceiling);
+/// - a facade is plumb: its normal is perpendicular to the local vertical (the ground plane's
+///   normal), up to the slope of the road the ground was fitted to. The fitted plane of a hedge,
+///   a tree row or a car side leans by several degrees, and leans differently from scan to
+///   scan, which is what makes such "walls" unrepeatable.
 #[derive(Clone, Debug, PartialEq)]
 pub struct WallQuality {
     /// The patch's top must be at least this high above the sensor's horizontal plane
@@ -73,14 +78,19 @@ pub struct WallQuality {
     pub min_top_above_sensor: f64,
     /// Largest RMS point-to-plane distance of the piece (m).
     pub max_rms: f64,
+    /// Largest angle between the piece's plane and the local vertical (rad): the normal's
+    /// elevation above the ground plane (or, without a ground, above the sensor's x-y plane).
+    pub max_lean: f64,
 }
 
 impl WallQuality {
     /// Building scale on a roof-mounted automotive lidar: the top above the sensor, RMS at
-    /// most 0.06 m (about half the RMS of a thick band at the default threshold ceiling).
+    /// most 0.08 m (below the 0.115 m of a band filling the threshold ceiling), and at most
+    /// 5° from plumb relative to the ground (admits streets of up to about 9 % grade).
     pub const BUILDING: WallQuality = WallQuality {
         min_top_above_sensor: 0.0,
-        max_rms: 0.06,
+        max_rms: 0.08,
+        max_lean: 5.0 * std::f64::consts::PI / 180.0,
     };
 }
 
@@ -107,19 +117,23 @@ impl Default for PlaneConfig {
             min_wall_height: 2.0,
             grid_cell: 1.0,
             min_cell_points: 3,
-            wall_quality: None,
+            wall_quality: Some(WallQuality::BUILDING),
         }
     }
 }
 
 impl PlaneConfig {
-    /// The default configuration with the facade test [`WallQuality::BUILDING`]: walls must
-    /// rise above the sensor and be flat. Stricter than the default, which keeps every
-    /// building-scale vertical piece (on KITTI frames without close facades that is mostly
-    /// hedges, fences and vegetation).
+    /// The default configuration, whose facade test is [`WallQuality::BUILDING`]: walls must
+    /// rise above the sensor, be flat and be plumb.
     pub fn building_scale() -> Self {
+        PlaneConfig::default()
+    }
+
+    /// The default configuration without the facade test: every building-scale vertical piece
+    /// is a wall (hedges, fences and large vehicles included).
+    pub fn any_vertical() -> Self {
         PlaneConfig {
-            wall_quality: Some(WallQuality::BUILDING),
+            wall_quality: None,
             ..Default::default()
         }
     }
@@ -159,10 +173,11 @@ impl PlaneConfig {
             }
         }
         if let Some(q) = &self.wall_quality {
-            if !(q.min_top_above_sensor.is_finite() && q.max_rms > 0.0) {
+            if !(q.min_top_above_sensor.is_finite() && q.max_rms > 0.0 && q.max_lean >= 0.0) {
                 return Err(Error::invalid(
                     "plane config field wall_quality",
-                    "min_top_above_sensor must be finite and max_rms positive",
+                    "min_top_above_sensor must be finite, max_rms positive and max_lean \
+                     non-negative",
                 ));
             }
         }

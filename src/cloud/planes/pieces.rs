@@ -19,7 +19,7 @@ pub(super) fn rms(plane: &Plane, idx: &[u32], pts: &[[f32; 3]]) -> f64 {
     (s / idx.len() as f64).sqrt()
 }
 
-fn point64(p: [f32; 3]) -> Point3<f64> {
+pub(super) fn point64(p: [f32; 3]) -> Point3<f64> {
     Point3::new(p[0] as f64, p[1] as f64, p[2] as f64)
 }
 
