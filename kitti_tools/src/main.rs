@@ -7,6 +7,7 @@ mod demo_cmd;
 mod detections_cmd;
 mod eval_cmd;
 mod info_cmd;
+mod paper_tables;
 mod planes_cmd;
 mod synth_cmd;
 mod track_cmd;

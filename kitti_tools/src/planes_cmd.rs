@@ -2,6 +2,7 @@
 //! one frame ahead and print the errors the way seed 001 reports them (areas, vertex
 //! distances, normal angle, prediction time).
 
+use crate::paper_tables;
 use anyhow::{bail, Context, Result};
 use smc_lmb::kitti::{OdometrySequence, RawDrive};
 use smc_lmb::metrics::{PlanePairError, PlanePredictionSummary};
@@ -40,6 +41,10 @@ pub struct Args {
     /// Print one JSON object instead of a table.
     #[arg(long)]
     json: bool,
+    /// Print frame K's pairs as seed 001's Tables 1–3 / 4–6, with the paper's values beside
+    /// ours on its drive (2011_09_26 drive 0005) at K = 11 and K = 124.
+    #[arg(long, conflicts_with_all = ["all", "json"])]
+    paper: bool,
 }
 
 /// Runs the command.
@@ -54,6 +59,11 @@ pub fn run(args: Args) -> Result<()> {
         Some(args.frame..args.frame + 1)
     };
     let mut rng = smc_lmb::rng::seeded(args.seed);
+    let source = match (&args.drive, &args.odometry, args.sequence) {
+        (Some(dir), _, _) => dir.display().to_string(),
+        (None, Some(root), Some(n)) => format!("{} sequence {n:04}", root.display()),
+        _ => String::new(),
+    };
     let results: Vec<PairPrediction> = match (&args.drive, &args.odometry) {
         (Some(dir), _) => {
             let drive =
@@ -82,6 +92,12 @@ pub fn run(args: Args) -> Result<()> {
         }
         (None, None) => bail!("give --drive DIR or --odometry ROOT --sequence NN"),
     };
+    if args.paper {
+        for r in &results {
+            paper_tables::print(r, args.runs, paper_tables::reference_for(&source, r.frame));
+        }
+        return Ok(());
+    }
     let (pairs, summary) = pairs_and_summary(&results);
     if args.json {
         let out = serde_json::json!({

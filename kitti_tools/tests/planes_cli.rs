@@ -1,0 +1,105 @@
+//! `kitti-tools planes --paper`: seed 001's tables for one frame pair, on a simulated drive
+//! (our pairs only) and on the paper's own drive at k = 11 (the paper's values beside ours).
+
+mod common;
+use common::{ok, output as run};
+use std::path::PathBuf;
+
+/// `../shared/data/REL` when present. Under `CI=true` a missing folder fails the test;
+/// elsewhere the test is skipped with a note on the terminal.
+fn shared_data(rel: &str) -> Option<PathBuf> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/data")
+        .join(rel);
+    if dir.exists() {
+        return Some(dir);
+    }
+    if std::env::var("CI").is_ok_and(|v| v == "true") {
+        panic!(
+            "CI=true but the shared data folder {} is missing",
+            dir.display()
+        );
+    }
+    eprintln!("SKIPPED: {} is missing", dir.display());
+    None
+}
+
+#[test]
+fn paper_tables_on_a_simulated_drive() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    ok(&run(&[
+        "synth",
+        "--out",
+        out.to_str().unwrap(),
+        "--frames",
+        "3",
+        "--seed",
+        "2",
+        "--quiet",
+    ]));
+    let drive = out.join("2020_01_01/2020_01_01_drive_0001_sync");
+    let text = ok(&run(&[
+        "planes",
+        "--drive",
+        drive.to_str().unwrap(),
+        "--frame",
+        "1",
+        "--runs",
+        "5",
+        "--paper",
+    ]));
+    for needle in [
+        "Table 1. Areas of the predicted and segmented planes for k = 2, mean of 5 runs",
+        "Table 2. Distances between each pair of plane vertexes",
+        "Table 3. Angles between each pair of normal vectors",
+        "Plane Pair 1",
+        "Vertex Pair 4",
+        "Execution time of the prediction",
+    ] {
+        assert!(text.contains(needle), "missing `{needle}` in\n{text}");
+    }
+    assert!(
+        !text.contains("paper"),
+        "no reference on a simulated drive:\n{text}"
+    );
+    // --paper is one frame pair's report: not with --all or --json.
+    let refused = run(&[
+        "planes",
+        "--drive",
+        drive.to_str().unwrap(),
+        "--all",
+        "--paper",
+    ]);
+    assert!(!refused.status.success());
+}
+
+#[test]
+fn paper_tables_on_the_papers_drive_find_its_three_walls() {
+    let Some(drive) = shared_data("kitti_raw/2011_09_26/2011_09_26_drive_0005_sync") else {
+        return;
+    };
+    let text = ok(&run(&[
+        "planes",
+        "--drive",
+        drive.to_str().unwrap(),
+        "--frame",
+        "11",
+        "--runs",
+        "20",
+        "--paper",
+    ]));
+    assert!(
+        text.contains("Table 4. Areas of the predicted and segmented planes for k = 12"),
+        "{text}"
+    );
+    assert!(text.contains("(ours | paper)"), "{text}");
+    // The paper's values are printed beside ours: its third pair's segmented area and its
+    // second pair's angle.
+    assert!(text.contains("| 90.5685"), "{text}");
+    assert!(text.contains("| 6.4916"), "{text}");
+    assert!(
+        text.contains("3 of the paper's 3 walls found and paired"),
+        "{text}"
+    );
+}
