@@ -95,12 +95,21 @@ fn is_facade(cloud_path: &Path, w: &PlaneDetection, ground: &Vector3<f64>) -> bo
         .iter()
         .map(|&i| {
             let i = i as usize;
-            let p = Point3::new(cloud.xs()[i] as f64, cloud.ys()[i] as f64, cloud.zs()[i] as f64);
+            let p = Point3::new(
+                cloud.xs()[i] as f64,
+                cloud.ys()[i] as f64,
+                cloud.zs()[i] as f64,
+            );
             plane.signed_distance(&p).powi(2)
         })
         .sum();
     let rms = (sq / w.inliers.len() as f64).sqrt();
-    let top = w.patch.vertices.iter().map(|v| v.z).fold(f64::MIN, f64::max);
+    let top = w
+        .patch
+        .vertices
+        .iter()
+        .map(|v| v.z)
+        .fold(f64::MIN, f64::max);
     let lean = plane.normal.dot(ground).abs().asin();
     rms <= 0.08 && top >= 0.0 && lean <= 5f64.to_radians()
 }

@@ -188,38 +188,36 @@ pub fn extract_planes(
         if active.len() < config.min_points {
             break;
         }
-        // Once a ground plane is out, the search is for walls: hypotheses are drawn only from
-        // points clearly above that plane and only near-vertical ones are kept.
-        let pool: Vec<u32> = match &first_ground {
-            Some(g) => active
-                .iter()
-                .copied()
-                .filter(|&i| g.residual_signed(&pts[i as usize]) > config.ground_clearance as f32)
-                .collect(),
-            None => active.clone(),
-        };
+        // Once a ground plane is out, the search is for walls among the points clearly above
+        // it (`active` was cut down to them when the ground came out): hypotheses are drawn
+        // from them and only near-vertical ones are kept. Their inliers come from the same
+        // points: a wall's foot on the road would otherwise pull its fit towards the ground
+        // on the visible side only.
         let min_tilt = if first_ground.is_some() {
             std::f64::consts::FRAC_PI_2 - config.max_wall_tilt
         } else {
             0.0
         };
-        if pool.len() < config.min_points {
-            break;
-        }
-        // Wall inliers come from the same points as the hypotheses: a wall's foot on the road
-        // would otherwise pull its fit towards the ground on the visible side only.
-        let candidates = if first_ground.is_some() { &pool } else { &active };
-        let Some((plane, inliers)) = one_round(&pts, candidates, &pool, min_tilt, config, rng) else {
+        let Some((plane, inliers)) = one_round(&pts, &active, &active, min_tilt, config, rng)
+        else {
             break;
         };
+        // `inliers` is a subsequence of `active`: remove it in one merge walk.
+        let mut next = inliers.iter().peekable();
+        active.retain(|i| {
+            if next.peek() == Some(&i) {
+                next.next();
+                false
+            } else {
+                true
+            }
+        });
         if first_ground.is_none() && ground_like(&plane) {
-            first_ground = Some(PlaneF32::new(&plane));
+            let g = PlaneF32::new(&plane);
+            let clearance = config.ground_clearance as f32;
+            active.retain(|&i| g.residual_signed(&pts[i as usize]) > clearance);
+            first_ground = Some(g);
         }
-        let mut is_inlier = vec![false; pts.len()];
-        for &i in &inliers {
-            is_inlier[i as usize] = true;
-        }
-        active.retain(|&i| !is_inlier[i as usize]);
         extracted.push((plane, inliers));
     }
 
