@@ -155,6 +155,19 @@ pub fn print_summary(tracks: &DriveTracks) {
         t.filter_ms,
         t.read_ms + t.planes_ms + t.clusters_ms + t.filter_ms
     );
+    let pairs = smc_lmb::pipeline::drive_tracking::tracked_wall_pairs(tracks);
+    if !pairs.is_empty() {
+        let w = smc_lmb::metrics::PlanePredictionSummary::from_pairs(&pairs, &[]);
+        println!(
+            "tracked walls frame to frame: {} pairs, normal angle median {:.3}° p90 {:.3}°, \
+             vertex distance median {:.3} m p90 {:.3} m",
+            w.pairs,
+            w.median_normal_angle_deg,
+            w.p90_normal_angle_deg,
+            w.median_vertex_distance_m,
+            w.p90_vertex_distance_m
+        );
+    }
 }
 
 #[cfg(test)]

@@ -22,6 +22,7 @@ pub mod detect;
 pub mod export;
 pub mod mixed;
 pub mod output;
+pub mod repeatability;
 pub mod tracker;
 
 pub use detect::{detect_objects, ClusterDetection, FrameDetections, WallDetection};
@@ -31,6 +32,7 @@ pub use export::point_labels;
 pub use output::{
     DriveTracks, StageTimes, TrackedCluster, TrackedFrame, TrackedPlane, TrackingSummary,
 };
+pub use repeatability::tracked_wall_pairs;
 pub use tracker::DriveTracker;
 
 use crate::cloud::planes::PlaneConfig;
