@@ -278,3 +278,41 @@ fn broken_sequences_fail_naming_file_and_line() {
         &["label_02/0000.txt:4: line: 16 values, expected 17"],
     );
 }
+
+#[test]
+fn pipelines_run_on_the_tracking_layout_as_on_the_raw_drive() {
+    use smc_lmb::pipeline::{
+        predict_drive_pairs, predict_tracking_pairs, track_tracking_sequence,
+        PlanePredictionConfig, TrackingConfig,
+    };
+    let Some(s) = shared() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    assemble(&s, tmp.path(), FRAMES);
+    let seq = TrackingSequence::open(tmp.path(), 0).unwrap();
+    let drive = RawDrive::open(&s.drive).unwrap();
+    // Measured poses: the same poses and scans give the same plane-prediction errors.
+    let config = PlanePredictionConfig {
+        use_vehicle_model: false,
+        ..PlanePredictionConfig::default()
+    };
+    let mut rng = smc_lmb::rng::seeded(3);
+    let a = predict_tracking_pairs(&seq, Some(11..12), &config, 2, &mut rng).unwrap();
+    let mut rng = smc_lmb::rng::seeded(3);
+    let b = predict_drive_pairs(&drive, Some(11..12), &config, 2, &mut rng).unwrap();
+    assert_eq!(a.len(), 1);
+    assert_eq!(a[0].pairs, b[0].pairs);
+    assert_eq!(
+        (a[0].predicted, a[0].segmented),
+        (b[0].predicted, b[0].segmented)
+    );
+    let mut c = TrackingConfig::default();
+    c.filter.particles = 100;
+    let tracks = track_tracking_sequence(&seq, Some(0..3), &c, 1, |_| Ok(())).unwrap();
+    assert_eq!(tracks.drive, "tracking_0000");
+    assert_eq!(tracks.ego, "oxts");
+    assert_eq!(tracks.frames.len(), 3);
+    let err = track_tracking_sequence(&seq, Some(40..60), &c, 1, |_| Ok(()))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("beyond its 50 frames"), "{err}");
+}

@@ -1,7 +1,7 @@
 //! Scores the output of a drive's tracking run ([`DriveTracks`]) against ground truth: the
 //! cluster tracks by OSPA and GOSPA (per frame and averaged) and label switches, against the
-//! objects of a simulated street ([`StreetTruth`]) or the tracklets of a KITTI raw drive
-//! ([`Tracklets`]); the wall tracks of a simulated street by the angle between their normals
+//! objects of a simulated street ([`StreetTruth`]), the tracklets of a KITTI raw drive
+//! ([`Tracklets`]) or the labels of a KITTI tracking sequence ([`TrackingLabel`]); the wall tracks of a simulated street by the angle between their normals
 //! and the truth wall's and the distance of their centres from its plane.
 //!
 //! Distances are horizontal (x, y of the world frame): a cluster's centroid is the mean of the
@@ -15,7 +15,7 @@
 
 use super::drive_tracking::DriveTracks;
 use crate::error::{Error, Result};
-use crate::kitti::Tracklets;
+use crate::kitti::{TrackingLabel, Tracklets};
 use crate::metrics::{gospa, ospa, percentile, LabelConsistency, LabelStats};
 use crate::sim::street::StreetTruth;
 use nalgebra::{Isometry3, Point3, Vector3};
@@ -80,6 +80,37 @@ pub fn tracklet_truth(tracklets: &Tracklets, poses: &[Isometry3<f64>]) -> TruthF
                 .collect()
         })
         .collect()
+}
+
+/// The objects of KITTI tracking labels (`label_02`, `DontCare` regions left out), per frame,
+/// moved into the Velodyne frame with `rect_from_velo` (the sequence's
+/// [`TrackingCalib::rect_from_velo`](crate::kitti::TrackingCalib::rect_from_velo)) and then
+/// into the world frame of the tracking output with the sequence's Velodyne poses (one per
+/// frame). An object counts only within `max_range` (horizontally) of the sensor. The labels
+/// cover the front camera's view only, so tracks of objects beside or behind the vehicle count
+/// as false. Frames beyond the poses are left out; the identity is the track id.
+pub fn label_truth(
+    labels: &[TrackingLabel],
+    rect_from_velo: &Isometry3<f64>,
+    poses: &[Isometry3<f64>],
+    max_range: f64,
+) -> TruthFrames {
+    let mut frames: TruthFrames = vec![Vec::new(); poses.len()];
+    for l in labels.iter().filter(|l| l.is_object()) {
+        if l.frame >= poses.len() || l.track_id < 0 {
+            continue;
+        }
+        let b = l.to_velodyne(rect_from_velo);
+        if b.center.x.hypot(b.center.y) > max_range {
+            continue;
+        }
+        let c = poses[l.frame] * b.center;
+        frames[l.frame].push(TruthObject {
+            id: l.track_id as u64,
+            position: [c.x, c.y],
+        });
+    }
+    frames
 }
 
 /// OSPA / GOSPA settings.
