@@ -8,10 +8,9 @@
 //! ROOT/label_02/NNNN.txt       the truth as tracking labels (street_labels)
 //! ```
 //!
-//! The frames must be [`FRAME_PERIOD`](crate::kitti::tracking::FRAME_PERIOD) apart (the layout
-//! keeps no time stamps). The scan folder is filled under a hidden temporary name and renamed
-//! into place when complete; a sequence whose scan folder, OXTS, calibration or label file
-//! already exists is never overwritten.
+//! The frames must be [`FRAME_PERIOD`] apart (the layout keeps no time stamps). The scan folder
+//! is filled under a hidden temporary name and renamed into place when complete; a sequence
+//! whose scan folder, OXTS, calibration or label file already exists is never overwritten.
 //!
 //! Not for: the raw layout (see [`super::writer`]) or simulating (see
 //! [`super::StreetSimulator`]).
