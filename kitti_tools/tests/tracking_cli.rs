@@ -107,6 +107,9 @@ fn synth_info_planes_track_eval_on_a_tracking_sequence() {
         r,
         "--sequence",
         "5",
+        "--planes",
+        "--runs",
+        "2",
         "--json",
     ]));
     let eval: serde_json::Value = serde_json::from_str(&eval).unwrap();
@@ -122,6 +125,10 @@ fn synth_info_planes_track_eval_on_a_tracking_sequence() {
         late["missed"].as_u64().unwrap(),
     );
     assert!(missed * 2 < truth, "{late}");
+    assert!(
+        eval["plane_prediction"]["pairs"].as_u64().unwrap() > 0,
+        "{eval}"
+    );
 }
 
 #[test]

@@ -313,3 +313,44 @@ pub fn evaluate_walls(tracks: &DriveTracks, truth: &StreetTruth) -> Result<WallE
         walls_matched: walls.len(),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kitti::{ObjectType, TrackingLabel};
+    use nalgebra::{Matrix3, Translation3, UnitQuaternion};
+    use std::path::Path;
+
+    #[test]
+    fn label_truth_by_hand() {
+        // The ideal rig without offsets: velo x → cam z, velo y → cam −x, velo z → cam −y.
+        let r = Matrix3::new(0.0, -1.0, 0.0, 0.0, 0.0, -1.0, 1.0, 0.0, 0.0);
+        let rect_from_velo =
+            Isometry3::from_parts(Translation3::identity(), UnitQuaternion::from_matrix(&r));
+        let line = "1 4 Cyclist 0 0 0 0 0 10 10 1.8 0.6 1.7 -2 1.7 12 0";
+        let cyclist = TrackingLabel::parse_line(line, Path::new("l.txt"), 1).unwrap();
+        let mut far = cyclist;
+        far.track_id = 5;
+        far.location = [0.0, 1.7, 50.0];
+        let mut region = cyclist;
+        region.object_type = ObjectType::DontCare;
+        region.track_id = -1;
+        // Frame 1's sensor is 3 m ahead of frame 0's, turned by 90° to the left.
+        let poses = [
+            Isometry3::identity(),
+            Isometry3::from_parts(
+                Translation3::new(3.0, 0.0, 0.0),
+                UnitQuaternion::from_euler_angles(0.0, 0.0, std::f64::consts::FRAC_PI_2),
+            ),
+        ];
+        let frames = label_truth(&[cyclist, far, region], &rect_from_velo, &poses, 40.0);
+        assert_eq!(frames.len(), 2);
+        assert!(frames[0].is_empty());
+        assert_eq!(frames[1].len(), 1, "{frames:?}");
+        // Velodyne (12, 2, ·) of frame 1 → world (3 − 2, 12).
+        let o = frames[1][0];
+        assert_eq!(o.id, 4);
+        assert!((o.position[0] - 1.0).abs() < 1e-12, "{o:?}");
+        assert!((o.position[1] - 12.0).abs() < 1e-12, "{o:?}");
+    }
+}
