@@ -210,6 +210,10 @@ fn broken_sequences_fail_naming_file_and_line() {
         seq.imu_poses().unwrap_err(),
         &["oxts/0000.txt:3: packet: missing: 2 packets for the 3 scans"],
     );
+    assert_eq!(seq.oxts_count(), 2);
+    assert!(seq.check().iter().any(
+        |i| matches!(i, Issue::CountMismatch { a_count: 3, b_count: 2, b, .. } if b.ends_with("oxts/0000.txt"))
+    ));
     // More packets than scans: the first extra one's line.
     std::fs::write(&oxts, &full).unwrap();
     assert_error(

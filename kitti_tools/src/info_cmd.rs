@@ -152,7 +152,7 @@ fn tracking_report(seq: &TrackingSequence) -> Report {
         drive: seq.root().display().to_string(),
         name: format!("tracking sequence {}", seq.name()),
         velodyne_frames: seq.velodyne_count(),
-        oxts_packets: seq.oxts().map_or(0, |p| p.len()),
+        oxts_packets: seq.oxts_count(),
         time_span,
         calibration,
         pose_frame,

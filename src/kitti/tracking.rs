@@ -279,13 +279,19 @@ impl TrackingSequence {
         self.velodyne.as_ref().map_or(0, Vec::len)
     }
 
+    /// Number of packets in `oxts/NNNN.txt`, whatever the number of scans (0 when the file is
+    /// missing or does not parse).
+    pub fn oxts_count(&self) -> usize {
+        self.read_packets().map_or(0, |p| p.len())
+    }
+
     /// Number of frames: the scans when `velodyne/NNNN` exists, otherwise the OXTS packets
     /// (0 when neither can be read).
     pub fn frame_count(&self) -> usize {
         if self.has_velodyne() {
             self.velodyne_count()
         } else {
-            self.read_packets().map_or(0, |p| p.len())
+            self.oxts_count()
         }
     }
 
