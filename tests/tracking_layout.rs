@@ -146,7 +146,7 @@ fn labels_of_sequence_0000_hold_lidar_points() {
             let expected = -l.rotation_y - std::f64::consts::FRAC_PI_2;
             let off = smc_lmb::geometry::wrap_angle(b.yaw - expected).abs();
             assert!(
-                off < 0.02,
+                off < 1e-3,
                 "frame {k} track {}: yaw off by {off}",
                 l.track_id
             );

@@ -271,7 +271,7 @@ impl TrackingLabel {
     /// camera-0 coordinates (`R_rect·Tr_velo_cam`). The centre is the bottom-face centre
     /// raised by h/2 along the camera's −y axis; the yaw is the heading of the box's length
     /// axis, R·(cos ry, 0, −sin ry) with R the calibration's rotation, about the Velodyne z
-    /// axis — for KITTI's calibration within a few mrad of −rotation_y − π/2.
+    /// axis — for KITTI's calibration within 1 mrad of −rotation_y − π/2.
     pub fn to_velodyne(&self, rect_from_velo: &Isometry3<f64>) -> VelodyneBox {
         let [h, w, l] = self.dimensions;
         let [x, y, z] = self.location;
