@@ -141,6 +141,18 @@ impl TrackingCalib {
         self.rect_from_velo().inverse()
     }
 
+    /// Velodyne → rectified camera 2: rectified camera 0 shifted by camera 2's offset read off
+    /// `P2 = K·[I | t]` (t = (P2₀₃ − c_x·t_z, P2₁₃ − c_y·t_z)/f, t_z = P2₂₃ with K's focal
+    /// lengths f and centre c), so that P2·p_rect = K·p_cam2.
+    pub fn cam2_rect_from_velo(&self) -> Isometry3<f64> {
+        let p = &self.projections[2];
+        let tz = p[(2, 3)];
+        let tx = (p[(0, 3)] - p[(0, 2)] * tz) / p[(0, 0)];
+        let ty = (p[(1, 3)] - p[(1, 2)] * tz) / p[(1, 1)];
+        Isometry3::from_parts(Translation3::new(tx, ty, tz), UnitQuaternion::identity())
+            * self.rect_from_velo()
+    }
+
     /// The pixel of camera 2 (the labels' image) at which a Velodyne point appears,
     /// P2·R_rect·Tr_velo_cam·p; `None` for a point not in front of the camera.
     pub fn project_to_image2(&self, p_velo: &Point3<f64>) -> Option<[f64; 2]> {
@@ -561,6 +573,17 @@ Tr_imu_velo 9.999976000000e-01 7.553071000000e-04 -2.035826000000e-03 -8.0867590
         let uv = c.project_to_image2(&Point3::new(10.0, 0.0, 0.0)).unwrap();
         assert!((uv[0] - 620.0).abs() < 30.0, "{uv:?}");
         assert!(c.project_to_image2(&Point3::new(-10.0, 0.0, 0.0)).is_none());
+        // Camera 2 sits about 6 cm left of camera 0 (t_x ≈ +0.06 m in its coordinates), and
+        // its intrinsics applied to cam2 coordinates give P2's pixel.
+        let c2 = c.cam2_rect_from_velo() * Point3::new(10.0, 0.0, 0.0);
+        assert!((c2.x - q.x - 0.06).abs() < 0.005, "{c2} {q}");
+        let (f, cx, cy) = (
+            c.projections[2][(0, 0)],
+            c.projections[2][(0, 2)],
+            c.projections[2][(1, 2)],
+        );
+        assert!((f * c2.x / c2.z + cx - uv[0]).abs() < 1e-9);
+        assert!((f * c2.y / c2.z + cy - uv[1]).abs() < 1e-9);
         let back = c.velo_from_rect() * q;
         assert!((back - Point3::new(10.0, 0.0, 0.0)).norm() < 1e-12);
         // Written and read back: the same transforms.
