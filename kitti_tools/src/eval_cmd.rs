@@ -67,7 +67,8 @@ pub struct Args {
 
 enum Truth {
     Street(Box<StreetTruth>),
-    Tracklets(TruthFrames),
+    /// Objects per frame only (KITTI tracklets or tracking labels): no walls.
+    Objects(TruthFrames),
 }
 
 /// The tracking sequence of `--tracking` / `--sequence`, if given.
@@ -89,7 +90,7 @@ fn label_02_truth(seq: &TrackingSequence, what: &str, max_range: f64) -> Result<
         .calib()
         .with_context(|| format!("reading the calibration of {what}"))?;
     let poses = seq.poses().with_context(|| format!("poses of {what}"))?;
-    Ok(Truth::Tracklets(label_truth(
+    Ok(Truth::Objects(label_truth(
         &labels,
         &calib.rect_from_velo(),
         &poses,
@@ -116,7 +117,7 @@ fn load_truth(args: &Args) -> Result<Truth> {
             .poses()
             .with_context(|| format!("poses of drive {}", dir.display()))?;
         let t = read_tracklets(p).with_context(|| format!("reading tracklets {}", p.display()))?;
-        Ok(Truth::Tracklets(tracklet_truth(&t, &poses)))
+        Ok(Truth::Objects(tracklet_truth(&t, &poses)))
     };
     match (&args.truth, &args.tracklets, &args.drive) {
         (Some(_), Some(_), _) => bail!("give --truth or --tracklets, not both"),
@@ -185,7 +186,7 @@ pub fn run(args: Args) -> Result<()> {
             street_object_truth(t, args.min_points, args.max_range),
             Some(evaluate_walls(&tracks, t)?),
         ),
-        Truth::Tracklets(f) => (f.clone(), None),
+        Truth::Objects(f) => (f.clone(), None),
     };
     let clusters = evaluate_clusters(&tracks, &frames, &config)
         .with_context(|| format!("scoring {}", args.tracks.display()))?;
