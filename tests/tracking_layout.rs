@@ -136,9 +136,7 @@ fn labels_of_sequence_0000_hold_lidar_points() {
             b.center.z += 0.15;
             b.size[2] -= 0.3;
             let range = b.center.coords.xy().norm();
-            let in_view = calib
-                .project_to_image2(&b.center)
-                .is_some_and(|[u, v]| (0.0..1242.0).contains(&u) && (0.0..375.0).contains(&v));
+            let in_view = calib.in_image2(&b.center);
             if range > 30.0 || !in_view {
                 continue;
             }

@@ -8,8 +8,9 @@ use anyhow::{bail, Context, Result};
 use smc_lmb::kitti::{read_tracklets, RawDrive, TrackingSequence};
 use smc_lmb::metrics::PlanePredictionSummary;
 use smc_lmb::pipeline::drive_evaluation::{
-    evaluate_clusters, evaluate_walls, label_truth, street_object_truth, tracklet_truth,
-    ClusterEvaluation, ClusterEvaluationConfig, FrameScore, TruthFrames, WallEvaluation,
+    evaluate_clusters, evaluate_walls, label_truth, retain_clusters, street_object_truth,
+    tracklet_truth, ClusterEvaluation, ClusterEvaluationConfig, FrameScore, TruthFrames,
+    WallEvaluation,
 };
 use smc_lmb::pipeline::{
     predict_drive_pairs, predict_tracking_pairs, DriveTracks, PlanePredictionConfig,
@@ -34,6 +35,10 @@ pub struct Args {
     /// Tracking sequence number.
     #[arg(long)]
     sequence: Option<u32>,
+    /// With `--tracking`: score only what camera 2 sees — labelled objects and cluster tracks
+    /// whose centre appears in its image — as KITTI labels only that view.
+    #[arg(long, requires = "tracking")]
+    camera_view: bool,
     /// A simulated street's `truth.json`.
     #[arg(long)]
     truth: Option<PathBuf>,
@@ -81,8 +86,14 @@ fn tracking_sequence(args: &Args) -> Result<Option<(TrackingSequence, String)>> 
     Ok(Some((seq, what)))
 }
 
-/// The objects of a tracking sequence's `label_02` file in the world frame of its poses.
-fn label_02_truth(seq: &TrackingSequence, what: &str, max_range: f64) -> Result<Truth> {
+/// The objects of a tracking sequence's `label_02` file in the world frame of its poses,
+/// within `max_range` and, with `camera_view`, in camera 2's image.
+fn label_02_truth(
+    seq: &TrackingSequence,
+    what: &str,
+    max_range: f64,
+    camera_view: bool,
+) -> Result<Truth> {
     let labels = seq
         .labels()
         .with_context(|| format!("reading the labels of {what}"))?;
@@ -94,13 +105,16 @@ fn label_02_truth(seq: &TrackingSequence, what: &str, max_range: f64) -> Result<
         &labels,
         &calib.rect_from_velo(),
         &poses,
-        max_range,
+        |b| {
+            b.center.x.hypot(b.center.y) <= max_range
+                && (!camera_view || calib.in_image2(&b.center))
+        },
     )))
 }
 
 fn load_truth(args: &Args) -> Result<Truth> {
     if let Some((seq, what)) = tracking_sequence(args)? {
-        return label_02_truth(&seq, &what, args.max_range);
+        return label_02_truth(&seq, &what, args.max_range, args.camera_view);
     }
     let street = |p: &Path| -> Result<Truth> {
         Ok(Truth::Street(Box::new(StreetTruth::read(p).with_context(
@@ -174,8 +188,18 @@ fn plane_statistics(args: &Args) -> Result<Option<PlanePredictionSummary>> {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    let tracks = DriveTracks::read_json(&args.tracks)
+    let mut tracks = DriveTracks::read_json(&args.tracks)
         .with_context(|| format!("reading tracks {}", args.tracks.display()))?;
+    if args.camera_view {
+        if let Some((seq, what)) = tracking_sequence(&args)? {
+            let calib = seq
+                .calib()
+                .with_context(|| format!("reading the calibration of {what}"))?;
+            retain_clusters(&mut tracks, |p| {
+                calib.in_image2(&nalgebra::Point3::new(p[0], p[1], p[2]))
+            });
+        }
+    }
     let truth = load_truth(&args)?;
     let config = ClusterEvaluationConfig {
         cutoff: args.cutoff,

@@ -129,6 +129,32 @@ fn synth_info_planes_track_eval_on_a_tracking_sequence() {
         eval["plane_prediction"]["pairs"].as_u64().unwrap() > 0,
         "{eval}"
     );
+
+    // Only what camera 2 sees: fewer labelled objects and fewer tracks, none of them new.
+    let front = ok(&common::output(&[
+        "eval",
+        "--tracks",
+        t,
+        "--tracking",
+        r,
+        "--sequence",
+        "5",
+        "--camera-view",
+        "--json",
+    ]));
+    let front: serde_json::Value = serde_json::from_str(&front).unwrap();
+    let sum = |v: &serde_json::Value, key: &str| -> u64 {
+        v["clusters"]["frames"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f[key].as_u64().unwrap())
+            .sum()
+    };
+    for key in ["truth", "estimates"] {
+        let (all, seen) = (sum(&eval, key), sum(&front, key));
+        assert!(0 < seen && seen < all, "{key}: {seen} of {all}");
+    }
 }
 
 #[test]

@@ -54,6 +54,10 @@ pub struct TrackingCalib {
     rect: UnitQuaternion<f64>,
 }
 
+/// Width and height (pixels) of KITTI's rectified camera images; the sequences' images differ
+/// from it by a few pixels at most.
+pub const IMAGE_SIZE: [f64; 2] = [1242.0, 375.0];
+
 /// The accepted spellings of each key, the first being the one in error messages.
 const KEYS_R_RECT: [&str; 2] = ["R_rect", "R0_rect"];
 const KEYS_VELO_CAM: [&str; 2] = ["Tr_velo_cam", "Tr_velo_to_cam"];
@@ -162,6 +166,14 @@ impl TrackingCalib {
         }
         let u = self.projections[2] * q.to_homogeneous();
         (u.z > 0.0).then(|| [u.x / u.z, u.y / u.z])
+    }
+
+    /// Whether a Velodyne point appears inside camera 2's image of [`IMAGE_SIZE`] (in front of
+    /// the camera).
+    pub fn in_image2(&self, p_velo: &Point3<f64>) -> bool {
+        self.project_to_image2(p_velo).is_some_and(|[u, v]| {
+            (0.0..IMAGE_SIZE[0]).contains(&u) && (0.0..IMAGE_SIZE[1]).contains(&v)
+        })
     }
 
     /// The calibration as a file in the tracking layout (keys without colons, 12 significant
@@ -573,6 +585,9 @@ Tr_imu_velo 9.999976000000e-01 7.553071000000e-04 -2.035826000000e-03 -8.0867590
         let uv = c.project_to_image2(&Point3::new(10.0, 0.0, 0.0)).unwrap();
         assert!((uv[0] - 620.0).abs() < 30.0, "{uv:?}");
         assert!(c.project_to_image2(&Point3::new(-10.0, 0.0, 0.0)).is_none());
+        assert!(c.in_image2(&Point3::new(10.0, 0.0, 0.0)));
+        assert!(!c.in_image2(&Point3::new(10.0, 30.0, 0.0)));
+        assert!(!c.in_image2(&Point3::new(-10.0, 0.0, 0.0)));
         // Camera 2 sits about 6 cm left of camera 0 (t_x ≈ +0.06 m in its coordinates), and
         // its intrinsics applied to cam2 coordinates give P2's pixel.
         let c2 = c.cam2_rect_from_velo() * Point3::new(10.0, 0.0, 0.0);

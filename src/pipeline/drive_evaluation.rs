@@ -15,7 +15,7 @@
 
 use super::drive_tracking::DriveTracks;
 use crate::error::{Error, Result};
-use crate::kitti::{TrackingLabel, Tracklets};
+use crate::kitti::{TrackingLabel, Tracklets, VelodyneBox};
 use crate::metrics::{gospa, ospa, percentile, LabelConsistency, LabelStats};
 use crate::sim::street::StreetTruth;
 use nalgebra::{Isometry3, Point3, Vector3};
@@ -86,14 +86,15 @@ pub fn tracklet_truth(tracklets: &Tracklets, poses: &[Isometry3<f64>]) -> TruthF
 /// moved into the Velodyne frame with `rect_from_velo` (the sequence's
 /// [`TrackingCalib::rect_from_velo`](crate::kitti::TrackingCalib::rect_from_velo)) and then
 /// into the world frame of the tracking output with the sequence's Velodyne poses (one per
-/// frame). An object counts only within `max_range` (horizontally) of the sensor. The labels
-/// cover the front camera's view only, so tracks of objects beside or behind the vehicle count
-/// as false. Frames beyond the poses are left out; the identity is the track id.
+/// frame). An object counts only when `keep` accepts its box in the Velodyne frame (a range
+/// limit, the camera's view). KITTI's labels cover the front camera's view only, so tracks of
+/// objects beside or behind the vehicle count as false unless the caller drops them too. Frames
+/// beyond the poses are left out; the identity is the track id.
 pub fn label_truth(
     labels: &[TrackingLabel],
     rect_from_velo: &Isometry3<f64>,
     poses: &[Isometry3<f64>],
-    max_range: f64,
+    keep: impl Fn(&VelodyneBox) -> bool,
 ) -> TruthFrames {
     let mut frames: TruthFrames = vec![Vec::new(); poses.len()];
     for l in labels.iter().filter(|l| l.is_object()) {
@@ -101,7 +102,7 @@ pub fn label_truth(
             continue;
         }
         let b = l.to_velodyne(rect_from_velo);
-        if b.center.x.hypot(b.center.y) > max_range {
+        if !keep(&b) {
             continue;
         }
         let c = poses[l.frame] * b.center;
@@ -111,6 +112,15 @@ pub fn label_truth(
         });
     }
     frames
+}
+
+/// Drops from every frame of `tracks` the cluster tracks that `keep` refuses (given the
+/// position in the sensor frame of that frame), e.g. those outside a camera's view when the
+/// truth covers that view only.
+pub fn retain_clusters(tracks: &mut DriveTracks, keep: impl Fn(&[f64; 3]) -> bool) {
+    for f in &mut tracks.frames {
+        f.clusters.retain(|c| keep(&c.position_sensor));
+    }
 }
 
 /// OSPA / GOSPA settings.
@@ -343,7 +353,9 @@ mod tests {
                 UnitQuaternion::from_euler_angles(0.0, 0.0, std::f64::consts::FRAC_PI_2),
             ),
         ];
-        let frames = label_truth(&[cyclist, far, region], &rect_from_velo, &poses, 40.0);
+        let frames = label_truth(&[cyclist, far, region], &rect_from_velo, &poses, |b| {
+            b.center.x.hypot(b.center.y) <= 40.0
+        });
         assert_eq!(frames.len(), 2);
         assert!(frames[0].is_empty());
         assert_eq!(frames[1].len(), 1, "{frames:?}");

@@ -21,7 +21,7 @@ use crate::cloud::write_kitti_bin;
 use crate::error::{Error, Result};
 use crate::geometry::wrap_angle;
 use crate::kitti::labels::{write_tracking_labels, ObjectType, TrackingLabel, VelodyneBox};
-use crate::kitti::tracking::{TrackingCalib, FRAME_PERIOD};
+use crate::kitti::tracking::{TrackingCalib, FRAME_PERIOD, IMAGE_SIZE as IMAGE};
 use nalgebra::{Point3, Vector3};
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -47,9 +47,6 @@ pub fn object_type(kind: ObjectKind) -> ObjectType {
         ObjectKind::Pedestrian => ObjectType::Pedestrian,
     }
 }
-
-/// Image size of KITTI's rectified camera 2 (pixels).
-const IMAGE: [f64; 2] = [1242.0, 375.0];
 
 /// The objects of `truth` as tracking labels, frame by frame: one label per object and frame
 /// in which at least one lidar point hits it (the point counts come from writing the scans).
