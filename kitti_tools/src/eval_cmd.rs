@@ -1,16 +1,20 @@
 //! `kitti-tools eval`: scores the output of `track` against ground truth — OSPA and GOSPA of
-//! the cluster tracks and their label switches against a simulated street's `truth.json` or a
-//! KITTI drive's `tracklet_labels.xml`, the wall tracks against the street's walls — and, on
-//! request, the drive's plane-prediction statistics.
+//! the cluster tracks and their label switches against a simulated street's `truth.json`, a
+//! KITTI drive's `tracklet_labels.xml` or a KITTI tracking sequence's `label_02` labels, the
+//! wall tracks against the street's walls — and, on request, the recording's plane-prediction
+//! statistics.
 
 use anyhow::{bail, Context, Result};
-use smc_lmb::kitti::{read_tracklets, RawDrive};
+use smc_lmb::kitti::{read_tracklets, RawDrive, TrackingSequence};
 use smc_lmb::metrics::PlanePredictionSummary;
 use smc_lmb::pipeline::drive_evaluation::{
-    evaluate_clusters, evaluate_walls, street_object_truth, tracklet_truth, ClusterEvaluation,
-    ClusterEvaluationConfig, FrameScore, TruthFrames, WallEvaluation,
+    evaluate_clusters, evaluate_walls, label_truth, retain_clusters, street_object_truth,
+    tracklet_truth, ClusterEvaluation, ClusterEvaluationConfig, FrameScore, TruthFrames,
+    WallEvaluation,
 };
-use smc_lmb::pipeline::{predict_drive_pairs, DriveTracks, PlanePredictionConfig};
+use smc_lmb::pipeline::{
+    predict_drive_pairs, predict_tracking_pairs, DriveTracks, PlanePredictionConfig,
+};
 use smc_lmb::sim::street::StreetTruth;
 use std::path::{Path, PathBuf};
 
@@ -22,8 +26,19 @@ pub struct Args {
     tracks: PathBuf,
     /// The drive folder; its `truth.json` (simulated) or `tracklet_labels.xml` (KITTI) is the
     /// truth unless `--truth` or `--tracklets` names one.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "tracking")]
     drive: Option<PathBuf>,
+    /// A KITTI tracking split folder (`.../training`); the sequence's `label_02/NNNN.txt`,
+    /// moved to the Velodyne frame, is the truth. Needs `--sequence`.
+    #[arg(long, requires = "sequence", conflicts_with_all = ["truth", "tracklets"])]
+    tracking: Option<PathBuf>,
+    /// Tracking sequence number.
+    #[arg(long)]
+    sequence: Option<u32>,
+    /// With `--tracking`: score only what camera 2 sees — labelled objects and cluster tracks
+    /// whose centre appears in its image — as KITTI labels only that view.
+    #[arg(long, requires = "tracking")]
+    camera_view: bool,
     /// A simulated street's `truth.json`.
     #[arg(long)]
     truth: Option<PathBuf>,
@@ -33,8 +48,8 @@ pub struct Args {
     /// Simulated objects count in a frame only with at least this many lidar points.
     #[arg(long, default_value_t = 15)]
     min_points: usize,
-    /// Simulated objects count only within this horizontal range of the sensor (m); the
-    /// default is the tracker's default cluster range.
+    /// Simulated and labelled objects count only within this horizontal range of the sensor
+    /// (m); the default is the tracker's default cluster range.
     #[arg(long, default_value_t = 40.0)]
     max_range: f64,
     /// OSPA/GOSPA cut-off c (m).
@@ -44,7 +59,7 @@ pub struct Args {
     #[arg(long, default_value_t = 1.0)]
     order: f64,
     /// Also predict every frame's walls to the next frame (ECT Monte Carlo, `--runs` runs) and
-    /// report the plane-prediction statistics (needs `--drive`).
+    /// report the plane-prediction statistics (needs `--drive` or `--tracking`).
     #[arg(long)]
     planes: bool,
     /// Monte-Carlo runs of `--planes`.
@@ -57,10 +72,50 @@ pub struct Args {
 
 enum Truth {
     Street(Box<StreetTruth>),
-    Tracklets(TruthFrames),
+    /// Objects per frame only (KITTI tracklets or tracking labels): no walls.
+    Objects(TruthFrames),
+}
+
+/// The tracking sequence of `--tracking` / `--sequence`, if given.
+fn tracking_sequence(args: &Args) -> Result<Option<(TrackingSequence, String)>> {
+    let (Some(root), Some(n)) = (&args.tracking, args.sequence) else {
+        return Ok(None);
+    };
+    let what = format!("tracking sequence {n:04} of {}", root.display());
+    let seq = TrackingSequence::open(root, n).with_context(|| format!("opening {what}"))?;
+    Ok(Some((seq, what)))
+}
+
+/// The objects of a tracking sequence's `label_02` file in the world frame of its poses,
+/// within `max_range` and, with `camera_view`, in camera 2's image.
+fn label_02_truth(
+    seq: &TrackingSequence,
+    what: &str,
+    max_range: f64,
+    camera_view: bool,
+) -> Result<Truth> {
+    let labels = seq
+        .labels()
+        .with_context(|| format!("reading the labels of {what}"))?;
+    let calib = seq
+        .calib()
+        .with_context(|| format!("reading the calibration of {what}"))?;
+    let poses = seq.poses().with_context(|| format!("poses of {what}"))?;
+    Ok(Truth::Objects(label_truth(
+        &labels,
+        &calib.rect_from_velo(),
+        &poses,
+        |b| {
+            b.center.x.hypot(b.center.y) <= max_range
+                && (!camera_view || calib.in_image2(&b.center))
+        },
+    )))
 }
 
 fn load_truth(args: &Args) -> Result<Truth> {
+    if let Some((seq, what)) = tracking_sequence(args)? {
+        return label_02_truth(&seq, &what, args.max_range, args.camera_view);
+    }
     let street = |p: &Path| -> Result<Truth> {
         Ok(Truth::Street(Box::new(StreetTruth::read(p).with_context(
             || format!("reading street truth {}", p.display()),
@@ -76,7 +131,7 @@ fn load_truth(args: &Args) -> Result<Truth> {
             .poses()
             .with_context(|| format!("poses of drive {}", dir.display()))?;
         let t = read_tracklets(p).with_context(|| format!("reading tracklets {}", p.display()))?;
-        Ok(Truth::Tracklets(tracklet_truth(&t, &poses)))
+        Ok(Truth::Objects(tracklet_truth(&t, &poses)))
     };
     match (&args.truth, &args.tracklets, &args.drive) {
         (Some(_), Some(_), _) => bail!("give --truth or --tracklets, not both"),
@@ -96,7 +151,7 @@ fn load_truth(args: &Args) -> Result<Truth> {
                 )
             }
         }
-        (None, None, None) => bail!("give --drive, --truth or --tracklets"),
+        (None, None, None) => bail!("give --drive, --truth, --tracklets or --tracking"),
     }
 }
 
@@ -104,11 +159,22 @@ fn plane_statistics(args: &Args) -> Result<Option<PlanePredictionSummary>> {
     if !args.planes {
         return Ok(None);
     }
+    let mut rng = smc_lmb::rng::seeded(1);
+    if let Some((seq, what)) = tracking_sequence(args)? {
+        let results = predict_tracking_pairs(
+            &seq,
+            None,
+            &PlanePredictionConfig::default(),
+            args.runs,
+            &mut rng,
+        )
+        .with_context(|| format!("predicting planes of {what}"))?;
+        return Ok(Some(crate::planes_cmd::pairs_and_summary(&results).1));
+    }
     let Some(dir) = &args.drive else {
-        bail!("--planes needs --drive");
+        bail!("--planes needs --drive or --tracking");
     };
     let drive = RawDrive::open(dir).with_context(|| format!("opening drive {}", dir.display()))?;
-    let mut rng = smc_lmb::rng::seeded(1);
     let results = predict_drive_pairs(
         &drive,
         None,
@@ -122,8 +188,18 @@ fn plane_statistics(args: &Args) -> Result<Option<PlanePredictionSummary>> {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    let tracks = DriveTracks::read_json(&args.tracks)
+    let mut tracks = DriveTracks::read_json(&args.tracks)
         .with_context(|| format!("reading tracks {}", args.tracks.display()))?;
+    if args.camera_view {
+        if let Some((seq, what)) = tracking_sequence(&args)? {
+            let calib = seq
+                .calib()
+                .with_context(|| format!("reading the calibration of {what}"))?;
+            retain_clusters(&mut tracks, |p| {
+                calib.in_image2(&nalgebra::Point3::new(p[0], p[1], p[2]))
+            });
+        }
+    }
     let truth = load_truth(&args)?;
     let config = ClusterEvaluationConfig {
         cutoff: args.cutoff,
@@ -134,7 +210,7 @@ pub fn run(args: Args) -> Result<()> {
             street_object_truth(t, args.min_points, args.max_range),
             Some(evaluate_walls(&tracks, t)?),
         ),
-        Truth::Tracklets(f) => (f.clone(), None),
+        Truth::Objects(f) => (f.clone(), None),
     };
     let clusters = evaluate_clusters(&tracks, &frames, &config)
         .with_context(|| format!("scoring {}", args.tracks.display()))?;

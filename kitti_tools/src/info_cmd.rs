@@ -1,5 +1,6 @@
-//! `kitti-tools info`: what a KITTI raw drive holds (frame counts, time span, calibration,
-//! first and last pose, OXTS path length) and its consistency issues.
+//! `kitti-tools info`: what a KITTI raw drive or tracking sequence holds (frame counts, time
+//! span, calibration, first and last pose, OXTS path length, label counts) and its consistency
+//! issues.
 //!
 //! Severity of issues: a missing sensor folder or missing file only limits what can be done
 //! with the drive and is a warning; everything else (numbering gaps, counts that disagree, time
@@ -9,7 +10,8 @@ use anyhow::{bail, Result};
 use nalgebra::Isometry3;
 use serde::Serialize;
 use smc_lmb::kitti::drive::{CALIB_CAM_TO_CAM, CALIB_IMU_TO_VELO, CALIB_VELO_TO_CAM};
-use smc_lmb::kitti::{Issue, RawDrive, Timestamps};
+use smc_lmb::kitti::tracking::FRAME_PERIOD;
+use smc_lmb::kitti::{Issue, RawDrive, Timestamps, TrackingSequence};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
@@ -17,8 +19,14 @@ use std::path::PathBuf;
 #[derive(clap::Args)]
 pub struct Args {
     /// The drive folder (`.../2011_09_26/2011_09_26_drive_0001_sync`).
+    #[arg(long, conflicts_with = "tracking")]
+    drive: Option<PathBuf>,
+    /// A KITTI tracking split folder (`.../training`); needs `--sequence`.
+    #[arg(long, requires = "sequence")]
+    tracking: Option<PathBuf>,
+    /// Tracking sequence number.
     #[arg(long)]
-    drive: PathBuf,
+    sequence: Option<u32>,
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
@@ -62,6 +70,9 @@ struct Report {
     first_pose: Option<PoseSummary>,
     last_pose: Option<PoseSummary>,
     path_length_m: Option<f64>,
+    /// Tracking sequences: label lines per object type (`label_02`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    labels: Option<BTreeMap<String, usize>>,
     issues: Vec<IssueReport>,
     errors: usize,
 }
@@ -92,6 +103,68 @@ fn summary(pose: &Isometry3<f64>) -> PoseSummary {
     }
 }
 
+fn path_length(poses: &[Isometry3<f64>]) -> f64 {
+    poses
+        .windows(2)
+        .map(|w| (w[1].translation.vector - w[0].translation.vector).norm())
+        .sum()
+}
+
+fn issue_reports(issues: &[Issue]) -> (Vec<IssueReport>, usize) {
+    let reports: Vec<IssueReport> = issues
+        .iter()
+        .map(|i| IssueReport {
+            severity: if is_error(i) { "error" } else { "warning" },
+            path: i.path().display().to_string(),
+            message: i.to_string(),
+        })
+        .collect();
+    let errors = reports.iter().filter(|i| i.severity == "error").count();
+    (reports, errors)
+}
+
+fn tracking_report(seq: &TrackingSequence) -> Report {
+    let frames = seq.frame_count();
+    let time_span = (frames > 0).then(|| TimeSpan {
+        source: "assumed 0.1 s-per-frame",
+        first: "0.000 s".to_string(),
+        last: format!("{:.3} s", (frames - 1) as f64 * FRAME_PERIOD),
+        seconds: (frames - 1) as f64 * FRAME_PERIOD,
+    });
+    let calib_name = format!("calib/{}.txt", seq.name());
+    let calibration = BTreeMap::from([(calib_name, seq.calib_path().is_file())]);
+    let imu = seq.imu_poses().ok();
+    let path_length_m = imu.as_deref().map(path_length);
+    let (pose_frame, poses) = match seq.poses() {
+        Ok(p) => (Some("velodyne"), Some(p)),
+        Err(_) => (imu.as_ref().map(|_| "imu"), imu.clone()),
+    };
+    let poses = poses.unwrap_or_default();
+    let labels = seq.labels().ok().map(|labels| {
+        let mut counts = BTreeMap::new();
+        for l in &labels {
+            *counts.entry(l.object_type.name().to_string()).or_insert(0) += 1;
+        }
+        counts
+    });
+    let (issues, errors) = issue_reports(&seq.check());
+    Report {
+        drive: seq.root().display().to_string(),
+        name: format!("tracking sequence {}", seq.name()),
+        velodyne_frames: seq.velodyne_count(),
+        oxts_packets: seq.oxts_count(),
+        time_span,
+        calibration,
+        pose_frame,
+        first_pose: poses.first().map(summary),
+        last_pose: poses.last().map(summary),
+        path_length_m,
+        labels,
+        issues,
+        errors,
+    }
+}
+
 fn report(drive: &RawDrive) -> Report {
     let velodyne_stamps = if drive.has_velodyne() {
         drive.timestamps().ok()
@@ -110,27 +183,13 @@ fn report(drive: &RawDrive) -> Report {
     } else {
         None
     };
-    let path_length_m = imu.as_ref().map(|poses| {
-        poses
-            .windows(2)
-            .map(|w| (w[1].translation.vector - w[0].translation.vector).norm())
-            .sum()
-    });
+    let path_length_m = imu.as_deref().map(path_length);
     let (pose_frame, poses) = match drive.poses() {
         Ok(p) => (Some("velodyne"), Some(p)),
         Err(_) => (imu.as_ref().map(|_| "imu"), imu.clone()),
     };
     let poses = poses.unwrap_or_default();
-    let issues: Vec<IssueReport> = drive
-        .check()
-        .iter()
-        .map(|i| IssueReport {
-            severity: if is_error(i) { "error" } else { "warning" },
-            path: i.path().display().to_string(),
-            message: i.to_string(),
-        })
-        .collect();
-    let errors = issues.iter().filter(|i| i.severity == "error").count();
+    let (issues, errors) = issue_reports(&drive.check());
     Report {
         drive: drive.dir().display().to_string(),
         name: drive.name(),
@@ -150,6 +209,7 @@ fn report(drive: &RawDrive) -> Report {
         first_pose: poses.first().map(summary),
         last_pose: poses.last().map(summary),
         path_length_m,
+        labels: None,
         issues,
         errors,
     }
@@ -189,6 +249,10 @@ fn print_text(r: &Report) {
         Some(l) => println!("path length     {l:.3} m (OXTS)"),
         None => println!("path length     unknown (no readable OXTS)"),
     }
+    if let Some(labels) = &r.labels {
+        let counts: Vec<String> = labels.iter().map(|(t, n)| format!("{n} {t}")).collect();
+        println!("labels          {}", counts.join(", "));
+    }
     if r.issues.is_empty() {
         println!("issues          none");
     }
@@ -199,19 +263,22 @@ fn print_text(r: &Report) {
 
 /// Runs the command; fails (non-zero exit) when the drive has an error-level issue.
 pub fn run(args: Args) -> Result<()> {
-    let drive = RawDrive::open(&args.drive)?;
-    let r = report(&drive);
+    let (r, source) = match (&args.drive, &args.tracking, args.sequence) {
+        (Some(dir), _, _) => (report(&RawDrive::open(dir)?), dir.display().to_string()),
+        (None, Some(root), Some(n)) => {
+            let seq = TrackingSequence::open(root, n)?;
+            let source = format!("tracking sequence {n:04} of {}", root.display());
+            (tracking_report(&seq), source)
+        }
+        _ => bail!("give --drive DIR or --tracking ROOT --sequence NNNN"),
+    };
     if args.json {
         println!("{}", serde_json::to_string_pretty(&r)?);
     } else {
         print_text(&r);
     }
     if r.errors > 0 {
-        bail!(
-            "{}: {} consistency error(s) (see above)",
-            args.drive.display(),
-            r.errors
-        );
+        bail!("{source}: {} consistency error(s) (see above)", r.errors);
     }
     Ok(())
 }

@@ -36,20 +36,23 @@ enum Command {
     Detections(detections_cmd::Args),
     /// Convert a point cloud between KITTI .bin, .las and .ply (by extension).
     Convert(convert_cmd::Args),
-    /// Describe a KITTI raw drive: frame counts, time span, calibration, poses, issues.
+    /// Describe a KITTI raw drive or tracking sequence: frame counts, time span, calibration,
+    /// poses, labels, issues.
     Info(info_cmd::Args),
-    /// Segment building walls in consecutive Velodyne frames of a drive or odometry
+    /// Segment building walls in consecutive Velodyne frames of a drive, odometry or tracking
     /// sequence, predict them one frame ahead and print area, vertex and normal errors.
     Planes(planes_cmd::Args),
     /// Simulate a street drive (lidar, OXTS, walls, cars, pedestrians) in the KITTI raw
-    /// layout, with a ground-truth JSON.
+    /// layout with a ground-truth JSON, or in the tracking layout with `label_02` truth.
     Synth(synth_cmd::Args),
-    /// Track building walls and point clusters of a KITTI raw drive with one labelled
-    /// multi-Bernoulli filter; write per-frame tracks (JSON), labelled clouds and a plot.
+    /// Track building walls and point clusters of a KITTI raw drive, tracking sequence or
+    /// odometry sequence with one labelled multi-Bernoulli filter; write per-frame tracks
+    /// (JSON), labelled clouds and a plot.
     Track(track_cmd::Args),
-    /// Score the output of `track` against ground truth (a simulated street's truth.json or
-    /// KITTI tracklets): OSPA, GOSPA and label switches of the clusters, wall accuracy, and
-    /// optionally the drive's plane-prediction statistics.
+    /// Score the output of `track` against ground truth (a simulated street's truth.json,
+    /// KITTI tracklets or a tracking sequence's label_02): OSPA, GOSPA and label switches of
+    /// the clusters, wall accuracy, and optionally the recording's plane-prediction
+    /// statistics.
     Eval(eval_cmd::Args),
 }
 

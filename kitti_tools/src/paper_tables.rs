@@ -68,7 +68,9 @@ pub const SEED_001: [PaperTables; 2] = [
 
 /// The paper's tables for `frame` (= k + 1) when `source` names its drive.
 pub fn reference_for(source: &str, frame: usize) -> Option<&'static PaperTables> {
-    let seed_drive = source.contains("2011_09_26_drive_0005") || source.contains("sequence 0000");
+    // Raw drive 0005 is the tracking benchmark's training sequence 0000.
+    let seed_drive = source.contains("2011_09_26_drive_0005")
+        || (source.contains("training") && source.contains("tracking sequence 0000"));
     if !seed_drive {
         return None;
     }
@@ -261,6 +263,10 @@ mod tests {
         assert_eq!(reference_for(d, 125).unwrap().tables, [1, 2, 3]);
         assert!(reference_for(d, 13).is_none());
         assert!(reference_for("2011_09_26_drive_0001_sync", 12).is_none());
+        let t = "/data/kitti_tracking/training tracking sequence 0000";
+        assert!(reference_for(t, 12).is_some());
+        assert!(reference_for("/data/kitti_tracking/testing tracking sequence 0000", 12).is_none());
+        assert!(reference_for("/data/odometry odometry sequence 00", 12).is_none());
     }
 
     #[test]

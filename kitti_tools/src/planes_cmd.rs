@@ -4,10 +4,11 @@
 
 use crate::paper_tables;
 use anyhow::{bail, Context, Result};
-use smc_lmb::kitti::{OdometrySequence, RawDrive};
+use smc_lmb::kitti::{OdometrySequence, RawDrive, TrackingSequence};
 use smc_lmb::metrics::{PlanePairError, PlanePredictionSummary};
 use smc_lmb::pipeline::{
-    predict_drive_pairs, predict_odometry_pairs, PairPrediction, PlanePredictionConfig,
+    predict_drive_pairs, predict_odometry_pairs, predict_tracking_pairs, PairPrediction,
+    PlanePredictionConfig,
 };
 use std::path::PathBuf;
 
@@ -15,12 +16,16 @@ use std::path::PathBuf;
 #[derive(clap::Args)]
 pub struct Args {
     /// A KITTI raw drive folder (`.../2011_09_26/2011_09_26_drive_0001_sync`).
-    #[arg(long, conflicts_with = "odometry")]
+    #[arg(long, conflicts_with_all = ["odometry", "tracking"])]
     drive: Option<PathBuf>,
     /// A KITTI odometry root (holding `sequences/` and `poses/`); needs `--sequence`.
-    #[arg(long, requires = "sequence")]
+    #[arg(long, requires = "sequence", conflicts_with = "tracking")]
     odometry: Option<PathBuf>,
-    /// Odometry sequence number.
+    /// A KITTI tracking split folder (`.../training`, holding `velodyne/`, `oxts/`,
+    /// `calib/`); needs `--sequence`.
+    #[arg(long, requires = "sequence")]
+    tracking: Option<PathBuf>,
+    /// Odometry or tracking sequence number.
     #[arg(long)]
     sequence: Option<u32>,
     /// Predict frame K into frame K + 1.
@@ -32,7 +37,8 @@ pub struct Args {
     /// Every consecutive frame pair instead of one, with the error distribution.
     #[arg(long)]
     all: bool,
-    /// Use the measured poses instead of the vehicle motion model (raw drives).
+    /// Use the measured poses instead of the vehicle motion model (raw drives and tracking
+    /// sequences).
     #[arg(long)]
     measured: bool,
     /// Random seed.
@@ -59,19 +65,22 @@ pub fn run(args: Args) -> Result<()> {
         Some(args.frame..args.frame + 1)
     };
     let mut rng = smc_lmb::rng::seeded(args.seed);
-    let source = match (&args.drive, &args.odometry, args.sequence) {
-        (Some(dir), _, _) => dir.display().to_string(),
-        (None, Some(root), Some(n)) => format!("{} sequence {n:04}", root.display()),
+    let source = match (&args.drive, &args.odometry, &args.tracking, args.sequence) {
+        (Some(dir), _, _, _) => dir.display().to_string(),
+        (None, Some(root), _, Some(n)) => format!("{} odometry sequence {n:02}", root.display()),
+        (None, None, Some(root), Some(n)) => {
+            format!("{} tracking sequence {n:04}", root.display())
+        }
         _ => String::new(),
     };
-    let results: Vec<PairPrediction> = match (&args.drive, &args.odometry) {
-        (Some(dir), _) => {
+    let results: Vec<PairPrediction> = match (&args.drive, &args.odometry, &args.tracking) {
+        (Some(dir), _, _) => {
             let drive =
                 RawDrive::open(dir).with_context(|| format!("opening drive {}", dir.display()))?;
             predict_drive_pairs(&drive, frames, &config, args.runs, &mut rng)
                 .with_context(|| format!("predicting planes of drive {}", dir.display()))?
         }
-        (None, Some(root)) => {
+        (None, Some(root), _) => {
             let Some(number) = args.sequence else {
                 bail!("--odometry needs --sequence");
             };
@@ -90,7 +99,19 @@ pub fn run(args: Args) -> Result<()> {
                 },
             )?
         }
-        (None, None) => bail!("give --drive DIR or --odometry ROOT --sequence NN"),
+        (None, None, Some(root)) => {
+            let Some(number) = args.sequence else {
+                bail!("--tracking needs --sequence");
+            };
+            let what = format!("tracking sequence {number:04} of {}", root.display());
+            let seq =
+                TrackingSequence::open(root, number).with_context(|| format!("opening {what}"))?;
+            predict_tracking_pairs(&seq, frames, &config, args.runs, &mut rng)
+                .with_context(|| format!("predicting planes of {what}"))?
+        }
+        (None, None, None) => bail!(
+            "give --drive DIR, --odometry ROOT --sequence NN or --tracking ROOT --sequence NNNN"
+        ),
     };
     if args.paper {
         for r in &results {

@@ -1,18 +1,37 @@
 //! `kitti-tools synth`: simulate a street drive (HDL-64E-like lidar, OXTS, walls, cars,
-//! pedestrians) and write it in the KITTI raw layout with `truth.json`.
+//! pedestrians) and write it in the KITTI raw layout with `truth.json`, or in the KITTI
+//! tracking layout with the cars and pedestrians as `label_02` labels.
 
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
-use smc_lmb::sim::street::{write_drive, ObjectKind, StreetConfig};
+use smc_lmb::sim::street::{
+    write_drive, write_tracking_sequence, ObjectKind, StreetConfig, StreetTruth,
+};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+
+/// The folder layouts `synth` writes.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Layout {
+    /// KITTI raw: OUT/DATE/DATE_drive_NNNN_sync with `truth.json`.
+    Raw,
+    /// KITTI tracking: OUT/{velodyne/NNNN, oxts, calib, label_02} (OUT is the split folder).
+    Tracking,
+}
 
 /// Flags of `synth`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Output root; the drive goes to OUT/DATE/DATE_drive_NNNN_sync.
+    /// Output root; the raw layout's drive goes to OUT/DATE/DATE_drive_NNNN_sync, the tracking
+    /// layout's sequence to OUT/velodyne/NNNN, OUT/oxts/NNNN.txt, ...
     #[arg(long)]
     out: PathBuf,
+    /// Folder layout to write.
+    #[arg(long, value_enum, default_value_t = Layout::Raw)]
+    layout: Layout,
+    /// Sequence number of the tracking layout.
+    #[arg(long, default_value_t = 0)]
+    sequence: u32,
     /// Number of frames (10 per second by default).
     #[arg(long, default_value_t = 50)]
     frames: usize,
@@ -55,17 +74,57 @@ pub fn run(args: Args) -> Result<()> {
             .expect("valid template"),
     );
     let started = Instant::now();
-    let drive = write_drive(&args.out, &config, args.frames, args.seed, |_| bar.inc(1))
-        .with_context(|| format!("writing a simulated drive under {}", args.out.display()))?;
-    bar.finish_and_clear();
+    let truth: StreetTruth = match args.layout {
+        Layout::Raw => {
+            let drive = write_drive(&args.out, &config, args.frames, args.seed, |_| bar.inc(1))
+                .with_context(|| {
+                    format!("writing a simulated drive under {}", args.out.display())
+                })?;
+            bar.finish_and_clear();
+            println!("drive    {}", drive.dir.display());
+            println!("truth    {}", drive.dir.join("truth.json").display());
+            drive.truth
+        }
+        Layout::Tracking => {
+            let seq = write_tracking_sequence(
+                &args.out,
+                &config,
+                args.frames,
+                args.seed,
+                args.sequence,
+                |_| bar.inc(1),
+            )
+            .with_context(|| {
+                format!(
+                    "writing simulated tracking sequence {:04} under {}",
+                    args.sequence,
+                    args.out.display()
+                )
+            })?;
+            bar.finish_and_clear();
+            let name = format!("{:04}", seq.sequence);
+            println!(
+                "sequence {name} of {} (--tracking {} --sequence {name})",
+                seq.root.display(),
+                seq.root.display()
+            );
+            println!(
+                "labels   {} ({} labels)",
+                seq.root
+                    .join("label_02")
+                    .join(format!("{name}.txt"))
+                    .display(),
+                seq.labels.len()
+            );
+            seq.truth
+        }
+    };
     let seconds = started.elapsed().as_secs_f64();
-    let truth = &drive.truth;
+    let truth = &truth;
     let points: usize = truth.frames.iter().map(|f| f.points).sum();
     let count = |kind: ObjectKind| truth.objects.iter().filter(|o| o.kind == kind).count();
     let last = truth.frames.last().map(|f| f.ego).unwrap_or_default();
     let first = truth.frames[0].ego;
-    println!("drive    {}", drive.dir.display());
-    println!("truth    {}", drive.dir.join("truth.json").display());
     println!(
         "frames   {} ({:.1} s), {:.0} points per frame on average",
         truth.frames.len(),

@@ -1,14 +1,15 @@
-//! `kitti-tools track`: one LMB run over a KITTI raw drive in which building walls and point
-//! clusters are labelled objects; writes the per-frame tracks as JSON and, on request,
+//! `kitti-tools track`: one LMB run over a KITTI raw drive, tracking sequence or odometry
+//! sequence in which building walls and point clusters are labelled objects; writes the per-frame tracks as JSON and, on request,
 //! labelled LAS/PLY clouds of chosen frames and a bird's-eye plot; prints a summary.
 
 use crate::config_file::read_config;
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use smc_lmb::cloud::{write_las_labelled, write_ply_labelled};
-use smc_lmb::kitti::RawDrive;
+use smc_lmb::kitti::{OdometrySequence, RawDrive, TrackingSequence};
 use smc_lmb::pipeline::drive_tracking::{
-    drive_plot, point_labels, track_drive, DriveTracks, EgoModel, TrackingConfig,
+    drive_plot, point_labels, track_drive, track_odometry_sequence, track_tracking_sequence,
+    DriveTracks, EgoModel, FrameView, TrackingConfig,
 };
 use std::ops::Range;
 use std::path::PathBuf;
@@ -17,8 +18,19 @@ use std::path::PathBuf;
 #[derive(clap::Args)]
 pub struct Args {
     /// A KITTI raw drive folder (`.../2011_09_26/2011_09_26_drive_0001_sync`).
+    #[arg(long, conflicts_with_all = ["odometry", "tracking"])]
+    drive: Option<PathBuf>,
+    /// A KITTI odometry root (holding `sequences/` and `poses/`); needs `--sequence`. Walls
+    /// move by the ground-truth poses (sequences 00–10).
+    #[arg(long, requires = "sequence", conflicts_with = "tracking")]
+    odometry: Option<PathBuf>,
+    /// A KITTI tracking split folder (`.../training`, holding `velodyne/`, `oxts/`,
+    /// `calib/`); needs `--sequence`.
+    #[arg(long, requires = "sequence")]
+    tracking: Option<PathBuf>,
+    /// Odometry or tracking sequence number.
     #[arg(long)]
-    drive: PathBuf,
+    sequence: Option<u32>,
     /// Frames to track, `A..B` (B excluded); default all.
     #[arg(long)]
     frames: Option<String>,
@@ -88,8 +100,6 @@ pub fn run(args: Args) -> Result<()> {
         };
     }
     let frames = args.frames.as_deref().map(parse_range).transpose()?;
-    let drive = RawDrive::open(&args.drive)
-        .with_context(|| format!("opening drive {}", args.drive.display()))?;
     for dir in [&args.las, &args.ply].into_iter().flatten() {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
@@ -102,7 +112,7 @@ pub fn run(args: Args) -> Result<()> {
         ProgressStyle::with_template("{bar:40} {pos}/{len} frames {elapsed} {msg}")
             .expect("valid template"),
     );
-    let tracks = track_drive(&drive, frames, &config, args.seed, |view| {
+    let on_frame = |view: &FrameView<'_>| -> smc_lmb::Result<()> {
         let (done, total) = view.progress;
         bar.set_length(total as u64);
         bar.set_position(done as u64);
@@ -123,8 +133,30 @@ pub fn run(args: Args) -> Result<()> {
             }
         }
         Ok(())
-    })
-    .with_context(|| format!("tracking drive {}", args.drive.display()))?;
+    };
+    let tracks = match (&args.drive, &args.odometry, &args.tracking, args.sequence) {
+        (Some(dir), _, _, _) => {
+            let drive =
+                RawDrive::open(dir).with_context(|| format!("opening drive {}", dir.display()))?;
+            track_drive(&drive, frames, &config, args.seed, on_frame)
+                .with_context(|| format!("tracking drive {}", dir.display()))?
+        }
+        (None, Some(root), _, Some(n)) => {
+            let what = format!("odometry sequence {n:02} of {}", root.display());
+            let seq = OdometrySequence::open(root, n).with_context(|| format!("opening {what}"))?;
+            track_odometry_sequence(&seq, frames, &config, args.seed, on_frame)
+                .with_context(|| format!("tracking {what}"))?
+        }
+        (None, None, Some(root), Some(n)) => {
+            let what = format!("tracking sequence {n:04} of {}", root.display());
+            let seq = TrackingSequence::open(root, n).with_context(|| format!("opening {what}"))?;
+            track_tracking_sequence(&seq, frames, &config, args.seed, on_frame)
+                .with_context(|| format!("tracking {what}"))?
+        }
+        _ => bail!(
+            "give --drive DIR, --odometry ROOT --sequence NN or --tracking ROOT --sequence NNNN"
+        ),
+    };
     bar.finish_and_clear();
     tracks.write_json(&args.out)?;
     if let Some(p) = &args.plot {

@@ -13,7 +13,8 @@
 //! and asking it for poses is an error naming the missing folder. [`RawDrive::check`] reports
 //! every inconsistency at once.
 //!
-//! Not for: camera images, or the odometry benchmark layout (see [`super::odometry`]).
+//! Not for: camera images, the odometry benchmark layout (see [`super::odometry`]) or the
+//! tracking benchmark layout (see [`super::tracking`]).
 
 use super::calib::{read_cam_to_cam, read_rigid_calib, CamToCamCalib, RigidCalib};
 use super::frames::{frame_file_name, list_frame_files, numbering_gaps, require_contiguous};

@@ -2,8 +2,9 @@
 //! folder, a gap in the frame numbering, counts that disagree, an unreadable file). A check
 //! collects all of them instead of stopping at the first, so a user sees the whole picture.
 //!
-//! Not for: the checks themselves (see [`super::drive::RawDrive::check`] and
-//! [`super::odometry::OdometrySequence::check`]).
+//! Not for: the checks themselves (see [`super::drive::RawDrive::check`],
+//! [`super::odometry::OdometrySequence::check`] and
+//! [`super::tracking::TrackingSequence::check`]).
 
 use crate::error::Error;
 use std::fmt;

@@ -21,7 +21,8 @@
 //! *bottom* face, (rx, ry, rz) rotation angles of which KITTI only uses rz (yaw about z).
 //! Elements not listed above are ignored; `<count>` values are checked against the items found.
 //!
-//! Not for: the tracking benchmark's `label_02` text files, or image-space boxes.
+//! Not for: the tracking benchmark's `label_02` text files (see [`super::labels`]), or
+//! image-space boxes.
 
 use crate::atomic::write_atomically;
 use crate::error::{Error, Result};

@@ -1,7 +1,7 @@
 //! Scores the output of a drive's tracking run ([`DriveTracks`]) against ground truth: the
 //! cluster tracks by OSPA and GOSPA (per frame and averaged) and label switches, against the
-//! objects of a simulated street ([`StreetTruth`]) or the tracklets of a KITTI raw drive
-//! ([`Tracklets`]); the wall tracks of a simulated street by the angle between their normals
+//! objects of a simulated street ([`StreetTruth`]), the tracklets of a KITTI raw drive
+//! ([`Tracklets`]) or the labels of a KITTI tracking sequence ([`TrackingLabel`]); the wall tracks of a simulated street by the angle between their normals
 //! and the truth wall's and the distance of their centres from its plane.
 //!
 //! Distances are horizontal (x, y of the world frame): a cluster's centroid is the mean of the
@@ -15,7 +15,7 @@
 
 use super::drive_tracking::DriveTracks;
 use crate::error::{Error, Result};
-use crate::kitti::Tracklets;
+use crate::kitti::{TrackingLabel, Tracklets, VelodyneBox};
 use crate::metrics::{gospa, ospa, percentile, LabelConsistency, LabelStats};
 use crate::sim::street::StreetTruth;
 use nalgebra::{Isometry3, Point3, Vector3};
@@ -80,6 +80,47 @@ pub fn tracklet_truth(tracklets: &Tracklets, poses: &[Isometry3<f64>]) -> TruthF
                 .collect()
         })
         .collect()
+}
+
+/// The objects of KITTI tracking labels (`label_02`, `DontCare` regions left out), per frame,
+/// moved into the Velodyne frame with `rect_from_velo` (the sequence's
+/// [`TrackingCalib::rect_from_velo`](crate::kitti::TrackingCalib::rect_from_velo)) and then
+/// into the world frame of the tracking output with the sequence's Velodyne poses (one per
+/// frame). An object counts only when `keep` accepts its box in the Velodyne frame (a range
+/// limit, the camera's view). KITTI's labels cover the front camera's view only, so tracks of
+/// objects beside or behind the vehicle count as false unless the caller drops them too. Frames
+/// beyond the poses are left out; the identity is the track id.
+pub fn label_truth(
+    labels: &[TrackingLabel],
+    rect_from_velo: &Isometry3<f64>,
+    poses: &[Isometry3<f64>],
+    keep: impl Fn(&VelodyneBox) -> bool,
+) -> TruthFrames {
+    let mut frames: TruthFrames = vec![Vec::new(); poses.len()];
+    for l in labels.iter().filter(|l| l.is_object()) {
+        if l.frame >= poses.len() || l.track_id < 0 {
+            continue;
+        }
+        let b = l.to_velodyne(rect_from_velo);
+        if !keep(&b) {
+            continue;
+        }
+        let c = poses[l.frame] * b.center;
+        frames[l.frame].push(TruthObject {
+            id: l.track_id as u64,
+            position: [c.x, c.y],
+        });
+    }
+    frames
+}
+
+/// Drops from every frame of `tracks` the cluster tracks that `keep` refuses (given the
+/// position in the sensor frame of that frame), e.g. those outside a camera's view when the
+/// truth covers that view only.
+pub fn retain_clusters(tracks: &mut DriveTracks, keep: impl Fn(&[f64; 3]) -> bool) {
+    for f in &mut tracks.frames {
+        f.clusters.retain(|c| keep(&c.position_sensor));
+    }
 }
 
 /// OSPA / GOSPA settings.
@@ -281,4 +322,47 @@ pub fn evaluate_walls(tracks: &DriveTracks, truth: &StreetTruth) -> Result<WallE
         p90_offset_m: stat(&offsets, 90.0),
         walls_matched: walls.len(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kitti::{ObjectType, TrackingLabel};
+    use nalgebra::{Matrix3, Translation3, UnitQuaternion};
+    use std::path::Path;
+
+    #[test]
+    fn label_truth_by_hand() {
+        // The ideal rig without offsets: velo x → cam z, velo y → cam −x, velo z → cam −y.
+        let r = Matrix3::new(0.0, -1.0, 0.0, 0.0, 0.0, -1.0, 1.0, 0.0, 0.0);
+        let rect_from_velo =
+            Isometry3::from_parts(Translation3::identity(), UnitQuaternion::from_matrix(&r));
+        let line = "1 4 Cyclist 0 0 0 0 0 10 10 1.8 0.6 1.7 -2 1.7 12 0";
+        let cyclist = TrackingLabel::parse_line(line, Path::new("l.txt"), 1).unwrap();
+        let mut far = cyclist;
+        far.track_id = 5;
+        far.location = [0.0, 1.7, 50.0];
+        let mut region = cyclist;
+        region.object_type = ObjectType::DontCare;
+        region.track_id = -1;
+        // Frame 1's sensor is 3 m ahead of frame 0's, turned by 90° to the left.
+        let poses = [
+            Isometry3::identity(),
+            Isometry3::from_parts(
+                Translation3::new(3.0, 0.0, 0.0),
+                UnitQuaternion::from_euler_angles(0.0, 0.0, std::f64::consts::FRAC_PI_2),
+            ),
+        ];
+        let frames = label_truth(&[cyclist, far, region], &rect_from_velo, &poses, |b| {
+            b.center.x.hypot(b.center.y) <= 40.0
+        });
+        assert_eq!(frames.len(), 2);
+        assert!(frames[0].is_empty());
+        assert_eq!(frames[1].len(), 1, "{frames:?}");
+        // Velodyne (12, 2, ·) of frame 1 → world (3 − 2, 12).
+        let o = frames[1][0];
+        assert_eq!(o.id, 4);
+        assert!((o.position[0] - 1.0).abs() < 1e-12, "{o:?}");
+        assert!((o.position[1] - 12.0).abs() < 1e-12, "{o:?}");
+    }
 }

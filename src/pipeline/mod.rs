@@ -11,14 +11,17 @@ pub mod plane_prediction;
 
 #[cfg(feature = "kitti")]
 pub use plane_prediction::{
-    predict_drive_pairs, predict_odometry_pairs, predict_planes_between, predict_walls,
-    segment_walls, EgoMotion, PairPrediction, PlanePredictionConfig,
+    predict_drive_pairs, predict_odometry_pairs, predict_planes_between, predict_tracking_pairs,
+    predict_walls, segment_walls, EgoMotion, PairPrediction, PlanePredictionConfig,
 };
 
 #[cfg(feature = "kitti")]
 pub mod drive_tracking;
 #[cfg(feature = "kitti")]
-pub use drive_tracking::{track_drive, DriveTracker, DriveTracks, TrackingConfig};
+pub use drive_tracking::{
+    track_drive, track_odometry_sequence, track_tracking_sequence, DriveTracker, DriveTracks,
+    TrackingConfig,
+};
 
 #[cfg(feature = "kitti")]
 pub mod drive_evaluation;

@@ -26,7 +26,7 @@ use crate::cloud::planes::{extract_planes, PlaneConfig};
 use crate::cloud::PointCloud;
 use crate::error::{Error, Result};
 use crate::geometry::PlanePatch;
-use crate::kitti::{OdometrySequence, RawDrive};
+use crate::kitti::{OdometrySequence, RawDrive, TrackingSequence};
 use crate::metrics::plane_prediction::{associate_planes, PlanePairError};
 use crate::models::plane::relative_motion;
 use crate::models::ExtendedConstantTurn;
@@ -350,6 +350,56 @@ pub fn predict_drive_pairs(
     predict_sequence(
         frames,
         &|k| drive.velodyne(k),
+        &poses,
+        states.as_deref(),
+        &dts,
+        &config,
+        runs,
+        rng,
+    )
+}
+
+/// Plane prediction over the consecutive frame pairs `(k, k + 1)`, `k ∈ frames`, of a KITTI
+/// tracking sequence, as [`predict_drive_pairs`] does a raw drive: Velodyne poses from the
+/// sequence's OXTS file and `Tr_imu_velo`; with `config.use_vehicle_model` Algorithm 1 from
+/// the OXTS vehicle states with `Tr_imu_velo` as the vehicle → sensor transform and steps of
+/// [`FRAME_PERIOD`](crate::kitti::tracking::FRAME_PERIOD) (the layout has no time stamps).
+/// `None` means every pair.
+pub fn predict_tracking_pairs(
+    sequence: &TrackingSequence,
+    frames: Option<std::ops::Range<usize>>,
+    config: &PlanePredictionConfig,
+    runs: usize,
+    rng: &mut FilterRng,
+) -> Result<Vec<PairPrediction>> {
+    let poses = sequence.poses()?;
+    let count = sequence.frame_count().min(poses.len());
+    let frames = frames.unwrap_or(0..count.saturating_sub(1));
+    check_range(
+        &frames,
+        count,
+        &format!(
+            "tracking sequence {} of {}",
+            sequence.name(),
+            sequence.root().display()
+        ),
+    )?;
+    let mut config = config.clone();
+    let (states, dts) = if config.use_vehicle_model {
+        let states: Vec<[f64; 6]> = sequence
+            .vehicle_states()?
+            .iter()
+            .map(|s| s.to_array())
+            .collect();
+        config.vehicle_to_sensor = sequence.calib()?.imu_to_velo;
+        let dts = vec![crate::kitti::tracking::FRAME_PERIOD; count.saturating_sub(1)];
+        (Some(states), dts)
+    } else {
+        (None, Vec::new())
+    };
+    predict_sequence(
+        frames,
+        &|k| sequence.velodyne(k),
         &poses,
         states.as_deref(),
         &dts,

@@ -1,19 +1,19 @@
-//! Tracking a whole KITTI raw drive with one LMB filter in which building walls and object
-//! clusters are both labelled objects (the mixed state and models of [`mixed`], written for
-//! this pipeline alone).
+//! Tracking a whole KITTI recording (a raw drive, a tracking sequence or an odometry sequence)
+//! with one LMB filter in which building walls and object clusters are both labelled objects
+//! (the mixed state and models of [`mixed`], written for this pipeline alone).
 //!
 //! Per frame: read the Velodyne `.bin`, segment the ground and walls, cluster the points on
 //! neither ([`detect`]), turn walls and cluster centroids into mixed measurements and step the
-//! filter with the frame's OXTS pose ([`tracker`]); the MAP estimate becomes a
+//! filter with the frame's pose ([`tracker`]); the MAP estimate becomes a
 //! [`TrackedFrame`] of labelled planes and clusters ([`output`]). Walls are tracked in the
 //! Velodyne frame and moved by the ego motion (the measured poses, or per particle by the
 //! extended constant-turn vehicle model, [`EgoModel`]); clusters are tracked in the world
 //! frame with constant velocity. The ground is not tracked (see [`detect`]).
 //!
 //! [`DriveTracker::step`] is the per-frame step on ready-made detections (for benchmarks);
-//! [`track_drive`] runs a whole drive and hands every frame (cloud, detections, report) to a
-//! callback, which is where a caller draws progress or writes labelled point clouds
-//! ([`export`]).
+//! [`track_drive`] ([`track_tracking_sequence`], [`track_odometry_sequence`]) runs a whole
+//! recording and hands every frame (cloud, detections, report) to a callback, which is where a
+//! caller draws progress or writes labelled point clouds ([`export`]).
 //!
 //! Not for: plane prediction scoring (see [`super::plane_prediction`]) or evaluation against
 //! ground truth.
@@ -39,7 +39,7 @@ use crate::cloud::planes::PlaneConfig;
 use crate::cloud::PointCloud;
 use crate::error::{ensure_positive, ensure_probability, Error, Result};
 use crate::filter::LmbConfig;
-use crate::kitti::RawDrive;
+use crate::kitti::{OdometrySequence, RawDrive, TrackingSequence};
 use crate::rng::stream;
 use nalgebra::Isometry3;
 use std::ops::Range;
@@ -293,6 +293,43 @@ pub struct FrameView<'a> {
 /// Stream key of the plane segmentation random stream of a frame.
 const KEY_SEGMENT: u64 = 0x5E6 << 48;
 
+/// What the tracking loop needs from a recording, whatever its layout.
+struct Recording<'a> {
+    /// Name in errors and in the output.
+    name: String,
+    /// Number of scans.
+    frames: usize,
+    /// Reads scan k.
+    read: &'a dyn Fn(usize) -> Result<PointCloud>,
+    /// Velodyne poses (frame k → frame 0), one per scan.
+    poses: Vec<Isometry3<f64>>,
+    /// Where the poses come from, e.g. `oxts` (`none` when every pose is the identity).
+    ego: String,
+    /// Vehicle states [X, Ẋ, Y, Ẏ, φ, φ̇] for the ECT ego model, one per scan.
+    vehicle: Option<Vec<[f64; 6]>>,
+    /// Frame times, s, one per scan.
+    times: Vec<f64>,
+}
+
+/// The pose source's name with `+ect` when the ECT ego model moves the walls.
+fn ego_name(source: &str, config: &TrackingConfig) -> String {
+    match config.ego {
+        EgoModel::Measured => source.to_string(),
+        EgoModel::Ect { .. } => format!("{source}+ect"),
+    }
+}
+
+/// The vehicle states the ECT ego model needs (`None` for measured poses).
+fn ect_states(
+    config: &TrackingConfig,
+    states: impl FnOnce() -> Result<Vec<crate::kitti::VehicleState>>,
+) -> Result<Option<Vec<[f64; 6]>>> {
+    match config.ego {
+        EgoModel::Measured => Ok(None),
+        EgoModel::Ect { .. } => Ok(Some(states()?.iter().map(|s| s.to_array()).collect())),
+    }
+}
+
 /// Tracks walls and clusters over `frames` (default: all) of `drive`.
 ///
 /// Poses come from OXTS when the drive has it; otherwise every frame is taken at the world
@@ -304,7 +341,7 @@ pub fn track_drive(
     frames: Option<Range<usize>>,
     config: &TrackingConfig,
     seed: u64,
-    mut on_frame: impl FnMut(&FrameView<'_>) -> Result<()>,
+    on_frame: impl FnMut(&FrameView<'_>) -> Result<()>,
 ) -> Result<DriveTracks> {
     config.validate()?;
     let name = drive.dir().display().to_string();
@@ -315,22 +352,9 @@ pub fn track_drive(
         ));
     }
     let n = drive.velodyne_count();
-    let range = frames.unwrap_or(0..n);
-    if range.start >= range.end || range.end > n {
-        return Err(Error::invalid(
-            format!("frame range of drive {name}"),
-            format!(
-                "{}..{} is empty or beyond its {n} frames",
-                range.start, range.end
-            ),
-        ));
-    }
+    check_frame_range(frames.as_ref(), n, &format!("drive {name}"))?;
     let (poses, ego) = if drive.has_oxts() {
-        let ego = match config.ego {
-            EgoModel::Measured => "oxts",
-            EgoModel::Ect { .. } => "oxts+ect",
-        };
-        (drive.poses()?, ego)
+        (drive.poses()?, ego_name("oxts", config))
     } else {
         if let EgoModel::Ect { .. } = config.ego {
             return Err(Error::invalid(
@@ -338,18 +362,9 @@ pub fn track_drive(
                 "the ECT ego model needs OXTS packets (oxts/data)",
             ));
         }
-        (vec![Isometry3::identity(); n], "none")
+        (vec![Isometry3::identity(); n], "none".to_string())
     };
-    let vehicle: Option<Vec<[f64; 6]>> = match config.ego {
-        EgoModel::Measured => None,
-        EgoModel::Ect { .. } => Some(
-            drive
-                .vehicle_states()?
-                .iter()
-                .map(|s| s.to_array())
-                .collect(),
-        ),
-    };
+    let vehicle = ect_states(config, || drive.vehicle_states())?;
     let times: Vec<f64> = if drive.velodyne_timestamps_path().is_file() {
         let t = drive.timestamps()?;
         if t.len() != n {
@@ -362,13 +377,149 @@ pub fn track_drive(
     } else {
         (0..n).map(|k| k as f64 * config.dt).collect()
     };
+    let read = |k: usize| drive.velodyne(k);
+    let recording = Recording {
+        name: drive.name(),
+        frames: n,
+        read: &read,
+        poses,
+        ego,
+        vehicle,
+        times,
+    };
+    track_recording(&recording, frames, config, seed, on_frame)
+}
 
+/// Tracks walls and clusters over `frames` (default: all) of a KITTI tracking sequence, as
+/// [`track_drive`] does a raw drive: poses from the sequence's OXTS file and `Tr_imu_velo`
+/// (required: the tracking layout always has them), frame k at k·0.1 s (the layout has no
+/// time stamps, see [`crate::kitti::tracking::FRAME_PERIOD`]). The output is named
+/// `tracking_NNNN`.
+pub fn track_tracking_sequence(
+    sequence: &TrackingSequence,
+    frames: Option<Range<usize>>,
+    config: &TrackingConfig,
+    seed: u64,
+    on_frame: impl FnMut(&FrameView<'_>) -> Result<()>,
+) -> Result<DriveTracks> {
+    config.validate()?;
+    let name = format!(
+        "tracking sequence {} of {}",
+        sequence.name(),
+        sequence.root().display()
+    );
+    if !sequence.has_velodyne() {
+        return Err(Error::invalid(
+            name,
+            format!("has no scan folder {}", sequence.velodyne_dir().display()),
+        ));
+    }
+    let n = sequence.velodyne_count();
+    check_frame_range(frames.as_ref(), n, &name)?;
+    let read = |k: usize| sequence.velodyne(k);
+    let recording = Recording {
+        name: format!("tracking_{}", sequence.name()),
+        frames: n,
+        read: &read,
+        poses: sequence.poses()?,
+        ego: ego_name("oxts", config),
+        vehicle: ect_states(config, || sequence.vehicle_states())?,
+        times: sequence.times(),
+    };
+    track_recording(&recording, frames, config, seed, on_frame)
+}
+
+/// Tracks walls and clusters over `frames` (default: all) of a KITTI odometry sequence, with
+/// the ground-truth poses of `poses/NN.txt` (sequences 00–10) moved to the Velodyne frame with
+/// `calib.txt`'s `Tr` (`ego = "odometry"`), and the times of `times.txt` (k·`config.dt` when it
+/// is absent). The ECT ego model needs vehicle states, which the layout has not: an error. The
+/// output is named `odometry_NN`.
+pub fn track_odometry_sequence(
+    sequence: &OdometrySequence,
+    frames: Option<Range<usize>>,
+    config: &TrackingConfig,
+    seed: u64,
+    on_frame: impl FnMut(&FrameView<'_>) -> Result<()>,
+) -> Result<DriveTracks> {
+    config.validate()?;
+    let name = format!("odometry sequence {}", sequence.dir().display());
+    if let EgoModel::Ect { .. } = config.ego {
+        return Err(Error::invalid(
+            name,
+            "the ECT ego model needs OXTS vehicle states, which the odometry layout has not",
+        ));
+    }
+    let n = sequence.frame_count();
+    if n == 0 {
+        return Err(Error::invalid(
+            name,
+            format!("has no scans in {}", sequence.velodyne_dir().display()),
+        ));
+    }
+    check_frame_range(frames.as_ref(), n, &name)?;
+    let poses = sequence.velodyne_poses()?;
+    if poses.len() < n {
+        return Err(Error::invalid(
+            format!("{}", sequence.poses_path().display()),
+            format!("has {} poses for {n} scans", poses.len()),
+        ));
+    }
+    let times = if sequence.times_path().is_file() {
+        let t = sequence.times()?;
+        if t.len() < n {
+            return Err(Error::invalid(
+                format!("{}", sequence.times_path().display()),
+                format!("has {} times for {n} scans", t.len()),
+            ));
+        }
+        t
+    } else {
+        (0..n).map(|k| k as f64 * config.dt).collect()
+    };
+    let read = |k: usize| sequence.velodyne(k);
+    let recording = Recording {
+        name: format!("odometry_{}", sequence.name()),
+        frames: n,
+        read: &read,
+        poses,
+        ego: "odometry".to_string(),
+        vehicle: None,
+        times,
+    };
+    track_recording(&recording, frames, config, seed, on_frame)
+}
+
+/// Fails when `frames` is empty or reaches beyond `n` frames of `what`.
+fn check_frame_range(frames: Option<&Range<usize>>, n: usize, what: &str) -> Result<()> {
+    let range = frames.cloned().unwrap_or(0..n);
+    if range.start >= range.end || range.end > n {
+        return Err(Error::invalid(
+            format!("frame range of {what}"),
+            format!(
+                "{}..{} is empty or beyond its {n} frames",
+                range.start, range.end
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The tracking loop over a recording's frames.
+fn track_recording(
+    rec: &Recording<'_>,
+    frames: Option<Range<usize>>,
+    config: &TrackingConfig,
+    seed: u64,
+    mut on_frame: impl FnMut(&FrameView<'_>) -> Result<()>,
+) -> Result<DriveTracks> {
+    let range = frames.unwrap_or(0..rec.frames);
+    let (poses, times, vehicle) = (&rec.poses, &rec.times, &rec.vehicle);
     let mut tracker = DriveTracker::new(config, seed)?;
     let mut out = Vec::with_capacity(range.len());
     let total = range.len();
     for k in range.clone() {
         let start = Instant::now();
-        let cloud = drive.velodyne(k)?;
+        let cloud = (rec.read)(k)?;
         let read_ms = start.elapsed().as_secs_f64() * 1e3;
         let detections = detect_objects(&cloud, config, &mut stream(seed, KEY_SEGMENT ^ k as u64))?;
         let previous_state = vehicle
@@ -386,10 +537,10 @@ pub fn track_drive(
     }
     let summary = TrackingSummary::of(&out);
     Ok(DriveTracks {
-        drive: drive.name(),
+        drive: rec.name.clone(),
         seed,
         particles: config.filter.particles,
-        ego: ego.to_string(),
+        ego: rec.ego.clone(),
         frames: out,
         summary,
     })

@@ -2,10 +2,13 @@
 //! and an OXTS unit drives at about 10 m/s along a street with turns, between building walls,
 //! past parked cars, moving cars and pedestrians. [`write_drive`] writes it as
 //! `DIR/DATE/DATE_drive_NNNN_sync/` that [`crate::kitti::RawDrive`] opens unchanged, plus
-//! `truth.json` ([`StreetTruth`]); [`generate`] keeps it in memory with per-point labels.
+//! `truth.json` ([`StreetTruth`]); [`write_tracking_sequence`] writes it in the KITTI tracking
+//! layout with its cars and pedestrians as `label_02` labels; [`generate`] keeps it in memory
+//! with per-point labels.
 //!
 //! The pieces: [`ego`] (the vehicle's motion), [`world`] (the scene), [`lidar`] (the ray
-//! caster), [`truth`] (what is written as ground truth), [`writer`] (the files).
+//! caster), [`truth`] (what is written as ground truth), [`writer`] (the raw layout's files),
+//! [`tracking_writer`] (the tracking layout's).
 //!
 //! **Poses.** The OXTS unit is simulated level (roll = pitch = 0) at constant height; the
 //! Velodyne pose follows from the IMU→Velodyne calibration exactly as the reader derives it
@@ -24,12 +27,14 @@
 pub mod calib_files;
 pub mod ego;
 pub mod lidar;
+pub mod tracking_writer;
 pub mod truth;
 pub mod world;
 pub mod writer;
 
 pub use ego::{EgoState, EgoTrajectory, LegSpec};
 pub use lidar::{LidarConfig, LidarScan, Surface};
+pub use tracking_writer::{write_tracking_sequence, WrittenSequence};
 pub use truth::{FrameTruth, ObjectState, ObjectTruth, PoseTruth, StreetTruth, WallTruth};
 pub use world::{ObjectKind, Street};
 pub use writer::{write_drive, WrittenDrive, TRUTH_FILE};
