@@ -1,0 +1,75 @@
+//! Lidar odometry on real KITTI scans: drive 0005 (a slow left bend, ~0.35 m a frame)
+//! against the drive's OXTS Velodyne poses. Skipped with a note when `../shared/data` is absent
+//! (a failure under CI=true).
+//!
+//! The bounds come from KISS-ICP itself (pip package `kiss-icp` 1.3.0, default configuration,
+//! no deskewing) on the same scans, see `docs/odometry.md`: over frames 0–49 its per-frame
+//! translation errors are about 4 cm and its rotation errors about 0.09° on average. The tests ask
+//! for that level with a margin (5 cm, 0.2°). The end-point drift is printed, not bounded:
+//! KISS-ICP's own drift on these frames has not been scored yet.
+//!
+//! This crate's odometry matches KISS-ICP to 1–3 cm a frame up to frame 37 and then drifts
+//! off in yaw (it reaches 19° a frame by frame 48; KISS-ICP does not): the test over all 50
+//! frames is ignored until that is found and fixed; the one over frames 0–36 guards what works.
+
+mod common;
+
+use smc_lmb::cloud::odometry::{odometry_of_files, OdometryConfig};
+use smc_lmb::kitti::RawDrive;
+use smc_lmb::metrics::{path_length, relative_pose_errors, Spread};
+
+const DRIVE: &str = "kitti_raw/2011_09_26/2011_09_26_drive_0005_sync";
+
+fn follows_oxts(frames: usize) {
+    let Some(dir) = common::shared_data(DRIVE) else {
+        return;
+    };
+    let drive = RawDrive::open(&dir).expect("drive 0005");
+    let reference = drive.poses().expect("OXTS Velodyne poses");
+    let scans: Vec<_> = (0..frames).map(|k| drive.velodyne_path(k)).collect();
+    let start = std::time::Instant::now();
+    let estimate = odometry_of_files(&scans, &OdometryConfig::default(), |_, _| {}).unwrap();
+    let ms = start.elapsed().as_secs_f64() * 1e3 / scans.len() as f64;
+
+    let reference = &reference[..frames];
+    let rpe = relative_pose_errors(&estimate, reference).unwrap();
+    let t: Vec<f64> = rpe.iter().map(|e| e.translation).collect();
+    let r: Vec<f64> = rpe.iter().map(|e| e.rotation_deg).collect();
+    let (t, r) = (Spread::of(&t).unwrap(), Spread::of(&r).unwrap());
+    let path = path_length(reference);
+    let last = estimate.len() - 1;
+    let drift = (reference[last].inverse() * estimate[last])
+        .translation
+        .vector
+        .norm();
+    println!(
+        "{frames} frames, {ms:.0} ms/scan; path {path:.2} m (estimated {:.2} m); translation \
+         mean {:.4} m, median {:.4} m, max {:.4} m; rotation mean {:.4}°, max {:.4}°; drift \
+         {drift:.3} m",
+        path_length(&estimate),
+        t.mean,
+        t.median,
+        t.max,
+        r.mean,
+        r.max
+    );
+    // Scale: drive 0005 moves ~3.5 m/s, ~0.35 m a frame.
+    let per_frame = path / last as f64;
+    assert!(
+        (0.3..0.4).contains(&per_frame),
+        "reference {per_frame} m a frame"
+    );
+    assert!(t.mean < 0.05, "mean translational RPE {} m", t.mean);
+    assert!(r.mean < 0.2, "mean rotational RPE {}°", r.mean);
+}
+
+#[test]
+fn drive_0005_frames_0_to_36_follow_the_oxts_trajectory() {
+    follows_oxts(37);
+}
+
+#[test]
+#[ignore = "drifts off in yaw from frame 37 on (KISS-ICP does not); see docs/odometry.md"]
+fn drive_0005_frames_0_to_49_follow_the_oxts_trajectory() {
+    follows_oxts(50);
+}
