@@ -7,6 +7,7 @@ mod demo_cmd;
 mod detections_cmd;
 mod eval_cmd;
 mod info_cmd;
+mod odometry_cmd;
 mod planes_cmd;
 mod synth_cmd;
 mod track_cmd;
@@ -37,6 +38,9 @@ enum Command {
     Convert(convert_cmd::Args),
     /// Describe a KITTI raw drive: frame counts, time span, calibration, poses, issues.
     Info(info_cmd::Args),
+    /// Lidar odometry (KISS-ICP's recipe) over the scans of a drive, an odometry sequence or
+    /// a folder of .bin files; write KITTI poses and, given a reference, print the errors.
+    Odometry(odometry_cmd::Args),
     /// Segment building walls in consecutive Velodyne frames of a drive or odometry
     /// sequence, predict them one frame ahead and print area, vertex and normal errors.
     Planes(planes_cmd::Args),
@@ -58,6 +62,7 @@ fn main() -> Result<()> {
         Command::Detections(args) => detections_cmd::run(args),
         Command::Convert(args) => convert_cmd::run(args),
         Command::Info(args) => info_cmd::run(args),
+        Command::Odometry(args) => odometry_cmd::run(args),
         Command::Planes(args) => planes_cmd::run(args),
         Command::Synth(args) => synth_cmd::run(args),
         Command::Track(args) => track_cmd::run(args),
