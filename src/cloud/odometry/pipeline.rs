@@ -4,6 +4,7 @@
 use super::config::OdometryConfig;
 use super::downsample::{crop_range, voxel_downsample};
 use super::registration::{align_points_to_map, IcpParams};
+use super::se3::renormalized;
 use super::threshold::AdaptiveThreshold;
 use super::voxel_map::VoxelHashMap;
 use crate::cloud::{read_kitti_bin, PointCloud};
@@ -89,7 +90,7 @@ impl LidarOdometry {
             .fixed_threshold
             .unwrap_or_else(|| self.threshold.threshold());
         // Constant-velocity prediction (Sec. III-A) and alignment (Sec. III-D).
-        let initial = self.last_pose * self.last_delta;
+        let initial = renormalized(&(self.last_pose * self.last_delta));
         let params = IcpParams {
             max_correspondence: 3.0 * sigma,
             kernel: sigma / 3.0,
@@ -101,7 +102,7 @@ impl LidarOdometry {
         // Update: threshold from the model deviation, map, velocity, pose.
         self.threshold.update(&(initial.inverse() * pose));
         self.map.update(&frame_down, &pose);
-        self.last_delta = self.last_pose.inverse() * pose;
+        self.last_delta = renormalized(&(self.last_pose.inverse() * pose));
         self.last_pose = pose;
         self.poses.push(pose);
         Ok(Registered {

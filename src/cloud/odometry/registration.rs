@@ -79,12 +79,12 @@ pub fn align_points_to_map(
                 *p = transform(&step, p);
             }
         });
-        t_icp = step * t_icp;
+        t_icp = se3::renormalized(&(step * t_icp));
         if dx.norm() < params.convergence {
             break;
         }
     }
-    out.pose = t_icp * initial;
+    out.pose = se3::renormalized(&(t_icp * initial));
     out
 }
 
