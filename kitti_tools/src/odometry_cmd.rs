@@ -235,7 +235,7 @@ fn report(estimate: &[Isometry3<f64>], reference: &[Isometry3<f64>], name: &str)
         .vector
         .norm();
     let path = path_length(reference);
-    if path > 1e-6 {
+    if path >= 1.0 {
         println!(
             "end-point drift {end:.3} m ({:.2} % of the reference path)",
             100.0 * end / path
