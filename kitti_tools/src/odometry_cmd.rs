@@ -123,7 +123,7 @@ fn input(args: &Args) -> Result<Input> {
             let poses = seq.poses_path();
             let reference = poses
                 .is_file()
-                .then(|| Reference::PoseFile(poses, Some(seq)));
+                .then_some(Reference::PoseFile(poses, Some(seq)));
             Ok(Input { scans, reference })
         }
         (None, None, Some(dir)) => Ok(Input {

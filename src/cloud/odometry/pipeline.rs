@@ -232,9 +232,13 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let f = dir.join("0000000000.bin");
         std::fs::write(&f, b"").unwrap();
-        let e = odometry_of_files(&[f.clone()], &OdometryConfig::default(), |_, _| {})
-            .unwrap_err()
-            .to_string();
+        let e = odometry_of_files(
+            std::slice::from_ref(&f),
+            &OdometryConfig::default(),
+            |_, _| {},
+        )
+        .unwrap_err()
+        .to_string();
         let _ = std::fs::remove_dir_all(&dir);
         assert!(e.contains("0000000000.bin"), "{e}");
     }
