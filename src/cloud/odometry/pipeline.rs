@@ -218,6 +218,31 @@ mod tests {
     }
 
     #[test]
+    fn poses_do_not_depend_on_the_number_of_threads() {
+        let step = Isometry3::new(Vector3::new(0.4, 0.02, 0.0), Vector3::new(0.0, 0.0, 0.0105));
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let mut odo = LidarOdometry::new(OdometryConfig {
+                    voxel_size: 0.5,
+                    ..OdometryConfig::default()
+                })
+                .unwrap();
+                let mut truth = Isometry3::identity();
+                for k in 0..3 {
+                    odo.register(&seen_from(&yard(0.1, k), &truth)).unwrap();
+                    truth *= step;
+                }
+                odo.poses().to_vec()
+            })
+        };
+        assert_eq!(run(1), run(3));
+    }
+
+    #[test]
     fn an_empty_scan_is_an_error_naming_the_scan() {
         let mut odo = LidarOdometry::new(OdometryConfig::default()).unwrap();
         let e = odo.register(&PointCloud::new()).unwrap_err().to_string();
