@@ -7,6 +7,7 @@ mod demo_cmd;
 mod detections_cmd;
 mod eval_cmd;
 mod info_cmd;
+mod odometry_cmd;
 mod paper_tables;
 mod planes_cmd;
 mod synth_cmd;
@@ -39,6 +40,9 @@ enum Command {
     /// Describe a KITTI raw drive or tracking sequence: frame counts, time span, calibration,
     /// poses, labels, issues.
     Info(info_cmd::Args),
+    /// Lidar odometry (KISS-ICP's recipe) over the scans of a drive, an odometry sequence or
+    /// a folder of .bin files; write KITTI poses and, given a reference, print the errors.
+    Odometry(odometry_cmd::Args),
     /// Segment building walls in consecutive Velodyne frames of a drive, odometry or tracking
     /// sequence, predict them one frame ahead and print area, vertex and normal errors.
     Planes(planes_cmd::Args),
@@ -62,6 +66,7 @@ fn main() -> Result<()> {
         Command::Detections(args) => detections_cmd::run(args),
         Command::Convert(args) => convert_cmd::run(args),
         Command::Info(args) => info_cmd::run(args),
+        Command::Odometry(args) => odometry_cmd::run(args),
         Command::Planes(args) => planes_cmd::run(args),
         Command::Synth(args) => synth_cmd::run(args),
         Command::Track(args) => track_cmd::run(args),

@@ -1,6 +1,7 @@
 //! Point clouds: the [`PointCloud`] type (structure of arrays, f32) and the KITTI Velodyne
 //! `.bin` reader and writer, LAS and PLY import/export (optionally coloured by label),
-//! and Euclidean clustering of points into object candidates.
+//! Euclidean clustering of points into object candidates, and lidar odometry (the scanner's
+//! motion from its own scans, [`odometry`]).
 //!
 //! Not for: finding the frames of a recording (see [`crate::kitti`]) or fitting
 //! planes to the points.
@@ -8,6 +9,7 @@
 pub mod cluster;
 pub mod kitti_bin;
 pub mod las_io;
+pub mod odometry;
 pub mod palette;
 pub mod planes;
 pub mod ply_io;

@@ -18,9 +18,11 @@ use super::calib::{rigid_from_parts, CalibFile};
 use super::frames::{list_frame_files, numbering_gaps};
 use super::issue::Issue;
 use super::text::{numbered_lines, parse_f64, read_text};
+use crate::atomic::write_atomically;
 use crate::cloud::{read_kitti_bin_with, BinScan, NonFinite, PointCloud};
 use crate::error::{Error, Result};
 use nalgebra::{Isometry3, Matrix3, Vector3};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// Reads a pose file: one row-major 3×4 matrix `[R | t]` (12 values) per non-blank line.
@@ -54,6 +56,24 @@ pub fn read_odometry_poses(path: impl AsRef<Path>) -> Result<Vec<Isometry3<f64>>
         poses.push(pose);
     }
     Ok(poses)
+}
+
+/// Writes a pose file in the layout [`read_odometry_poses`] reads: one row-major 3×4 matrix
+/// `[R | t]` per line, twelve values in scientific notation, atomically.
+pub fn write_odometry_poses(path: impl AsRef<Path>, poses: &[Isometry3<f64>]) -> Result<()> {
+    write_atomically(path.as_ref(), |w| {
+        for pose in poses {
+            let m = pose.to_homogeneous();
+            let mut row = Vec::with_capacity(12);
+            for r in 0..3 {
+                for c in 0..4 {
+                    row.push(format!("{:.9e}", m[(r, c)]));
+                }
+            }
+            writeln!(w, "{}", row.join(" "))?;
+        }
+        Ok(())
+    })
 }
 
 /// Reads `times.txt`: one time in seconds per non-blank line.
@@ -265,6 +285,25 @@ impl OdometrySequence {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn written_poses_read_back() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("00.txt");
+        let poses = vec![
+            Isometry3::identity(),
+            Isometry3::new(
+                Vector3::new(0.35, -0.01, 0.002),
+                Vector3::new(0.001, 0.0, 0.01),
+            ),
+        ];
+        write_odometry_poses(&p, &poses).unwrap();
+        let back = read_odometry_poses(&p).unwrap();
+        assert_eq!(back.len(), 2);
+        assert_eq!(back[0], Isometry3::identity());
+        let d = poses[1].inverse() * back[1];
+        assert!(d.translation.vector.norm() < 1e-9 && d.rotation.angle() < 1e-9);
+    }
 
     #[test]
     fn pose_line_errors() {

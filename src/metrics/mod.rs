@@ -12,6 +12,7 @@
 //! | [`labels`] | Label switches and label persistence of estimates matched to truth |
 //! | [`plane_prediction`] | Area, vertex-distance and normal-angle errors of predicted plane patches |
 //! | [`rmse`] | RMS error of error vectors and the averaged-NIS consistency check |
+//! | [`trajectory`] | Relative pose errors and KITTI's segment errors of an ego trajectory |
 //!
 //! Points are slices of `f64` coordinates of any (common) dimension; all distances between
 //! points are Euclidean. Functions accept anything that derefs to `[f64]` per point, so a
@@ -30,6 +31,7 @@ pub mod ospa2;
 pub mod plane_prediction;
 mod points;
 pub mod rmse;
+pub mod trajectory;
 
 pub use cardinality::{cardinality_error, CardinalityError};
 pub use gospa::{gospa, Gospa};
@@ -38,3 +40,7 @@ pub use ospa::{ospa, Ospa};
 pub use ospa2::{ospa2, ospa2_parts, ospa2_series, tracks_from_frames, TrackHistory};
 pub use plane_prediction::{associate_planes, percentile, PlanePairError, PlanePredictionSummary};
 pub use rmse::{average_nis, chi_square_quantile, rms_error, NisCheck};
+pub use trajectory::{
+    path_length, relative_pose_errors, segment_errors, PoseError, SegmentErrors, Spread,
+    KITTI_SEGMENT_LENGTHS,
+};

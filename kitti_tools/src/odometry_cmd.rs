@@ -1,0 +1,254 @@
+//! `kitti-tools odometry`: lidar odometry (KISS-ICP's recipe) over the scans of a raw drive,
+//! an odometry sequence or a folder of `.bin` files; writes KITTI pose lines and, given a
+//! reference trajectory, prints its relative pose errors.
+
+use anyhow::{bail, Context, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+use nalgebra::Isometry3;
+use smc_lmb::cloud::odometry::{odometry_of_files, OdometryConfig};
+use smc_lmb::kitti::odometry::{read_odometry_poses, write_odometry_poses};
+use smc_lmb::kitti::{OdometrySequence, RawDrive};
+use smc_lmb::metrics::{
+    path_length, relative_pose_errors, segment_errors, Spread, KITTI_SEGMENT_LENGTHS,
+};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Flags of `odometry`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// A KITTI raw drive folder; its OXTS Velodyne poses, when present, are the reference.
+    #[arg(long, conflicts_with_all = ["odometry", "scans"])]
+    drive: Option<PathBuf>,
+    /// A KITTI odometry root (holding `sequences/` and `poses/`); needs `--sequence`. Its
+    /// `poses/NN.txt`, when present, is the reference.
+    #[arg(long, requires = "sequence", conflicts_with = "scans")]
+    odometry: Option<PathBuf>,
+    /// Odometry sequence number.
+    #[arg(long)]
+    sequence: Option<u32>,
+    /// A folder of `.bin` scans, taken in file-name order.
+    #[arg(long)]
+    scans: Option<PathBuf>,
+    /// Only the first N scans.
+    #[arg(long)]
+    frames: Option<usize>,
+    /// Where to write the poses (one row-major 3×4 matrix a line, scan k → scan 0).
+    #[arg(long, required_unless_present = "evaluate")]
+    out: Option<PathBuf>,
+    /// A KITTI pose file to compare with instead of the drive's or sequence's own reference
+    /// (for instance another odometry's output).
+    #[arg(long)]
+    reference: Option<PathBuf>,
+    /// Score this pose file against the reference instead of running the odometry.
+    #[arg(long)]
+    evaluate: Option<PathBuf>,
+    /// Voxel edge in metres (default: max range / 100).
+    #[arg(long)]
+    voxel_size: Option<f64>,
+    /// Maximum range in metres.
+    #[arg(long, default_value_t = 100.0)]
+    max_range: f64,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
+
+/// The scans to register and where the reference trajectory comes from.
+struct Input {
+    scans: Vec<PathBuf>,
+    reference: Option<Reference>,
+}
+
+enum Reference {
+    Drive(RawDrive),
+    PoseFile(PathBuf, Option<OdometrySequence>),
+}
+
+/// Runs the command.
+pub fn run(args: Args) -> Result<()> {
+    let mut input = input(&args)?;
+    if let Some(n) = args.frames {
+        input.scans.truncate(n);
+    }
+    if input.scans.is_empty() {
+        bail!("no .bin scans to register");
+    }
+    let estimate = match &args.evaluate {
+        Some(file) => read_odometry_poses(file)
+            .with_context(|| format!("reading the poses to score, {}", file.display()))?,
+        None => estimate(&args, &input.scans)?,
+    };
+    if let Some(file) = &args.reference {
+        input.reference = Some(Reference::PoseFile(file.clone(), None));
+    }
+    if let Some(reference) = &input.reference {
+        let (name, poses) = reference_poses(reference)?;
+        if poses.len() < estimate.len() {
+            bail!(
+                "{name}: the reference has {} poses for {} scans",
+                poses.len(),
+                estimate.len()
+            );
+        }
+        report(&estimate, &poses[..estimate.len()], &name)?;
+    }
+    Ok(())
+}
+
+fn input(args: &Args) -> Result<Input> {
+    match (&args.drive, &args.odometry, &args.scans) {
+        (Some(dir), _, _) => {
+            let drive =
+                RawDrive::open(dir).with_context(|| format!("opening drive {}", dir.display()))?;
+            let scans = (0..drive.velodyne_count())
+                .map(|k| drive.velodyne_path(k))
+                .collect();
+            let reference = drive.has_oxts().then_some(Reference::Drive(drive));
+            Ok(Input { scans, reference })
+        }
+        (None, Some(root), _) => {
+            let Some(number) = args.sequence else {
+                bail!("--odometry needs --sequence");
+            };
+            let seq = OdometrySequence::open(root, number).with_context(|| {
+                format!(
+                    "opening odometry sequence {number:02} of {}",
+                    root.display()
+                )
+            })?;
+            let scans = (0..seq.frame_count())
+                .map(|k| seq.velodyne_path(k))
+                .collect();
+            let poses = seq.poses_path();
+            let reference = poses
+                .is_file()
+                .then_some(Reference::PoseFile(poses, Some(seq)));
+            Ok(Input { scans, reference })
+        }
+        (None, None, Some(dir)) => Ok(Input {
+            scans: bin_files(dir)?,
+            reference: None,
+        }),
+        (None, None, None) => {
+            bail!("give --drive DIR, --odometry ROOT --sequence NN or --scans DIR")
+        }
+    }
+}
+
+/// The `.bin` files of `dir` in file-name order; an error naming the folder when there is none.
+fn bin_files(dir: &Path) -> Result<Vec<PathBuf>> {
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
+        let path = entry
+            .with_context(|| format!("reading {}", dir.display()))?
+            .path();
+        if path.extension().is_some_and(|e| e == "bin") && path.is_file() {
+            files.push(path);
+        }
+    }
+    if files.is_empty() {
+        bail!("{}: no .bin scans in this folder", dir.display());
+    }
+    files.sort();
+    Ok(files)
+}
+
+fn estimate(args: &Args, scans: &[PathBuf]) -> Result<Vec<Isometry3<f64>>> {
+    let config = OdometryConfig {
+        max_range: args.max_range,
+        voxel_size: args.voxel_size.unwrap_or(args.max_range / 100.0),
+        ..OdometryConfig::default()
+    };
+    let bar = if args.quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(scans.len() as u64)
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} scans {elapsed}")
+            .expect("valid template"),
+    );
+    let start = Instant::now();
+    let poses = odometry_of_files(scans, &config, |_, _| bar.inc(1))?;
+    let elapsed = start.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+    let out = args
+        .out
+        .as_ref()
+        .expect("clap requires --out without --evaluate");
+    write_odometry_poses(out, &poses)?;
+    println!(
+        "{} scans, {:.1} m path, {:.1} ms/scan (reading included); poses written to {}",
+        poses.len(),
+        path_length(&poses),
+        1000.0 * elapsed / poses.len() as f64,
+        out.display()
+    );
+    Ok(poses)
+}
+
+fn reference_poses(reference: &Reference) -> Result<(String, Vec<Isometry3<f64>>)> {
+    match reference {
+        Reference::Drive(drive) => {
+            let poses = drive.poses().with_context(|| {
+                format!("reading the OXTS reference of {}", drive.dir().display())
+            })?;
+            Ok((format!("{} (OXTS)", drive.oxts_dir().display()), poses))
+        }
+        Reference::PoseFile(file, seq) => {
+            let poses = match seq {
+                Some(seq) => seq.velodyne_poses(),
+                None => read_odometry_poses(file),
+            }
+            .with_context(|| format!("reading the reference {}", file.display()))?;
+            Ok((file.display().to_string(), poses))
+        }
+    }
+}
+
+fn report(estimate: &[Isometry3<f64>], reference: &[Isometry3<f64>], name: &str) -> Result<()> {
+    let rpe = relative_pose_errors(estimate, reference)?;
+    println!(
+        "against {name}: reference path {:.1} m, estimated {:.1} m",
+        path_length(reference),
+        path_length(estimate)
+    );
+    let t: Vec<f64> = rpe.iter().map(|e| e.translation).collect();
+    let r: Vec<f64> = rpe.iter().map(|e| e.rotation_deg).collect();
+    if let (Some(t), Some(r)) = (Spread::of(&t), Spread::of(&r)) {
+        println!(
+            "per-frame relative pose error over {} pairs: translation mean {:.4} m, median {:.4} m, \
+             max {:.4} m; rotation mean {:.4}°, median {:.4}°, max {:.4}°",
+            rpe.len(),
+            t.mean,
+            t.median,
+            t.max,
+            r.mean,
+            r.median,
+            r.max
+        );
+    }
+    let last = estimate.len() - 1;
+    let end = (reference[last].inverse() * estimate[last])
+        .translation
+        .vector
+        .norm();
+    let path = path_length(reference);
+    if path >= 1.0 {
+        println!(
+            "end-point drift {end:.3} m ({:.2} % of the reference path)",
+            100.0 * end / path
+        );
+    } else {
+        println!("end-point drift {end:.3} m");
+    }
+    match segment_errors(estimate, reference, &KITTI_SEGMENT_LENGTHS)? {
+        Some(s) => println!(
+            "KITTI segments (100..800 m, {} segments): translation {:.3} %, rotation {:.4} °/100 m",
+            s.segments, s.translation_percent, s.rotation_deg_per_100m
+        ),
+        None => println!("KITTI segment errors: the path is shorter than 100 m"),
+    }
+    Ok(())
+}

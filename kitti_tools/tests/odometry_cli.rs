@@ -1,0 +1,157 @@
+//! `kitti-tools odometry` through the built binary: a folder of scans (the vendored real frame,
+//! twice), the odometry layout with its reference poses, and refused inputs.
+
+mod common;
+use common::{ok, run};
+use std::path::{Path, PathBuf};
+
+fn vendored(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/data/kitti")
+        .join(rel)
+}
+
+fn frame() -> PathBuf {
+    vendored("2011_09_26/2011_09_26_drive_UNKNOWN_sync/velodyne_points/data/0000000000.bin")
+}
+
+/// A folder holding the vendored frame as scans 0 and 1 (a standing sensor).
+fn standing_scans(dir: &Path) -> PathBuf {
+    let scans = dir.join("scans");
+    std::fs::create_dir_all(&scans).unwrap();
+    for k in 0..2 {
+        std::fs::copy(frame(), scans.join(format!("{k:010}.bin"))).unwrap();
+    }
+    scans
+}
+
+fn identity_lines(n: usize) -> String {
+    "1 0 0 0 0 1 0 0 0 0 1 0\n".repeat(n)
+}
+
+#[test]
+fn a_standing_sensor_stays_at_the_origin() {
+    let dir = tempfile::tempdir().unwrap();
+    let scans = standing_scans(dir.path());
+    let out = dir.path().join("poses.txt");
+    let reference = dir.path().join("reference.txt");
+    std::fs::write(&reference, identity_lines(2)).unwrap();
+    let (good, stdout, stderr) = run(&[
+        "odometry",
+        "--scans",
+        scans.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--reference",
+        reference.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(good, "{stdout}\n{stderr}");
+    assert!(
+        stdout.contains("2 scans") && stdout.contains("ms/scan"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("translation mean 0.00"), "{stdout}");
+    let poses = smc_lmb::kitti::odometry::read_odometry_poses(&out).unwrap();
+    assert_eq!(poses.len(), 2);
+    assert!(poses[1].translation.vector.norm() < 1e-3, "{:?}", poses[1]);
+    // Scoring the written file gives the same report without running again.
+    let scored = ok(&common::output(&[
+        "odometry",
+        "--scans",
+        scans.to_str().unwrap(),
+        "--evaluate",
+        out.to_str().unwrap(),
+        "--reference",
+        reference.to_str().unwrap(),
+    ]));
+    assert!(
+        scored.contains("translation mean 0.00") && !scored.contains("ms/scan"),
+        "{scored}"
+    );
+}
+
+#[test]
+fn the_odometry_layout_is_scored_against_its_poses_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("poses.txt");
+    let stdout = ok(&common::output(&[
+        "odometry",
+        "--odometry",
+        vendored("odometry").to_str().unwrap(),
+        "--sequence",
+        "0",
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]));
+    assert!(stdout.contains("2 scans"), "{stdout}");
+    assert!(
+        stdout.contains("00.txt") && stdout.contains("relative pose error"),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn an_empty_folder_is_refused_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("poses.txt");
+    let (good, _, stderr) = run(&[
+        "odometry",
+        "--scans",
+        dir.path().to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!good);
+    assert!(
+        stderr.contains("no .bin scans") && stderr.contains(dir.path().to_str().unwrap()),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn an_empty_scan_is_refused_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let scans = standing_scans(dir.path());
+    std::fs::write(scans.join("0000000002.bin"), b"").unwrap();
+    let out = dir.path().join("poses.txt");
+    let (good, _, stderr) = run(&[
+        "odometry",
+        "--scans",
+        scans.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(!good);
+    assert!(
+        stderr.contains("0000000002.bin") && stderr.contains("no finite point"),
+        "{stderr}"
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_short_reference_is_refused_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let scans = standing_scans(dir.path());
+    let out = dir.path().join("poses.txt");
+    let reference = dir.path().join("short.txt");
+    std::fs::write(&reference, identity_lines(1)).unwrap();
+    let (good, _, stderr) = run(&[
+        "odometry",
+        "--scans",
+        scans.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--reference",
+        reference.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(!good);
+    assert!(
+        stderr.contains("short.txt") && stderr.contains("1 poses for 2 scans"),
+        "{stderr}"
+    );
+}
