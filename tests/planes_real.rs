@@ -192,3 +192,38 @@ fn seed_drive_walls_repeat() {
         assert!(s.median_vertex_distance_m <= 0.3, "{s:?}");
     }
 }
+
+/// The same targets with the ego motion from lidar odometry on the scans instead of OXTS, as
+/// for a recording without poses.
+#[test]
+fn seed_drive_walls_repeat_with_lidar_odometry() {
+    use smc_lmb::cloud::odometry::{odometry_of_frames, OdometryConfig};
+    use smc_lmb::kitti::RawDrive;
+    use smc_lmb::metrics::PlanePredictionSummary;
+    use smc_lmb::pipeline::plane_prediction::{predict_pairs_with_poses, PlanePredictionConfig};
+    let Some(dir) = common::shared_data(SEED_DRIVE) else {
+        return;
+    };
+    let drive = RawDrive::open(&dir).expect("drive");
+    let count = drive.velodyne_count();
+    let load = |k: usize| drive.velodyne(k);
+    let poses = odometry_of_frames(count, &load, &OdometryConfig::default()).unwrap();
+    let config = PlanePredictionConfig::default();
+    let results = predict_pairs_with_poses(
+        0..count - 1,
+        &load,
+        &poses,
+        "drive 0005",
+        &config,
+        1,
+        &mut seeded(1),
+    )
+    .unwrap();
+    let pairs: Vec<_> = results.iter().flat_map(|r| r.pairs.clone()).collect();
+    let s = PlanePredictionSummary::from_pairs(&pairs, &[]);
+    println!("lidar odometry: {s:?}");
+    assert!(s.pairs >= 2 * (count - 1), "{} pairs", s.pairs);
+    assert!(s.median_normal_angle_deg <= 0.5, "{s:?}");
+    assert!(s.p90_normal_angle_deg <= 3.0, "{s:?}");
+    assert!(s.median_vertex_distance_m <= 0.3, "{s:?}");
+}

@@ -51,6 +51,55 @@ pub struct Args {
     /// ours on its drive (2011_09_26 drive 0005) at K = 11 and K = 124.
     #[arg(long, conflicts_with_all = ["all", "json"])]
     paper: bool,
+    /// Where the ego motion comes from: the recording's own poses (OXTS, `poses/NN.txt`),
+    /// lidar odometry on the scans, or `auto` (recorded poses when the recording has them,
+    /// lidar odometry otherwise). Lidar odometry predicts with the measured motion.
+    #[arg(long, value_enum, default_value_t = Ego::Auto)]
+    ego: Ego,
+}
+
+/// Source of the ego motion.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Ego {
+    /// Recorded poses when there are any, lidar odometry otherwise.
+    Auto,
+    /// The recording's poses (fails without them).
+    Recorded,
+    /// Lidar odometry (KISS-ICP's recipe) on the recording's scans.
+    Lidar,
+}
+
+/// The recording `planes` reads.
+enum Input {
+    Drive(RawDrive),
+    Odometry(OdometrySequence),
+    Tracking(TrackingSequence),
+}
+
+impl Input {
+    fn has_poses(&self) -> bool {
+        match self {
+            Input::Drive(d) => d.has_oxts(),
+            Input::Odometry(s) => s.poses_path().is_file(),
+            Input::Tracking(s) => s.has_oxts(),
+        }
+    }
+
+    fn scan_count(&self) -> usize {
+        match self {
+            Input::Drive(d) => d.velodyne_count(),
+            Input::Odometry(s) => s.frame_count(),
+            Input::Tracking(s) => s.velodyne_count(),
+        }
+    }
+
+    fn load(&self, k: usize) -> smc_lmb::error::Result<smc_lmb::cloud::PointCloud> {
+        match self {
+            Input::Drive(d) => d.velodyne(k),
+            Input::Odometry(s) => s.velodyne(k),
+            Input::Tracking(s) => s.velodyne(k),
+        }
+    }
 }
 
 /// Runs the command.
@@ -73,47 +122,87 @@ pub fn run(args: Args) -> Result<()> {
         }
         _ => String::new(),
     };
-    let results: Vec<PairPrediction> = match (&args.drive, &args.odometry, &args.tracking) {
-        (Some(dir), _, _) => {
-            let drive =
-                RawDrive::open(dir).with_context(|| format!("opening drive {}", dir.display()))?;
-            predict_drive_pairs(&drive, frames, &config, args.runs, &mut rng)
-                .with_context(|| format!("predicting planes of drive {}", dir.display()))?
-        }
+    let input = match (&args.drive, &args.odometry, &args.tracking) {
+        (Some(dir), _, _) => Input::Drive(
+            RawDrive::open(dir).with_context(|| format!("opening drive {}", dir.display()))?,
+        ),
         (None, Some(root), _) => {
             let Some(number) = args.sequence else {
                 bail!("--odometry needs --sequence");
             };
-            let seq = OdometrySequence::open(root, number).with_context(|| {
+            Input::Odometry(OdometrySequence::open(root, number).with_context(|| {
                 format!(
                     "opening odometry sequence {number:02} of {}",
                     root.display()
                 )
-            })?;
-            predict_odometry_pairs(&seq, frames, &config, args.runs, &mut rng).with_context(
-                || {
-                    format!(
-                        "predicting planes of odometry sequence {number:02} of {}",
-                        root.display()
-                    )
-                },
-            )?
+            })?)
         }
         (None, None, Some(root)) => {
             let Some(number) = args.sequence else {
                 bail!("--tracking needs --sequence");
             };
-            let what = format!("tracking sequence {number:04} of {}", root.display());
-            let seq =
-                TrackingSequence::open(root, number).with_context(|| format!("opening {what}"))?;
-            predict_tracking_pairs(&seq, frames, &config, args.runs, &mut rng)
-                .with_context(|| format!("predicting planes of {what}"))?
+            Input::Tracking(TrackingSequence::open(root, number).with_context(|| {
+                format!(
+                    "opening tracking sequence {number:04} of {}",
+                    root.display()
+                )
+            })?)
         }
         (None, None, None) => bail!(
             "give --drive DIR, --odometry ROOT --sequence NN or --tracking ROOT --sequence NNNN"
         ),
     };
+    let lidar = match args.ego {
+        Ego::Lidar => true,
+        Ego::Recorded => false,
+        Ego::Auto => !input.has_poses(),
+    };
+    let ego_line = if lidar {
+        "ego motion: lidar odometry on the scans (measured motion)".to_string()
+    } else if args.measured || matches!(input, Input::Odometry(_)) {
+        "ego motion: recorded poses (measured motion)".to_string()
+    } else {
+        format!(
+            "ego motion: vehicle model (ECT, {} Monte-Carlo runs) from the recorded OXTS states",
+            args.runs
+        )
+    };
+    let results: Vec<PairPrediction> = if lidar {
+        let count = input.scan_count();
+        let end = frames.as_ref().map_or(count, |r| (r.end + 1).min(count));
+        let poses = smc_lmb::cloud::odometry::odometry_of_frames(
+            end,
+            &|k| input.load(k),
+            &smc_lmb::cloud::odometry::OdometryConfig::default(),
+        )
+        .with_context(|| format!("lidar odometry on {source}"))?;
+        let frames = frames.unwrap_or(0..end.saturating_sub(1));
+        smc_lmb::pipeline::plane_prediction::predict_pairs_with_poses(
+            frames,
+            &|k| input.load(k),
+            &poses,
+            &source,
+            &config,
+            args.runs,
+            &mut rng,
+        )
+        .with_context(|| format!("predicting planes of {source}"))?
+    } else {
+        match &input {
+            Input::Drive(drive) => predict_drive_pairs(drive, frames, &config, args.runs, &mut rng)
+                .with_context(|| format!("predicting planes of drive {source}"))?,
+            Input::Odometry(seq) => {
+                predict_odometry_pairs(seq, frames, &config, args.runs, &mut rng)
+                    .with_context(|| format!("predicting planes of {source}"))?
+            }
+            Input::Tracking(seq) => {
+                predict_tracking_pairs(seq, frames, &config, args.runs, &mut rng)
+                    .with_context(|| format!("predicting planes of {source}"))?
+            }
+        }
+    };
     if args.paper {
+        println!("{ego_line}");
         for r in &results {
             paper_tables::print(r, args.runs, paper_tables::reference_for(&source, r.frame));
         }
@@ -122,6 +211,7 @@ pub fn run(args: Args) -> Result<()> {
     let (pairs, summary) = pairs_and_summary(&results);
     if args.json {
         let out = serde_json::json!({
+            "ego": ego_line,
             "pairs": pairs,
             "summary": {
                 "median_normal_angle_deg": summary.median_normal_angle_deg,
@@ -135,6 +225,7 @@ pub fn run(args: Args) -> Result<()> {
         println!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
     }
+    println!("{ego_line}");
     print_pairs(&results);
     if args.all {
         print_summary(&summary, results.len());

@@ -103,3 +103,48 @@ fn paper_tables_on_the_papers_drive_find_its_three_walls() {
         "{text}"
     );
 }
+
+#[test]
+fn ego_motion_source_is_chosen_and_said() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    ok(&run(&[
+        "synth",
+        "--out",
+        out.to_str().unwrap(),
+        "--frames",
+        "3",
+        "--seed",
+        "4",
+        "--quiet",
+    ]));
+    let drive = out.join("2020_01_01/2020_01_01_drive_0001_sync");
+    let d = drive.to_str().unwrap();
+    let text = ok(&run(&[
+        "planes", "--drive", d, "--frame", "0", "--runs", "2",
+    ]));
+    assert!(text.starts_with("ego motion: vehicle model (ECT"), "{text}");
+    let text = ok(&run(&[
+        "planes",
+        "--drive",
+        d,
+        "--frame",
+        "0",
+        "--measured",
+    ]));
+    assert!(text.starts_with("ego motion: recorded poses"), "{text}");
+    let text = ok(&run(&[
+        "planes", "--drive", d, "--frame", "0", "--ego", "lidar",
+    ]));
+    assert!(text.starts_with("ego motion: lidar odometry"), "{text}");
+    // Without OXTS, `auto` falls back to lidar odometry and `recorded` is refused.
+    std::fs::remove_dir_all(drive.join("oxts")).unwrap();
+    let text = ok(&run(&[
+        "planes", "--drive", d, "--frame", "0", "--runs", "2",
+    ]));
+    assert!(text.starts_with("ego motion: lidar odometry"), "{text}");
+    assert!(text.contains("frame"), "{text}");
+    let refused = run(&["planes", "--drive", d, "--frame", "0", "--ego", "recorded"]);
+    assert!(!refused.status.success());
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("oxts"));
+}

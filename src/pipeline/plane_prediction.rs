@@ -409,6 +409,23 @@ pub fn predict_tracking_pairs(
     )
 }
 
+/// Plane prediction over the consecutive frame pairs `(k, k + 1)`, `k ∈ frames`, of any
+/// recording, with the measured motion between the given sensor `poses` (sensor → world, one
+/// per frame; e.g. from [`crate::cloud::odometry`] when the recording has no poses of its
+/// own). `source` names the recording in errors.
+pub fn predict_pairs_with_poses(
+    frames: std::ops::Range<usize>,
+    load: &dyn Fn(usize) -> Result<PointCloud>,
+    poses: &[Isometry3<f64>],
+    source: &str,
+    config: &PlanePredictionConfig,
+    runs: usize,
+    rng: &mut FilterRng,
+) -> Result<Vec<PairPrediction>> {
+    check_range(&frames, poses.len(), source)?;
+    predict_sequence(frames, load, poses, None, &[], config, runs, rng)
+}
+
 /// Plane prediction over the consecutive frame pairs of a KITTI odometry sequence (ground-truth
 /// poses, so sequences 00–10 only), always with the measured poses. `None` means every pair.
 pub fn predict_odometry_pairs(

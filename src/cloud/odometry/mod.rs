@@ -43,7 +43,7 @@ mod test_scene;
 
 pub use config::OdometryConfig;
 pub use downsample::{crop_range, voxel_downsample};
-pub use pipeline::{odometry_of_files, LidarOdometry, Registered};
+pub use pipeline::{odometry_of_files, odometry_of_frames, LidarOdometry, Registered};
 pub use registration::{align_points_to_map, Alignment, IcpParams};
 pub use threshold::AdaptiveThreshold;
 pub use voxel_map::{Voxel, VoxelHashMap};

@@ -152,6 +152,24 @@ pub fn odometry_of_files(
     Ok(odometry.poses.clone())
 }
 
+/// Runs the odometry over frames `0..count` given by `load` (e.g. a drive's Velodyne
+/// scans) and returns one pose per frame (scan → first scan). Errors from `load` pass
+/// through; a scan with no point in range is an error naming its frame number.
+pub fn odometry_of_frames(
+    count: usize,
+    load: &dyn Fn(usize) -> Result<PointCloud>,
+    config: &OdometryConfig,
+) -> Result<Vec<Isometry3<f64>>> {
+    if count == 0 {
+        return Err(Error::invalid("odometry scans", "no scans given"));
+    }
+    let mut odometry = LidarOdometry::new(config.clone())?;
+    for k in 0..count {
+        odometry.register(&load(k)?)?;
+    }
+    Ok(odometry.poses.clone())
+}
+
 fn named(path: &Path, e: Error) -> Error {
     match e {
         Error::InvalidInput { reason, .. } => {
