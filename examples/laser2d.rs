@@ -24,7 +24,14 @@
 //!
 //! With `--carmen` or `--bag` a recording is tracked end to end instead (LMB only): per-scan
 //! people as JSON (`--out`), a plot of the tracks over the scan points (`--plot`, `.svg` or
-//! `.png`), and a summary of the tracks on standard output.
+//! `.png`), and a summary of the tracks on standard output. `--truth-topic` scores a bag
+//! against its leg annotations, `--empty` a recording without people:
+//!
+//! ```text
+//! cargo run --release --example laser2d -- --bag positive_1_extracted.bag --topic /training_scan \
+//!     --truth-topic /leg_cluster_positions
+//! cargo run --release --example laser2d -- --bag negative_2.bag --topic /right_scan --empty
+//! ```
 
 use anyhow::{Context, Result};
 use clap::Parser;
@@ -120,6 +127,15 @@ struct Args {
     /// Bearing noise of the recorded scanner (rad).
     #[arg(long, default_value_t = 0.005)]
     sigma_bearing: f64,
+    /// Score a `--bag` recording against its leg annotations on this topic
+    /// (`geometry_msgs/PoseArray`, e.g. `/leg_cluster_positions`): per-scan precision, recall,
+    /// F1 and false people per scan of the front end and of the tracker, and the tracker's
+    /// MOTA, IDF1 and ID switches (rules: `smc_lmb::pipeline::people_tracking::score`).
+    #[arg(long)]
+    truth_topic: Option<String>,
+    /// Score a recording that holds nobody (every person reported is false).
+    #[arg(long, conflicts_with = "truth_topic")]
+    empty: bool,
     /// People farther than this (m) are not tracked in recordings.
     #[arg(long, default_value_t = 15.0)]
     max_range: f64,
@@ -380,7 +396,12 @@ fn print_table(args: &Args, names: &[&str], summaries: &[Summary]) {
 mod recording {
     use super::Args;
     use anyhow::{Context, Result};
-    use smc_lmb::laser2d::{read_bag, read_carmen, BagOptions, CarmenOptions, Scan, TimeOrder};
+    use smc_lmb::laser2d::{
+        read_bag, read_carmen, read_pose_arrays, BagOptions, CarmenOptions, Scan, TimeOrder,
+    };
+    use smc_lmb::pipeline::people_tracking::score::{
+        truth_for_scans, DetectionScore, TrackScore, FIRST_SCORED_SCAN,
+    };
     use smc_lmb::pipeline::people_tracking::{
         config_for_scans, track_scans_with, write_people_json, PeopleRun,
     };
@@ -402,6 +423,7 @@ mod recording {
         )?;
         cfg.filter.seed = args.seed;
         super::apply_lmb_args(args, &mut cfg);
+        let min_visibility = cfg.min_visibility;
         let t0 = Instant::now();
         let fe = super::front_end(args)?;
         println!("front end {}", fe.name());
@@ -415,6 +437,80 @@ mod recording {
                 .with_context(|| format!("plotting {}", path.display()))?;
         }
         report(&scans, &run, read_s, secs);
+        if args.truth_topic.is_some() || args.empty {
+            let truth = truth(args, &scans)?;
+            score(&run, &truth, min_visibility)?;
+        }
+        Ok(())
+    }
+
+    /// The people of every scan: from the annotations of `--truth-topic`, or nobody.
+    fn truth(args: &Args, scans: &[Scan]) -> Result<Vec<Vec<[f64; 2]>>> {
+        let Some(topic) = &args.truth_topic else {
+            return Ok(vec![Vec::new(); scans.len()]);
+        };
+        let path = args
+            .bag
+            .as_ref()
+            .context("--truth-topic needs --bag")?;
+        anyhow::ensure!(
+            args.scans.is_none(),
+            "--truth-topic scores whole recordings: drop --scans"
+        );
+        let annotations = read_pose_arrays(path, topic)
+            .with_context(|| format!("reading {}", path.display()))?;
+        let options = match &args.topic {
+            Some(t) => BagOptions::topic(t.clone()),
+            None => BagOptions::default(),
+        };
+        let received = read_bag(path, &options)?.receive_times;
+        anyhow::ensure!(received.len() == scans.len(), "the bag changed while reading");
+        Ok(truth_for_scans(
+            &received,
+            &annotations,
+            &format!("{} {topic}", path.display()),
+        )?)
+    }
+
+    /// Prints the scores of the front end's people and of the tracker's visible people.
+    fn score(run: &PeopleRun, truth: &[Vec<[f64; 2]>], min_visibility: f64) -> Result<()> {
+        let mut detector = DetectionScore::default();
+        let mut tracks = TrackScore::default();
+        for (s, t) in run.scans.iter().zip(truth) {
+            let scored = s.scan >= FIRST_SCORED_SCAN;
+            if scored {
+                detector.add_scan(t, &s.detections)?;
+            }
+            // Estimates back into the sensor frame of the scan.
+            let to_sensor = |p: [f64; 2]| match s.pose {
+                Some([x, y, th]) => {
+                    let (dx, dy) = (p[0] - x, p[1] - y);
+                    let (sn, cs) = th.sin_cos();
+                    [cs * dx + sn * dy, -sn * dx + cs * dy]
+                }
+                None => p,
+            };
+            let est: Vec<_> = s
+                .people
+                .iter()
+                .filter(|p| p.visibility >= min_visibility)
+                .map(|p| (p.label, to_sensor(p.position)))
+                .collect();
+            tracks.add_scan(t, &est, scored)?;
+        }
+        let line = |what: &str, d: &DetectionScore| {
+            println!(
+                "{what}: {} scans scored, {} people, {} reported; precision {:.3}, recall {:.3}, F1 {:.3}, false people per scan {:.3}",
+                d.scans, d.people, d.estimates, d.precision(), d.recall(), d.f1(), d.false_per_scan()
+            )
+        };
+        line("front end", &detector);
+        let t = tracks.summary();
+        line("tracker", &t.detection);
+        println!(
+            "tracker: MOTA {:.3}, IDF1 {:.3}, ID switches {}",
+            t.mota, t.idf1, t.id_switches
+        );
         Ok(())
     }
 

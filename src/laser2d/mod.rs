@@ -49,7 +49,10 @@ pub use self::moving::{
     MovingCluster, MovingDetections, MovingDetectorConfig, MovingObjectDetector,
 };
 pub use self::person_groups::{person_groups, PersonGroup, PersonGrouping};
-pub use self::rosbag::{bag_topics, read_bag, BagOptions, BagScans, BagTopic, OdometryTopic};
+pub use self::rosbag::{
+    bag_topics, read_bag, read_pose_arrays, BagOptions, BagScans, BagTopic, OdometryTopic,
+    PoseArrayRecord,
+};
 pub use self::scan::{attach_odometry, OdometryRecord, Scan};
 pub use self::segment::{breakpoint_threshold, segment_scan, BreakpointConfig, Segment};
 pub use crate::geometry::Pose2;

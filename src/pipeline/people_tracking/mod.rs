@@ -6,7 +6,8 @@
 //! are classed static or dynamic ([`motion_state`]), a whole recording becomes a
 //! [`PeopleRun`] ([`run`]) drawn by [`plot`], and any tracker — the LMB or a baseline of
 //! [`crate::trackers`] — is scored on a simulated run ([`evaluate`], with the innovations of
-//! [`innovation`] for the consistency checks).
+//! [`innovation`] for the consistency checks); a recording with leg annotations is scored by
+//! [`score`].
 //!
 //! Not for: reading or segmenting scans (see [`crate::laser2d`]) or the baseline trackers
 //! themselves (see [`crate::trackers`]).
@@ -20,6 +21,7 @@ pub mod motion_state;
 #[cfg(feature = "plot")]
 pub mod plot;
 pub mod run;
+pub mod score;
 pub mod tracker;
 
 pub use birth::PeopleBirth;

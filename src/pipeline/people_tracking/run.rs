@@ -36,6 +36,10 @@ pub struct ScanPeople {
     /// Every person of the filter's estimate, visible or not (see
     /// [`PersonEstimate::visibility`]).
     pub people: Vec<PersonEstimate>,
+    /// The front end's people of the scan, `[x, y]` in the sensor frame (what the tracker
+    /// was handed).
+    #[serde(default)]
+    pub detections: Vec<[f64; 2]>,
 }
 
 /// One track over the recording, counted over the scans in which it was reported as visible
@@ -130,6 +134,12 @@ pub fn track_scans_with(
     for (i, scan) in scans.iter().enumerate() {
         let at = |e: Error| Error::invalid(format!("scan {i} (time {})", scan.time), e.to_string());
         let out = fe.measure(scan, scan.odometry).map_err(at)?;
+        let detections = (0..out.measurements.len())
+            .map(|j| {
+                let z = out.measurements.get(j);
+                [z[0] * z[1].cos(), z[0] * z[1].sin()]
+            })
+            .collect();
         let pose = out.corrected_pose.or(scan.odometry);
         tracker.observe(scan);
         let people = tracker
@@ -140,6 +150,7 @@ pub fn track_scans_with(
             time: scan.time,
             pose: pose.map(|p: Pose2| [p.x, p.y, p.theta]),
             people,
+            detections,
         });
     }
     run.tracks = summarise(&run.scans, min_visibility);
@@ -214,18 +225,21 @@ mod tests {
                 time: 0.0,
                 pose: None,
                 people: vec![person(0.0, 0.9, false)],
+                detections: Vec::new(),
             },
             ScanPeople {
                 scan: 1,
                 time: 0.5,
                 pose: None,
                 people: vec![person(0.5, 0.1, true)],
+                detections: Vec::new(),
             },
             ScanPeople {
                 scan: 2,
                 time: 1.0,
                 pose: None,
                 people: vec![person(1.0, 0.8, true)],
+                detections: Vec::new(),
             },
         ];
         let t = summarise(&scans, 0.5);
