@@ -5,7 +5,7 @@
 //! ```text
 //! cargo run --release --example laser2d -- --scenario one --runs 10 --seed 1 [--json]
 //!     [--trackers lmb,gnn,ml_ransac,jpda_imm] [--pose odometry|truth|icp] [--frame robot|world]
-//!     [--front-end segments|moving]
+//!     [--front-end segments|moving|legs]
 //! cargo run --release --example laser2d -- --carmen intel.clf.bz2 [--scans 2000..2600] --out people.json --plot tracks.svg
 //! cargo run --release --example laser2d -- --bag demo.bag --topic /scan --out people.json --plot tracks.png
 //! ```
@@ -71,8 +71,9 @@ struct Args {
     /// got — scores tracking apart from odometry drift) or `world` (drift counts as error).
     #[arg(long, default_value = "robot")]
     frame: String,
-    /// Which returns become measurements: `segments` or `moving`; default by scenario
-    /// (see the program documentation).
+    /// Which returns become measurements: `segments`, `moving` or `legs` (real scans at leg
+    /// height: the boosted leg classifier of `laser2d::legs`); default by scenario (see the
+    /// program documentation).
     #[arg(long)]
     front_end: Option<String>,
     /// Moving front end: which returns count as moving, `clusters` (the detector's moving
@@ -130,7 +131,8 @@ struct Args {
     /// Score a `--bag` recording against its leg annotations on this topic
     /// (`geometry_msgs/PoseArray`, e.g. `/leg_cluster_positions`): per-scan precision, recall,
     /// F1 and false people per scan of the front end and of the tracker, and the tracker's
-    /// MOTA, IDF1 and ID switches (rules: `smc_lmb::pipeline::people_tracking::score`).
+    /// MOTA, IDF1 and ID switches (rules: `smc_lmb::pipeline::people_tracking::score`); the
+    /// tracker is scored on all its visible people and on those classed dynamic.
     #[arg(long)]
     truth_topic: Option<String>,
     /// Score a recording that holds nobody (every person reported is false).
@@ -476,6 +478,7 @@ mod recording {
     fn score(run: &PeopleRun, truth: &[Vec<[f64; 2]>], min_visibility: f64) -> Result<()> {
         let mut detector = DetectionScore::default();
         let mut tracks = TrackScore::default();
+        let mut walking = TrackScore::default();
         for (s, t) in run.scans.iter().zip(truth) {
             let scored = s.scan >= FIRST_SCORED_SCAN;
             if scored {
@@ -490,13 +493,17 @@ mod recording {
                 }
                 None => p,
             };
-            let est: Vec<_> = s
-                .people
-                .iter()
-                .filter(|p| p.visibility >= min_visibility)
+            let visible = s.people.iter().filter(|p| p.visibility >= min_visibility);
+            let est: Vec<_> = visible
+                .clone()
                 .map(|p| (p.label, to_sensor(p.position)))
                 .collect();
             tracks.add_scan(t, &est, scored)?;
+            let est: Vec<_> = visible
+                .filter(|p| p.moving)
+                .map(|p| (p.label, to_sensor(p.position)))
+                .collect();
+            walking.add_scan(t, &est, scored)?;
         }
         let line = |what: &str, d: &DetectionScore| {
             println!(
@@ -505,12 +512,14 @@ mod recording {
             )
         };
         line("front end", &detector);
-        let t = tracks.summary();
-        line("tracker", &t.detection);
-        println!(
-            "tracker: MOTA {:.3}, IDF1 {:.3}, ID switches {}",
-            t.mota, t.idf1, t.id_switches
-        );
+        for (what, acc) in [("tracker", &tracks), ("tracker, dynamic only", &walking)] {
+            let t = acc.summary();
+            line(what, &t.detection);
+            println!(
+                "{what}: MOTA {:.3}, IDF1 {:.3}, ID switches {}",
+                t.mota, t.idf1, t.id_switches
+            );
+        }
         Ok(())
     }
 

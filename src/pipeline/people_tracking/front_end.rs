@@ -11,6 +11,12 @@
 //!   propagated background and the static local map do not explain, in clusters of at least
 //!   three); the person grouping decides what is one person and where its centre is, exactly
 //!   as for `Segments`, so the two front ends differ only in which groups they keep.
+//! * [`FrontEnd::Legs`]: people found by their legs ([`crate::laser2d::legs`]): segments
+//!   classed as legs by the shipped boosted classifier, paired into people. Made for real
+//!   scans of a laser at leg height; the simulated scenarios draw people as discs and keep
+//!   the other two. Without a moving-object detector the corrected pose is the leg
+//!   detector's chain of scan-to-scan alignments ([`LegDetector::pose`]), so that a scanner
+//!   without odometry still sees walls and furniture stand still.
 //!
 //! The detector also refines the odometry by ICP against its local map; the corrected robot
 //! pose is returned with the measurements ([`FrontEndOutput::corrected_pose`]) whenever a
@@ -28,6 +34,7 @@ use crate::geometry::Pose2;
 use crate::laser2d::moving::{
     ClusterStage, MovingDetections, MovingDetectorConfig, MovingObjectDetector,
 };
+use crate::laser2d::legs::LegDetector;
 use crate::laser2d::moving_rule::MovingRule;
 use crate::laser2d::person_groups::{person_groups, PersonGroup};
 use crate::laser2d::Scan;
@@ -42,17 +49,20 @@ pub enum FrontEnd {
     Segments,
     /// Person-sized groups the moving-object detector marks as moving.
     Moving,
+    /// Legs found by the leg classifier, paired into people.
+    Legs,
 }
 
 impl FrontEnd {
-    /// `segments` or `moving`.
+    /// `segments`, `moving` or `legs`.
     pub fn parse(name: &str) -> Result<Self> {
         match name {
             "segments" => Ok(FrontEnd::Segments),
             "moving" => Ok(FrontEnd::Moving),
+            "legs" => Ok(FrontEnd::Legs),
             other => Err(Error::invalid(
                 "front end",
-                format!("`{other}` (expected segments or moving)"),
+                format!("`{other}` (expected segments, moving or legs)"),
             )),
         }
     }
@@ -62,6 +72,7 @@ impl FrontEnd {
         match self {
             FrontEnd::Segments => "segments",
             FrontEnd::Moving => "moving",
+            FrontEnd::Legs => "legs",
         }
     }
 }
@@ -83,6 +94,7 @@ pub struct PersonFrontEnd {
     kind: FrontEnd,
     people: PeopleTrackerConfig,
     detector: Option<MovingObjectDetector>,
+    legs: Option<LegDetector>,
     /// A person group is moving when at least this share of its returns lies on beams of
     /// moving clusters. Default 0.5.
     pub min_moving_share: f64,
@@ -184,7 +196,7 @@ pub fn adapt_tracker_config(people: &mut PeopleTrackerConfig, kind: FrontEnd) {
 impl PersonFrontEnd {
     /// A front end grouping returns as `people` says. A detector runs when `detector` is
     /// given (with [`FrontEnd::Segments`] it only corrects the pose); [`FrontEnd::Moving`]
-    /// needs one.
+    /// needs one; [`FrontEnd::Legs`] runs the shipped leg model ([`LegDetector::shipped`]).
     pub fn new(
         kind: FrontEnd,
         people: &PeopleTrackerConfig,
@@ -200,6 +212,10 @@ impl PersonFrontEnd {
             kind,
             people: people.clone(),
             detector: detector.map(MovingObjectDetector::new).transpose()?,
+            legs: match kind {
+                FrontEnd::Legs => Some(LegDetector::shipped()?),
+                _ => None,
+            },
             min_moving_share: 0.5,
             evidence: MovingEvidence::MovingClusters,
             moving_beams: Vec::new(),
@@ -218,6 +234,21 @@ impl PersonFrontEnd {
             Some(det) => Some(det.process(scan, odometry.unwrap_or(Pose2::new(0.0, 0.0, 0.0)))?),
             None => None,
         };
+        if let Some(legs) = &mut self.legs {
+            let rows: Vec<[f64; 2]> = legs
+                .people(scan)?
+                .iter()
+                .map(|p| [p[0].hypot(p[1]), p[1].atan2(p[0])])
+                .collect();
+            return Ok(FrontEndOutput {
+                measurements: Measurements::from_rows(2, &rows)?,
+                corrected_pose: detections
+                    .as_ref()
+                    .map(|d| d.pose)
+                    .or(Some(legs.pose())),
+                detections,
+            });
+        }
         let groups = person_groups(scan, &person_grouping(&self.people))?;
         let groups = match (&detections, self.kind) {
             (Some(d), FrontEnd::Moving) => {
@@ -350,7 +381,7 @@ mod tests {
         let people = PeopleTrackerConfig::for_scanner(0.03, 0.01, 20.0, 1.5, [0.1, 0.0]);
         assert!(PersonFrontEnd::new(FrontEnd::Moving, &people, None).is_err());
         assert_eq!(sensor_mount(&people), [0.1, 0.0]);
-        for f in [FrontEnd::Segments, FrontEnd::Moving] {
+        for f in [FrontEnd::Segments, FrontEnd::Moving, FrontEnd::Legs] {
             assert_eq!(FrontEnd::parse(f.name()).unwrap(), f);
         }
         assert!(FrontEnd::parse("walls").is_err());
