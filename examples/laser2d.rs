@@ -135,6 +135,9 @@ struct Args {
     /// tracker is scored on all its visible people and on those classed dynamic.
     #[arg(long)]
     truth_topic: Option<String>,
+    /// Legs front end: run this model (JSON, as `train_legs` writes) instead of the shipped one.
+    #[arg(long)]
+    leg_model: Option<std::path::PathBuf>,
     /// Score a recording that holds nobody (every person reported is false).
     #[arg(long, conflicts_with = "truth_topic")]
     empty: bool,
@@ -401,11 +404,12 @@ mod recording {
     use smc_lmb::laser2d::{
         read_bag, read_carmen, read_pose_arrays, BagOptions, CarmenOptions, Scan, TimeOrder,
     };
+    use smc_lmb::laser2d::legs::LegModel;
     use smc_lmb::pipeline::people_tracking::score::{
         truth_for_scans, DetectionScore, TrackScore, FIRST_SCORED_SCAN,
     };
     use smc_lmb::pipeline::people_tracking::{
-        config_for_scans, track_scans_with, write_people_json, PeopleRun,
+        config_for_scans, track_scans_with_model, write_people_json, PeopleRun,
     };
     use smc_lmb::pipeline::people_tracking::{write_people_plot, PeoplePlotOptions};
     use std::path::Path;
@@ -429,7 +433,14 @@ mod recording {
         let t0 = Instant::now();
         let fe = super::front_end(args)?;
         println!("front end {}", fe.name());
-        let run = track_scans_with(&scans, cfg, fe)?;
+        let model = match &args.leg_model {
+            Some(p) => Some(
+                LegModel::from_json(&std::fs::read_to_string(p)?)
+                    .with_context(|| format!("reading {}", p.display()))?,
+            ),
+            None => None,
+        };
+        let run = track_scans_with_model(&scans, cfg, fe, model)?;
         let secs = t0.elapsed().as_secs_f64();
         if let Some(path) = &args.out {
             write_people_json(path, &run).with_context(|| format!("writing {}", path.display()))?;

@@ -44,6 +44,10 @@ struct Args {
     /// Write the model trained on all recordings here.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Write each fold's model here as `fold_<i>.json` (to run the tracker on its held-out
+    /// recordings with `laser2d --leg-model`).
+    #[arg(long)]
+    fold_models: Option<PathBuf>,
 }
 
 const POSITIVE: [&str; 4] = [
@@ -194,8 +198,8 @@ fn score(model: &Boosted, rec: &Recording, cfg: &LegDetectorConfig) -> Result<De
 /// The decision thresholds tried on the held-out folds.
 fn grid(base: &LegDetectorConfig) -> Vec<LegDetectorConfig> {
     let mut out = Vec::new();
-    for leg_score in [-0.2, -0.1, 0.0, 0.1, 0.2] {
-        for single in [-0.1, 0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 1.0] {
+    for leg_score in [-0.05, -0.025, 0.0, 0.025, 0.05, 0.1] {
+        for single in [0.0, 0.025, 0.05, 0.075, 0.1, 0.15, 1.0] {
             if single >= leg_score {
                 out.push(LegDetectorConfig {
                     leg_score,
@@ -226,6 +230,18 @@ fn header(title: &str) {
     println!("|---|---|---|---|---|---|---|");
 }
 
+fn leg_model(model: &Boosted, cfg: &LegDetectorConfig, trained_on: &str) -> LegModel {
+    LegModel {
+        description: format!(
+            "AdaBoost, {} decision stumps on the leg candidates of {trained_on}",
+            model.stumps.len()
+        ),
+        features: LEG_FEATURE_NAMES.iter().map(|s| s.to_string()).collect(),
+        config: *cfg,
+        classifier: model.clone(),
+    }
+}
+
 fn main() -> Result<()> {
     let args = Args::parse();
     let cfg = LegDetectorConfig::default();
@@ -250,6 +266,12 @@ fn main() -> Result<()> {
             )
             .collect();
         let model = train(&train_set, args.rounds)?;
+        if let Some(dir) = &args.fold_models {
+            std::fs::create_dir_all(dir)?;
+            let path = dir.join(format!("fold_{}.json", i + 1));
+            let held = format!("{} and negative_2 {}", pos[i].name, LASERS[held_laser]);
+            std::fs::write(&path, leg_model(&model, &cfg, &format!("fold {}: all but {held}", i + 1)).to_json())?;
+        }
         let (lp, ln) = (scored(&model, &pos[i]), scored(&model, &neg[held_laser]));
         for (k, c) in settings.iter().enumerate() {
             grid_pos[k].merge(&score_legs(&lp, &pos[i], c)?);
@@ -293,18 +315,16 @@ fn main() -> Result<()> {
         row(&r.name, &score(&model, r, &cfg)?);
     }
     if let Some(out) = &args.out {
-        let m = LegModel {
-            description: format!(
-                "AdaBoost, {} decision stumps on the leg candidates of positive_{{1,2,3,4}}_extracted.bag \
-                 and negative_2.bag (all lasers); `cargo run --release --example train_legs -- --rounds {} --out {}`",
-                model.stumps.len(),
+        let m = leg_model(
+            &model,
+            &cfg,
+            &format!(
+                "positive_{{1,2,3,4}}_extracted.bag and negative_2.bag (all lasers); \
+                 `cargo run --release --example train_legs -- --rounds {} --out {}`",
                 args.rounds,
                 out.display()
             ),
-            features: LEG_FEATURE_NAMES.iter().map(|s| s.to_string()).collect(),
-            config: cfg,
-            classifier: model,
-        };
+        );
         std::fs::write(out, m.to_json() + "\n")
             .with_context(|| format!("writing {}", out.display()))?;
         eprintln!("wrote {}", out.display());

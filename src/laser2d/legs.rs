@@ -90,7 +90,7 @@ impl Default for LegDetectorConfig {
             max_width: 0.8,
             max_range: 8.0,
             leg_score: 0.0,
-            single_leg_score: 0.0,
+            single_leg_score: 0.025,
             pair_distance: 0.6,
         }
     }

@@ -34,7 +34,7 @@ use crate::geometry::Pose2;
 use crate::laser2d::moving::{
     ClusterStage, MovingDetections, MovingDetectorConfig, MovingObjectDetector,
 };
-use crate::laser2d::legs::LegDetector;
+use crate::laser2d::legs::{LegDetector, LegModel};
 use crate::laser2d::moving_rule::MovingRule;
 use crate::laser2d::person_groups::{person_groups, PersonGroup};
 use crate::laser2d::Scan;
@@ -220,6 +220,19 @@ impl PersonFrontEnd {
             evidence: MovingEvidence::MovingClusters,
             moving_beams: Vec::new(),
         })
+    }
+
+    /// Runs `model` instead of the shipped leg model (the [`FrontEnd::Legs`] front end
+    /// only; an error for the others).
+    pub fn set_leg_model(&mut self, model: LegModel) -> Result<()> {
+        if self.kind != FrontEnd::Legs {
+            return Err(Error::invalid(
+                "front end",
+                format!("a leg model needs the legs front end, not {}", self.kind.name()),
+            ));
+        }
+        self.legs = Some(LegDetector::new(model)?);
+        Ok(())
     }
 
     /// Which front end this is.

@@ -19,6 +19,7 @@ use crate::error::{Error, Result};
 use crate::filter::Label;
 use crate::geometry::platform_isometry;
 use crate::geometry::Pose2;
+use crate::laser2d::legs::LegModel;
 use crate::laser2d::Scan;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -117,8 +118,19 @@ pub fn track_scans(scans: &[Scan], config: PeopleTrackerConfig) -> Result<People
 /// (see the module documentation; the moving detector takes [`default_detector_config`]).
 pub fn track_scans_with(
     scans: &[Scan],
+    config: PeopleTrackerConfig,
+    front_end: FrontEnd,
+) -> Result<PeopleRun> {
+    track_scans_with_model(scans, config, front_end, None)
+}
+
+/// [`track_scans_with`], the legs front end running `leg_model` instead of the shipped model
+/// when one is given.
+pub fn track_scans_with_model(
+    scans: &[Scan],
     mut config: PeopleTrackerConfig,
     front_end: FrontEnd,
+    leg_model: Option<LegModel>,
 ) -> Result<PeopleRun> {
     let min_visibility = config.min_visibility;
     let detector = match (front_end, scans.first()) {
@@ -129,6 +141,9 @@ pub fn track_scans_with(
     };
     adapt_tracker_config(&mut config, front_end);
     let mut fe = PersonFrontEnd::new(front_end, &config, detector)?;
+    if let Some(model) = leg_model {
+        fe.set_leg_model(model)?;
+    }
     let mut tracker = PeopleTracker::new(config)?;
     let mut run = PeopleRun::default();
     for (i, scan) in scans.iter().enumerate() {
