@@ -401,10 +401,10 @@ fn print_table(args: &Args, names: &[&str], summaries: &[Summary]) {
 mod recording {
     use super::Args;
     use anyhow::{Context, Result};
+    use smc_lmb::laser2d::legs::LegModel;
     use smc_lmb::laser2d::{
         read_bag, read_carmen, read_pose_arrays, BagOptions, CarmenOptions, Scan, TimeOrder,
     };
-    use smc_lmb::laser2d::legs::LegModel;
     use smc_lmb::pipeline::people_tracking::score::{
         truth_for_scans, DetectionScore, TrackScore, FIRST_SCORED_SCAN,
     };
@@ -462,22 +462,22 @@ mod recording {
         let Some(topic) = &args.truth_topic else {
             return Ok(vec![Vec::new(); scans.len()]);
         };
-        let path = args
-            .bag
-            .as_ref()
-            .context("--truth-topic needs --bag")?;
+        let path = args.bag.as_ref().context("--truth-topic needs --bag")?;
         anyhow::ensure!(
             args.scans.is_none(),
             "--truth-topic scores whole recordings: drop --scans"
         );
-        let annotations = read_pose_arrays(path, topic)
-            .with_context(|| format!("reading {}", path.display()))?;
+        let annotations =
+            read_pose_arrays(path, topic).with_context(|| format!("reading {}", path.display()))?;
         let options = match &args.topic {
             Some(t) => BagOptions::topic(t.clone()),
             None => BagOptions::default(),
         };
         let received = read_bag(path, &options)?.receive_times;
-        anyhow::ensure!(received.len() == scans.len(), "the bag changed while reading");
+        anyhow::ensure!(
+            received.len() == scans.len(),
+            "the bag changed while reading"
+        );
         Ok(truth_for_scans(
             &received,
             &annotations,

@@ -114,7 +114,10 @@ fn load(args: &Args, cfg: &LegDetectorConfig) -> Result<(Vec<Recording>, Vec<Rec
         pos.push(Recording {
             name: name.to_string(),
             scans: per_scan,
-            people: legs.iter().map(|l| people_from_legs(l, LEG_MERGE)).collect(),
+            people: legs
+                .iter()
+                .map(|l| people_from_legs(l, LEG_MERGE))
+                .collect(),
         });
     }
     let mut neg = Vec::new();
@@ -179,13 +182,21 @@ fn scored(model: &Boosted, rec: &Recording) -> Vec<Vec<Leg>> {
         .collect()
 }
 
-fn score_legs(legs: &[Vec<Leg>], rec: &Recording, cfg: &LegDetectorConfig) -> Result<DetectionScore> {
+fn score_legs(
+    legs: &[Vec<Leg>],
+    rec: &Recording,
+    cfg: &LegDetectorConfig,
+) -> Result<DetectionScore> {
     let mut d = DetectionScore::default();
     for (k, (s, truth)) in legs.iter().zip(&rec.people).enumerate() {
         if k < FIRST_SCORED_SCAN {
             continue;
         }
-        let legs: Vec<Leg> = s.iter().copied().filter(|l| l.score > cfg.leg_score).collect();
+        let legs: Vec<Leg> = s
+            .iter()
+            .copied()
+            .filter(|l| l.score > cfg.leg_score)
+            .collect();
         d.add_scan(truth, &pair_legs(&legs, cfg))?;
     }
     Ok(d)
@@ -270,7 +281,10 @@ fn main() -> Result<()> {
             std::fs::create_dir_all(dir)?;
             let path = dir.join(format!("fold_{}.json", i + 1));
             let held = format!("{} and negative_2 {}", pos[i].name, LASERS[held_laser]);
-            std::fs::write(&path, leg_model(&model, &cfg, &format!("fold {}: all but {held}", i + 1)).to_json())?;
+            std::fs::write(
+                &path,
+                leg_model(&model, &cfg, &format!("fold {}: all but {held}", i + 1)).to_json(),
+            )?;
         }
         let (lp, ln) = (scored(&model, &pos[i]), scored(&model, &neg[held_laser]));
         for (k, c) in settings.iter().enumerate() {

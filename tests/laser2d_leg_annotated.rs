@@ -16,9 +16,7 @@ use smc_lmb::pipeline::people_tracking::score::{
     legs_for_scans, people_from_legs, truth_for_scans, DetectionScore, TrackScore,
     FIRST_SCORED_SCAN, LEG_MERGE,
 };
-use smc_lmb::pipeline::people_tracking::{
-    config_for_scans, track_scans_with_model, PeopleRun,
-};
+use smc_lmb::pipeline::people_tracking::{config_for_scans, track_scans_with_model, PeopleRun};
 use std::path::PathBuf;
 
 const F1_TARGET: f64 = 0.8;
@@ -89,37 +87,52 @@ fn shipped_on_the_shared_recordings() -> Option<(DetectionScore, DetectionScore)
 fn shipped_detector_reaches_the_f1_target_on_the_shared_recordings() {
     // The four bags are the model's training data: this checks the shipped model and the
     // pipeline end to end, not generalisation (see the held-out test below).
-    let Some((d, _)) = shipped_on_the_shared_recordings() else { return };
+    let Some((d, _)) = shipped_on_the_shared_recordings() else {
+        return;
+    };
     assert!(d.f1() >= F1_TARGET, "detector F1 {:.3}", d.f1());
 }
 
 #[test]
 #[ignore = "target not met: the tracker's F1 on the four bags is 0.79–0.82 depending on the seed (docs/people_real.md)"]
 fn shipped_tracker_reaches_the_f1_target_on_the_shared_recordings() {
-    let Some((_, t)) = shipped_on_the_shared_recordings() else { return };
+    let Some((_, t)) = shipped_on_the_shared_recordings() else {
+        return;
+    };
     assert!(t.f1() >= F1_TARGET, "tracker F1 {:.3}", t.f1());
 }
 
 #[test]
 fn a_missing_annotation_topic_names_the_bag_and_topic() {
-    let Some(p) = bag("negative_2.bag") else { return };
+    let Some(p) = bag("negative_2.bag") else {
+        return;
+    };
     let e = read_pose_arrays(&p, "/leg_cluster_positions")
         .unwrap_err()
         .to_string();
-    assert!(e.contains("negative_2.bag") && e.contains("/leg_cluster_positions"), "{e}");
+    assert!(
+        e.contains("negative_2.bag") && e.contains("/leg_cluster_positions"),
+        "{e}"
+    );
     // One annotation short of the scans: an error naming the source.
     let Some(p) = positive(2) else { return };
     let b = read_bag(&p, &BagOptions::topic("/training_scan")).unwrap();
     let ann = read_pose_arrays(&p, "/leg_cluster_positions").unwrap();
-    let e = truth_for_scans(&b.receive_times, &ann[1..], "positive_2 /leg_cluster_positions")
-        .unwrap_err()
-        .to_string();
+    let e = truth_for_scans(
+        &b.receive_times,
+        &ann[1..],
+        "positive_2 /leg_cluster_positions",
+    )
+    .unwrap_err()
+    .to_string();
     assert!(e.contains("positive_2 /leg_cluster_positions"), "{e}");
 }
 
 #[test]
 fn empty_rooms_stay_empty() {
-    let Some(p) = bag("negative_2.bag") else { return };
+    let Some(p) = bag("negative_2.bag") else {
+        return;
+    };
     for topic in LASERS {
         let scans = read_bag(&p, &BagOptions::topic(topic)).unwrap().scans;
         let truth = vec![Vec::new(); scans.len()];
@@ -144,7 +157,9 @@ fn held_out_recordings_reach_the_f1_target() {
         let legs = legs_for_scans(&b.receive_times, &ann, "test").unwrap();
         bags.push((b.scans, legs));
     }
-    let Some(neg) = bag("negative_2.bag") else { return };
+    let Some(neg) = bag("negative_2.bag") else {
+        return;
+    };
     let shipped = LegModel::shipped().unwrap();
     let finder = {
         let mut m = shipped.clone();
@@ -155,7 +170,12 @@ fn held_out_recordings_reach_the_f1_target() {
     for topic in LASERS {
         let mut f = finder();
         for s in read_bag(&neg, &BagOptions::topic(topic)).unwrap().scans {
-            negatives.extend(f.candidates(&s).unwrap().into_iter().map(|c| c.features.to_vec()));
+            negatives.extend(
+                f.candidates(&s)
+                    .unwrap()
+                    .into_iter()
+                    .map(|c| c.features.to_vec()),
+            );
         }
     }
     let (mut d, mut t) = (DetectionScore::default(), DetectionScore::default());
@@ -184,7 +204,10 @@ fn held_out_recordings_reach_the_f1_target() {
             ..shipped.clone()
         };
         let (scans, legs) = &bags[held];
-        let truth: Vec<_> = legs.iter().map(|l| people_from_legs(l, LEG_MERGE)).collect();
+        let truth: Vec<_> = legs
+            .iter()
+            .map(|l| people_from_legs(l, LEG_MERGE))
+            .collect();
         let (di, ti) = score(&run(scans, Some(model)), &truth);
         d.merge(&di);
         t.merge(&ti);

@@ -76,7 +76,10 @@ impl Boosted {
         if n_pos == 0 || n_pos == n {
             return Err(bad("both classes are needed".into()));
         }
-        let y: Vec<f64> = positive.iter().map(|&p| if p { 1.0 } else { -1.0 }).collect();
+        let y: Vec<f64> = positive
+            .iter()
+            .map(|&p| if p { 1.0 } else { -1.0 })
+            .collect();
         let mut w: Vec<f64> = positive
             .iter()
             .map(|&p| {

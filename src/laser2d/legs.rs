@@ -161,7 +161,10 @@ pub fn leg_segments(
             speed: 0.0,
         };
         let f = segment_features(&pts, &ctx).map_err(|e| {
-            Error::invalid(format!("scan at {} s, beam {}", scan.time, s[0].0), e.to_string())
+            Error::invalid(
+                format!("scan at {} s, beam {}", scan.time, s[0].0),
+                e.to_string(),
+            )
         })?;
         let mut features = [0.0; NUM_LEG_FEATURES];
         features[..13].copy_from_slice(&f[..13]);
@@ -199,15 +202,22 @@ impl LegModel {
 
     /// Parses a model and checks it against this build's features.
     pub fn from_json(text: &str) -> Result<LegModel> {
-        let m: LegModel = serde_json::from_str(text)
-            .map_err(|e| Error::invalid("leg model", e.to_string()))?;
+        let m: LegModel =
+            serde_json::from_str(text).map_err(|e| Error::invalid("leg model", e.to_string()))?;
         if m.features != LEG_FEATURE_NAMES {
             return Err(Error::invalid(
                 "leg model",
-                format!("features {:?} differ from {:?}", m.features, LEG_FEATURE_NAMES),
+                format!(
+                    "features {:?} differ from {:?}",
+                    m.features, LEG_FEATURE_NAMES
+                ),
             ));
         }
-        if m.classifier.stumps.iter().any(|s| s.feature >= NUM_LEG_FEATURES) {
+        if m.classifier
+            .stumps
+            .iter()
+            .any(|s| s.feature >= NUM_LEG_FEATURES)
+        {
             return Err(Error::invalid("leg model", "a stump names no feature"));
         }
         Ok(m)
@@ -395,7 +405,11 @@ mod tests {
             assert!(l.features[5] < 0.13, "width {}", l.features[5]);
             // The wall lies 2 m behind on both sides.
             assert!(l.features[14] > 1.5 && l.features[15] > 1.5);
-            assert!(l.features[8] > 0.02 && l.features[8] < 0.2, "radius {}", l.features[8]);
+            assert!(
+                l.features[8] > 0.02 && l.features[8] < 0.2,
+                "radius {}",
+                l.features[8]
+            );
             assert_eq!(l.features[16], 0.5);
         }
         // The wall itself is far wider than max_width: split into pieces or dropped.
@@ -440,7 +454,10 @@ mod tests {
         let first = d.candidates(&s).unwrap();
         assert!(first.iter().all(|c| c.features[16] == UNKNOWN_MOTION));
         let again = d.candidates(&s).unwrap();
-        assert!(again.iter().all(|c| (0.0..0.01).contains(&c.features[16])), "{again:?}");
+        assert!(
+            again.iter().all(|c| (0.0..0.01).contains(&c.features[16])),
+            "{again:?}"
+        );
     }
 
     #[test]

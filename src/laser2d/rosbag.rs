@@ -98,9 +98,8 @@ pub fn read_pose_arrays(path: impl AsRef<Path>, topic: &str) -> Result<Vec<PoseA
                 continue;
             }
             let k = out.len() + 1;
-            let rec = decode_pose_array(msg.data, msg.time).map_err(|(f, r)| {
-                Error::parse(path, 0, format!("{topic} message {k}: {f}"), r)
-            })?;
+            let rec = decode_pose_array(msg.data, msg.time)
+                .map_err(|(f, r)| Error::parse(path, 0, format!("{topic} message {k}: {f}"), r))?;
             out.push(rec);
         }
     }

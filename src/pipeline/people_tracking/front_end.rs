@@ -31,10 +31,10 @@ use crate::config::MeasurementConfig;
 use crate::error::{Error, Result};
 use crate::filter::Measurements;
 use crate::geometry::Pose2;
+use crate::laser2d::legs::{LegDetector, LegModel};
 use crate::laser2d::moving::{
     ClusterStage, MovingDetections, MovingDetectorConfig, MovingObjectDetector,
 };
-use crate::laser2d::legs::{LegDetector, LegModel};
 use crate::laser2d::moving_rule::MovingRule;
 use crate::laser2d::person_groups::{person_groups, PersonGroup};
 use crate::laser2d::Scan;
@@ -253,7 +253,10 @@ impl PersonFrontEnd {
         if self.kind != FrontEnd::Legs {
             return Err(Error::invalid(
                 "front end",
-                format!("a leg model needs the legs front end, not {}", self.kind.name()),
+                format!(
+                    "a leg model needs the legs front end, not {}",
+                    self.kind.name()
+                ),
             ));
         }
         self.legs = Some(LegDetector::new(model)?);
@@ -280,10 +283,7 @@ impl PersonFrontEnd {
                 .collect();
             return Ok(FrontEndOutput {
                 measurements: Measurements::from_rows(2, &rows)?,
-                corrected_pose: detections
-                    .as_ref()
-                    .map(|d| d.pose)
-                    .or(Some(legs.pose())),
+                corrected_pose: detections.as_ref().map(|d| d.pose).or(Some(legs.pose())),
                 detections,
             });
         }

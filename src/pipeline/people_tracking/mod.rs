@@ -29,8 +29,8 @@ pub use motion_state::{probability_moving, MotionClassifier, MotionConfig};
 #[cfg(feature = "plot")]
 pub use plot::{write_people_plot, PeoplePlotCounts, PeoplePlotOptions};
 pub use run::{
-    config_for_scans, track_scans, track_scans_with, track_scans_with_model, write_people_json, PeopleRun, PersonTrack,
-    ScanPeople,
+    config_for_scans, track_scans, track_scans_with, track_scans_with_model, write_people_json,
+    PeopleRun, PersonTrack, ScanPeople,
 };
 pub use tracker::{
     centre_noise, person_measurements, person_segments, PeopleTracker, PeopleTrackerConfig,

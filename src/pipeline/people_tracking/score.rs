@@ -102,7 +102,11 @@ pub fn legs_for_scans(
         ));
     }
     let mut order: Vec<usize> = (0..annotations.len()).collect();
-    order.sort_by(|&a, &b| annotations[a].receive_time.total_cmp(&annotations[b].receive_time));
+    order.sort_by(|&a, &b| {
+        annotations[a]
+            .receive_time
+            .total_cmp(&annotations[b].receive_time)
+    });
     let times: Vec<f64> = order.iter().map(|&i| annotations[i].receive_time).collect();
     scan_times
         .iter()
@@ -140,7 +144,11 @@ pub fn truth_for_scans(
 pub fn match_people(truth: &[[f64; 2]], estimates: &[[f64; 2]]) -> Result<Vec<Option<usize>>> {
     let t: Vec<&[f64]> = truth.iter().map(|p| &p[..]).collect();
     let e: Vec<&[f64]> = estimates.iter().map(|p| &p[..]).collect();
-    if t.iter().chain(&e).flat_map(|p| p.iter()).any(|v| !v.is_finite()) {
+    if t.iter()
+        .chain(&e)
+        .flat_map(|p| p.iter())
+        .any(|v| !v.is_finite())
+    {
         return Err(Error::invalid("people score", "non-finite position"));
     }
     gated_pairing(&t, &e, MATCH_DISTANCE, 1.0)
@@ -327,7 +335,11 @@ impl TrackScore {
         let idtp = crate::assignment::solve(&cost, truths.len(), cols)
             .map_or(0.0, |(_, total)| 0.0 - total);
         let denom = (d.people + d.estimates) as f64;
-        let idf1 = if denom == 0.0 { 1.0 } else { 2.0 * idtp / denom };
+        let idf1 = if denom == 0.0 {
+            1.0
+        } else {
+            2.0 * idtp / denom
+        };
         TrackScoreSummary {
             detection: d,
             id_switches: switches,
@@ -347,11 +359,11 @@ mod tests {
         assert_eq!(p.len(), 1);
         assert!((p[0][0] - 1.0).abs() < 1e-12 && (p[0][1] - 0.15).abs() < 1e-12);
         // Legs 0.6 m apart or more are two people; four legs, two people.
-        assert_eq!(people_from_legs(&[[0.0, 0.0], [0.0, 0.6]], LEG_MERGE).len(), 2);
-        let four = people_from_legs(
-            &[[1.0, 0.0], [3.0, 0.0], [1.2, 0.0], [3.0, 0.2]],
-            LEG_MERGE,
+        assert_eq!(
+            people_from_legs(&[[0.0, 0.0], [0.0, 0.6]], LEG_MERGE).len(),
+            2
         );
+        let four = people_from_legs(&[[1.0, 0.0], [3.0, 0.0], [1.2, 0.0], [3.0, 0.2]], LEG_MERGE);
         assert_eq!(four.len(), 2);
         assert!((four[0][0] - 1.1).abs() < 1e-12);
         assert!((four[1][1] - 0.1).abs() < 1e-12);
@@ -372,7 +384,8 @@ mod tests {
         assert_eq!(s.false_per_scan(), 0.5);
         // One to one: two estimates at one person, one of them false.
         let mut one = DetectionScore::default();
-        one.add_scan(&[[0.0, 0.0]], &[[0.1, 0.0], [0.0, 0.1]]).unwrap();
+        one.add_scan(&[[0.0, 0.0]], &[[0.1, 0.0], [0.0, 0.1]])
+            .unwrap();
         assert_eq!((one.matched, one.estimates), (1, 2));
         // An empty room: every estimate is false, recall is not defined and reported 1.
         let mut empty = DetectionScore::default();
@@ -404,7 +417,10 @@ mod tests {
         let e = truth_for_scans(&scans, &anns[..1], "b.bag /legs")
             .unwrap_err()
             .to_string();
-        assert!(e.contains("b.bag /legs") && e.contains("1 annotations for 2 scans"), "{e}");
+        assert!(
+            e.contains("b.bag /legs") && e.contains("1 annotations for 2 scans"),
+            "{e}"
+        );
         let late = [ann(1.5, &[]), ann(1.9, &[])];
         let e = truth_for_scans(&scans, &late, "b.bag /legs")
             .unwrap_err()
