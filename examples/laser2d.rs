@@ -5,7 +5,7 @@
 //! ```text
 //! cargo run --release --example laser2d -- --scenario one --runs 10 --seed 1 [--json]
 //!     [--trackers lmb,gnn,ml_ransac,jpda_imm] [--pose odometry|truth|icp] [--frame robot|world]
-//!     [--front-end segments|moving]
+//!     [--front-end segments|moving|legs]
 //! cargo run --release --example laser2d -- --carmen intel.clf.bz2 [--scans 2000..2600] --out people.json --plot tracks.svg
 //! cargo run --release --example laser2d -- --bag demo.bag --topic /scan --out people.json --plot tracks.png
 //! ```
@@ -24,7 +24,14 @@
 //!
 //! With `--carmen` or `--bag` a recording is tracked end to end instead (LMB only): per-scan
 //! people as JSON (`--out`), a plot of the tracks over the scan points (`--plot`, `.svg` or
-//! `.png`), and a summary of the tracks on standard output.
+//! `.png`), and a summary of the tracks on standard output. `--truth-topic` scores a bag
+//! against its leg annotations, `--empty` a recording without people:
+//!
+//! ```text
+//! cargo run --release --example laser2d -- --bag positive_1_extracted.bag --topic /training_scan \
+//!     --truth-topic /leg_cluster_positions
+//! cargo run --release --example laser2d -- --bag negative_2.bag --topic /right_scan --empty
+//! ```
 
 use anyhow::{Context, Result};
 use clap::Parser;
@@ -64,8 +71,9 @@ struct Args {
     /// got — scores tracking apart from odometry drift) or `world` (drift counts as error).
     #[arg(long, default_value = "robot")]
     frame: String,
-    /// Which returns become measurements: `segments` or `moving`; default by scenario
-    /// (see the program documentation).
+    /// Which returns become measurements: `segments`, `moving` or `legs` (real scans at leg
+    /// height: the boosted leg classifier of `laser2d::legs`); default by scenario (see the
+    /// program documentation).
     #[arg(long)]
     front_end: Option<String>,
     /// Moving front end: which returns count as moving, `clusters` (the detector's moving
@@ -120,6 +128,19 @@ struct Args {
     /// Bearing noise of the recorded scanner (rad).
     #[arg(long, default_value_t = 0.005)]
     sigma_bearing: f64,
+    /// Score a `--bag` recording against its leg annotations on this topic
+    /// (`geometry_msgs/PoseArray`, e.g. `/leg_cluster_positions`): per-scan precision, recall,
+    /// F1 and false people per scan of the front end and of the tracker, and the tracker's
+    /// MOTA, IDF1 and ID switches (rules: `smc_lmb::pipeline::people_tracking::score`); the
+    /// tracker is scored on all its visible people and on those classed dynamic.
+    #[arg(long)]
+    truth_topic: Option<String>,
+    /// Legs front end: run this model (JSON, as `train_legs` writes) instead of the shipped one.
+    #[arg(long)]
+    leg_model: Option<std::path::PathBuf>,
+    /// Score a recording that holds nobody (every person reported is false).
+    #[arg(long, conflicts_with = "truth_topic")]
+    empty: bool,
     /// People farther than this (m) are not tracked in recordings.
     #[arg(long, default_value_t = 15.0)]
     max_range: f64,
@@ -380,9 +401,15 @@ fn print_table(args: &Args, names: &[&str], summaries: &[Summary]) {
 mod recording {
     use super::Args;
     use anyhow::{Context, Result};
-    use smc_lmb::laser2d::{read_bag, read_carmen, BagOptions, CarmenOptions, Scan, TimeOrder};
+    use smc_lmb::laser2d::legs::LegModel;
+    use smc_lmb::laser2d::{
+        read_bag, read_carmen, read_pose_arrays, BagOptions, CarmenOptions, Scan, TimeOrder,
+    };
+    use smc_lmb::pipeline::people_tracking::score::{
+        truth_for_scans, DetectionScore, TrackScore, FIRST_SCORED_SCAN,
+    };
     use smc_lmb::pipeline::people_tracking::{
-        config_for_scans, track_scans_with, write_people_json, PeopleRun,
+        config_for_scans, track_scans_with_model, write_people_json, PeopleRun,
     };
     use smc_lmb::pipeline::people_tracking::{write_people_plot, PeoplePlotOptions};
     use std::path::Path;
@@ -402,10 +429,18 @@ mod recording {
         )?;
         cfg.filter.seed = args.seed;
         super::apply_lmb_args(args, &mut cfg);
+        let min_visibility = cfg.min_visibility;
         let t0 = Instant::now();
         let fe = super::front_end(args)?;
         println!("front end {}", fe.name());
-        let run = track_scans_with(&scans, cfg, fe)?;
+        let model = match &args.leg_model {
+            Some(p) => Some(
+                LegModel::from_json(&std::fs::read_to_string(p)?)
+                    .with_context(|| format!("reading {}", p.display()))?,
+            ),
+            None => None,
+        };
+        let run = track_scans_with_model(&scans, cfg, fe, model)?;
         let secs = t0.elapsed().as_secs_f64();
         if let Some(path) = &args.out {
             write_people_json(path, &run).with_context(|| format!("writing {}", path.display()))?;
@@ -415,6 +450,87 @@ mod recording {
                 .with_context(|| format!("plotting {}", path.display()))?;
         }
         report(&scans, &run, read_s, secs);
+        if args.truth_topic.is_some() || args.empty {
+            let truth = truth(args, &scans)?;
+            score(&run, &truth, min_visibility)?;
+        }
+        Ok(())
+    }
+
+    /// The people of every scan: from the annotations of `--truth-topic`, or nobody.
+    fn truth(args: &Args, scans: &[Scan]) -> Result<Vec<Vec<[f64; 2]>>> {
+        let Some(topic) = &args.truth_topic else {
+            return Ok(vec![Vec::new(); scans.len()]);
+        };
+        let path = args.bag.as_ref().context("--truth-topic needs --bag")?;
+        anyhow::ensure!(
+            args.scans.is_none(),
+            "--truth-topic scores whole recordings: drop --scans"
+        );
+        let annotations =
+            read_pose_arrays(path, topic).with_context(|| format!("reading {}", path.display()))?;
+        let options = match &args.topic {
+            Some(t) => BagOptions::topic(t.clone()),
+            None => BagOptions::default(),
+        };
+        let received = read_bag(path, &options)?.receive_times;
+        anyhow::ensure!(
+            received.len() == scans.len(),
+            "the bag changed while reading"
+        );
+        Ok(truth_for_scans(
+            &received,
+            &annotations,
+            &format!("{} {topic}", path.display()),
+        )?)
+    }
+
+    /// Prints the scores of the front end's people and of the tracker's visible people.
+    fn score(run: &PeopleRun, truth: &[Vec<[f64; 2]>], min_visibility: f64) -> Result<()> {
+        let mut detector = DetectionScore::default();
+        let mut tracks = TrackScore::default();
+        let mut walking = TrackScore::default();
+        for (s, t) in run.scans.iter().zip(truth) {
+            let scored = s.scan >= FIRST_SCORED_SCAN;
+            if scored {
+                detector.add_scan(t, &s.detections)?;
+            }
+            // Estimates back into the sensor frame of the scan.
+            let to_sensor = |p: [f64; 2]| match s.pose {
+                Some([x, y, th]) => {
+                    let (dx, dy) = (p[0] - x, p[1] - y);
+                    let (sn, cs) = th.sin_cos();
+                    [cs * dx + sn * dy, -sn * dx + cs * dy]
+                }
+                None => p,
+            };
+            let visible = s.people.iter().filter(|p| p.visibility >= min_visibility);
+            let est: Vec<_> = visible
+                .clone()
+                .map(|p| (p.label, to_sensor(p.position)))
+                .collect();
+            tracks.add_scan(t, &est, scored)?;
+            let est: Vec<_> = visible
+                .filter(|p| p.moving)
+                .map(|p| (p.label, to_sensor(p.position)))
+                .collect();
+            walking.add_scan(t, &est, scored)?;
+        }
+        let line = |what: &str, d: &DetectionScore| {
+            println!(
+                "{what}: {} scans scored, {} people, {} reported; precision {:.3}, recall {:.3}, F1 {:.3}, false people per scan {:.3}",
+                d.scans, d.people, d.estimates, d.precision(), d.recall(), d.f1(), d.false_per_scan()
+            )
+        };
+        line("front end", &detector);
+        for (what, acc) in [("tracker", &tracks), ("tracker, dynamic only", &walking)] {
+            let t = acc.summary();
+            line(what, &t.detection);
+            println!(
+                "{what}: MOTA {:.3}, IDF1 {:.3}, ID switches {}",
+                t.mota, t.idf1, t.id_switches
+            );
+        }
         Ok(())
     }
 

@@ -13,6 +13,8 @@
 //!   [`icp`] (scan matching), [`local_map`] (averaged static points), [`background`]
 //!   (per-beam background map), [`features`] (segment shape features) and [`fuzzy_art`]
 //!   (on-line shape categories); [`moving_rule`] decides which clusters are moving.
+//! * [`legs`]: people found by their legs, segments classed by a boosted classifier
+//!   ([`boost`]) trained on annotated recordings.
 //!
 //! Not for: tracking — segments, person candidates and moving clusters are the hand-over
 //! point to the people-tracking pipeline ([`crate::pipeline::people_tracking`]) — or global
@@ -27,11 +29,13 @@
 //! ```
 
 pub mod background;
+pub mod boost;
 pub mod carmen;
 pub mod csv;
 pub mod features;
 pub mod fuzzy_art;
 pub mod icp;
+pub mod legs;
 pub mod local_map;
 pub mod moving;
 pub mod moving_rule;
@@ -49,7 +53,10 @@ pub use self::moving::{
     MovingCluster, MovingDetections, MovingDetectorConfig, MovingObjectDetector,
 };
 pub use self::person_groups::{person_groups, PersonGroup, PersonGrouping};
-pub use self::rosbag::{bag_topics, read_bag, BagOptions, BagScans, BagTopic, OdometryTopic};
+pub use self::rosbag::{
+    bag_topics, read_bag, read_pose_arrays, BagOptions, BagScans, BagTopic, OdometryTopic,
+    PoseArrayRecord,
+};
 pub use self::scan::{attach_odometry, OdometryRecord, Scan};
 pub use self::segment::{breakpoint_threshold, segment_scan, BreakpointConfig, Segment};
 pub use crate::geometry::Pose2;

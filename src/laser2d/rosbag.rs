@@ -26,6 +26,9 @@
 //! [`Scan`] treats it as "no return". Odometry poses become planar: `theta` is the yaw of
 //! the quaternion; `linear_velocity` is twist.linear.x, `angular_velocity` twist.angular.z.
 //! Each scan gets the latest odometry pose not after its time ([`attach_odometry`]).
+//! [`read_pose_arrays`] reads the `geometry_msgs/PoseArray` messages of one topic (header,
+//! `u32` count, then per pose position x y z and orientation x y z w, f64), e.g. the leg
+//! annotations of a recording; a non-finite position is refused with the message's stamp.
 //! Messages are returned in the bag's storage order; their stamps are not checked for order
 //! (a scan stamped before the one preceding it is returned as it is, and the people tracker
 //! then stops with an error naming that scan).
@@ -40,6 +43,68 @@ use std::path::Path;
 
 const LASER_SCAN: &str = "sensor_msgs/LaserScan";
 const ODOMETRY: &str = "nav_msgs/Odometry";
+const POSE_ARRAY: &str = "geometry_msgs/PoseArray";
+
+/// One `geometry_msgs/PoseArray` message: the positions of its poses (orientations are read
+/// and dropped).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PoseArrayRecord {
+    /// Header stamp (s), or the bag's receive time when the stamp is zero.
+    pub time: f64,
+    /// The bag's receive time (s).
+    pub receive_time: f64,
+    /// `[x, y, z]` of every pose, in the header's frame.
+    pub positions: Vec<[f64; 3]>,
+}
+
+/// Reads every `geometry_msgs/PoseArray` message of `topic` in storage order. A missing
+/// topic, a topic of another type, a malformed message or a non-finite position is an
+/// [`Error::Parse`] naming the bag, the topic and (for a bad message) its time stamp.
+pub fn read_pose_arrays(path: impl AsRef<Path>, topic: &str) -> Result<Vec<PoseArrayRecord>> {
+    let path = path.as_ref();
+    let bag = open_bag(path)?;
+    let conns = connections(&bag, path)?;
+    let ids: Vec<u32> = conns
+        .iter()
+        .filter(|(_, t, ty)| t == topic && ty == POSE_ARRAY)
+        .map(|(id, _, _)| *id)
+        .collect();
+    if ids.is_empty() {
+        let names: Vec<String> = topics_of(&conns)
+            .iter()
+            .map(|t| format!("{} ({})", t.topic, t.message_type))
+            .collect();
+        return Err(Error::parse(
+            path,
+            0,
+            "topic",
+            format!(
+                "`{topic}` is not a {POSE_ARRAY} topic of the bag; topics present: {}",
+                names.join(", ")
+            ),
+        ));
+    }
+    let bag_err = |what: &str, e: ::rosbag::Error| Error::parse(path, 0, what, format!("{e}"));
+    let mut out = Vec::new();
+    for record in bag.chunk_records() {
+        let ChunkRecord::Chunk(chunk) = record.map_err(|e| bag_err("chunk section", e))? else {
+            continue;
+        };
+        for msg in chunk.messages() {
+            let MessageRecord::MessageData(msg) = msg.map_err(|e| bag_err("chunk", e))? else {
+                continue;
+            };
+            if !ids.contains(&msg.conn_id) {
+                continue;
+            }
+            let k = out.len() + 1;
+            let rec = decode_pose_array(msg.data, msg.time)
+                .map_err(|(f, r)| Error::parse(path, 0, format!("{topic} message {k}: {f}"), r))?;
+            out.push(rec);
+        }
+    }
+    Ok(out)
+}
 
 /// A topic stored in a bag, with its message type.
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -88,6 +153,9 @@ impl BagOptions {
 pub struct BagScans {
     /// The scans, in storage order.
     pub scans: Vec<Scan>,
+    /// The bag's receive time (s) of every scan, for pairing with other topics when the
+    /// header stamps of the topics come from different clocks.
+    pub receive_times: Vec<f64>,
     /// The odometry records, in storage order (empty without an odometry topic).
     pub odometry: Vec<OdometryRecord>,
     /// The topic the scans came from.
@@ -201,6 +269,7 @@ pub fn read_bag(path: impl AsRef<Path>, options: &BagOptions) -> Result<BagScans
 
     let bag_err = |what: &str, e: ::rosbag::Error| Error::parse(path, 0, what, format!("{e}"));
     let mut scans = Vec::new();
+    let mut receive_times = Vec::new();
     let mut odometry = Vec::new();
     for record in bag.chunk_records() {
         let ChunkRecord::Chunk(chunk) = record.map_err(|e| bag_err("chunk section", e))? else {
@@ -217,6 +286,7 @@ pub fn read_bag(path: impl AsRef<Path>, options: &BagOptions) -> Result<BagScans
                         Error::parse(path, 0, format!("{scan_topic} message {k}: {f}"), r)
                     })?;
                     scans.push(scan);
+                    receive_times.push(msg.time as f64 * 1e-9);
                 }
                 Some(Feed::Odometry) => {
                     let k = odometry.len() + 1;
@@ -235,6 +305,7 @@ pub fn read_bag(path: impl AsRef<Path>, options: &BagOptions) -> Result<BagScans
     }
     Ok(BagScans {
         scans,
+        receive_times,
         odometry,
         scan_topic,
         odometry_topic,
@@ -481,6 +552,42 @@ fn laser_scan_to_scan(data: &[u8], receive_ns: u64) -> DecodeResult<Scan> {
     })
 }
 
+/// Decodes a `geometry_msgs/PoseArray`: header, then a `u32` count of poses, each position
+/// x y z and orientation x y z w (f64). A non-finite position is refused with the stamp.
+fn decode_pose_array(data: &[u8], receive_ns: u64) -> DecodeResult<PoseArrayRecord> {
+    let mut b = Bytes::new(data);
+    let time = b.header(receive_ns)?;
+    let n = b.u32("poses")? as usize;
+    if n.saturating_mul(56) > data.len() {
+        return Err((
+            "poses".into(),
+            format!("{n} poses cannot fit in a message of {} bytes", data.len()),
+        ));
+    }
+    let mut positions = Vec::with_capacity(n);
+    for i in 0..n {
+        let x = b.f64("poses.position.x")?;
+        let y = b.f64("poses.position.y")?;
+        let z = b.f64("poses.position.z")?;
+        for f in ["x", "y", "z", "w"] {
+            b.f64(&format!("poses.orientation.{f}"))?;
+        }
+        if !(x.is_finite() && y.is_finite() && z.is_finite()) {
+            return Err((
+                format!("poses[{i}].position"),
+                format!("[{x}, {y}, {z}] is not finite (stamp {time:.9} s)"),
+            ));
+        }
+        positions.push([x, y, z]);
+    }
+    b.finish("poses")?;
+    Ok(PoseArrayRecord {
+        time,
+        receive_time: receive_ns as f64 * 1e-9,
+        positions,
+    })
+}
+
 /// Decodes a `nav_msgs/Odometry` into a planar [`OdometryRecord`].
 fn decode_odometry(data: &[u8], receive_ns: u64) -> DecodeResult<OdometryRecord> {
     let mut b = Bytes::new(data);
@@ -649,6 +756,41 @@ mod tests {
             decode_odometry(&m[..m.len() - 1], 0).unwrap_err().0,
             "twist.covariance"
         );
+    }
+
+    fn pose_array_bytes(points: &[[f64; 3]]) -> Vec<u8> {
+        let mut m = Vec::new();
+        header(&mut m, 4, 250_000_000);
+        m.extend((points.len() as u32).to_le_bytes());
+        for p in points {
+            for v in [p[0], p[1], p[2], 0.0, 0.0, 0.0, 1.0] {
+                m.extend(f64::to_le_bytes(v));
+            }
+        }
+        m
+    }
+
+    #[test]
+    fn pose_arrays_decode_and_nan_is_refused_with_its_stamp() {
+        let m = pose_array_bytes(&[[1.0, 2.0, 0.0], [-0.5, 0.25, 0.1]]);
+        let r = decode_pose_array(&m, 9_000_000_000).unwrap();
+        assert_eq!(r.time, 4.25);
+        assert_eq!(r.receive_time, 9.0);
+        assert_eq!(r.positions, vec![[1.0, 2.0, 0.0], [-0.5, 0.25, 0.1]]);
+        assert!(decode_pose_array(&pose_array_bytes(&[]), 0)
+            .unwrap()
+            .positions
+            .is_empty());
+        let (field, reason) =
+            decode_pose_array(&pose_array_bytes(&[[f64::NAN, 0.0, 0.0]]), 0).unwrap_err();
+        assert_eq!(field, "poses[0].position");
+        assert!(reason.contains("4.25"), "{reason}");
+        for cut in 0..m.len() {
+            assert!(decode_pose_array(&m[..cut], 0).is_err(), "cut at {cut}");
+        }
+        let mut huge = m[..21].to_vec();
+        huge.extend(u32::MAX.to_le_bytes());
+        assert_eq!(decode_pose_array(&huge, 0).unwrap_err().0, "poses");
     }
 
     #[test]

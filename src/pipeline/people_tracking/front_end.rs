@@ -11,6 +11,12 @@
 //!   propagated background and the static local map do not explain, in clusters of at least
 //!   three); the person grouping decides what is one person and where its centre is, exactly
 //!   as for `Segments`, so the two front ends differ only in which groups they keep.
+//! * [`FrontEnd::Legs`]: people found by their legs ([`crate::laser2d::legs`]): segments
+//!   classed as legs by the shipped boosted classifier, paired into people. Made for real
+//!   scans of a laser at leg height; the simulated scenarios draw people as discs and keep
+//!   the other two. Without a moving-object detector the corrected pose is the leg
+//!   detector's chain of scan-to-scan alignments ([`LegDetector::pose`]), so that a scanner
+//!   without odometry still sees walls and furniture stand still.
 //!
 //! The detector also refines the odometry by ICP against its local map; the corrected robot
 //! pose is returned with the measurements ([`FrontEndOutput::corrected_pose`]) whenever a
@@ -25,6 +31,7 @@ use crate::config::MeasurementConfig;
 use crate::error::{Error, Result};
 use crate::filter::Measurements;
 use crate::geometry::Pose2;
+use crate::laser2d::legs::{LegDetector, LegModel};
 use crate::laser2d::moving::{
     ClusterStage, MovingDetections, MovingDetectorConfig, MovingObjectDetector,
 };
@@ -42,17 +49,20 @@ pub enum FrontEnd {
     Segments,
     /// Person-sized groups the moving-object detector marks as moving.
     Moving,
+    /// Legs found by the leg classifier, paired into people.
+    Legs,
 }
 
 impl FrontEnd {
-    /// `segments` or `moving`.
+    /// `segments`, `moving` or `legs`.
     pub fn parse(name: &str) -> Result<Self> {
         match name {
             "segments" => Ok(FrontEnd::Segments),
             "moving" => Ok(FrontEnd::Moving),
+            "legs" => Ok(FrontEnd::Legs),
             other => Err(Error::invalid(
                 "front end",
-                format!("`{other}` (expected segments or moving)"),
+                format!("`{other}` (expected segments, moving or legs)"),
             )),
         }
     }
@@ -62,6 +72,7 @@ impl FrontEnd {
         match self {
             FrontEnd::Segments => "segments",
             FrontEnd::Moving => "moving",
+            FrontEnd::Legs => "legs",
         }
     }
 }
@@ -83,6 +94,7 @@ pub struct PersonFrontEnd {
     kind: FrontEnd,
     people: PeopleTrackerConfig,
     detector: Option<MovingObjectDetector>,
+    legs: Option<LegDetector>,
     /// A person group is moving when at least this share of its returns lies on beams of
     /// moving clusters. Default 0.5.
     pub min_moving_share: f64,
@@ -163,11 +175,36 @@ pub const MOVING_CONFIRM_DETECTIONS: f64 = 5.0;
 /// 0.08 (scenario one) and 0.12 (lobby) per scan, rounded up for recordings.
 pub const MOVING_CLUTTER_RATE: f64 = 0.3;
 
+/// p_D the tracker assumes behind [`FrontEnd::Legs`]. With [`LEGS_CONFIRM_DETECTIONS`],
+/// chosen on the pooled leave-one-bag-out folds of the annotated `leg_tracker` bags (the
+/// held-out positive bags and the held-out lasers of `negative_2.bag`; tracker F1 / false
+/// people per empty-room scan): the tracker's defaults (p_D 0.9, no confirmation count) 0.756
+/// / 0.31; p_D 0.9 with 5 detections 0.696 / 0.039; p_D 0.7 with 6, 7, 8 detections 0.751 /
+/// 0.058, 0.735 / 0.045, 0.719 / 0.009. A low p_D keeps a person whose legs the detector
+/// misses for a few scans; the confirmation count keeps furniture legs that are found now
+/// and then from becoming people.
+pub const LEGS_DETECTION_PROBABILITY: f64 = 0.7;
+
+/// Expected detections before a track behind [`FrontEnd::Legs`] is reported (see
+/// [`LEGS_DETECTION_PROBABILITY`]).
+pub const LEGS_CONFIRM_DETECTIONS: f64 = 8.0;
+
 /// Adapts the LMB people tracker to the front end `kind`: behind [`FrontEnd::Moving`] misses
 /// come in runs ([`MOVING_DETECTABILITY`], p_D [`MOVING_DETECTABLE_PROBABILITY`] while
 /// detectable), tracks are confirmed after [`MOVING_CONFIRM_DETECTIONS`] and the clutter rate
-/// is [`MOVING_CLUTTER_RATE`]; the segment front end keeps the tracker's own settings.
+/// is [`MOVING_CLUTTER_RATE`]; behind [`FrontEnd::Legs`] p_D is [`LEGS_DETECTION_PROBABILITY`]
+/// and tracks are confirmed after [`LEGS_CONFIRM_DETECTIONS`]; the segment front end keeps
+/// the tracker's own settings.
 pub fn adapt_tracker_config(people: &mut PeopleTrackerConfig, kind: FrontEnd) {
+    if kind == FrontEnd::Legs {
+        if let crate::config::DetectionConfig::FieldOfView { p_inside, .. } =
+            &mut people.filter.detection
+        {
+            *p_inside = LEGS_DETECTION_PROBABILITY;
+        }
+        people.confirm_detections = LEGS_CONFIRM_DETECTIONS;
+        return;
+    }
     if kind != FrontEnd::Moving {
         return;
     }
@@ -184,7 +221,7 @@ pub fn adapt_tracker_config(people: &mut PeopleTrackerConfig, kind: FrontEnd) {
 impl PersonFrontEnd {
     /// A front end grouping returns as `people` says. A detector runs when `detector` is
     /// given (with [`FrontEnd::Segments`] it only corrects the pose); [`FrontEnd::Moving`]
-    /// needs one.
+    /// needs one; [`FrontEnd::Legs`] runs the shipped leg model ([`LegDetector::shipped`]).
     pub fn new(
         kind: FrontEnd,
         people: &PeopleTrackerConfig,
@@ -200,10 +237,30 @@ impl PersonFrontEnd {
             kind,
             people: people.clone(),
             detector: detector.map(MovingObjectDetector::new).transpose()?,
+            legs: match kind {
+                FrontEnd::Legs => Some(LegDetector::shipped()?),
+                _ => None,
+            },
             min_moving_share: 0.5,
             evidence: MovingEvidence::MovingClusters,
             moving_beams: Vec::new(),
         })
+    }
+
+    /// Runs `model` instead of the shipped leg model (the [`FrontEnd::Legs`] front end
+    /// only; an error for the others).
+    pub fn set_leg_model(&mut self, model: LegModel) -> Result<()> {
+        if self.kind != FrontEnd::Legs {
+            return Err(Error::invalid(
+                "front end",
+                format!(
+                    "a leg model needs the legs front end, not {}",
+                    self.kind.name()
+                ),
+            ));
+        }
+        self.legs = Some(LegDetector::new(model)?);
+        Ok(())
     }
 
     /// Which front end this is.
@@ -218,6 +275,18 @@ impl PersonFrontEnd {
             Some(det) => Some(det.process(scan, odometry.unwrap_or(Pose2::new(0.0, 0.0, 0.0)))?),
             None => None,
         };
+        if let Some(legs) = &mut self.legs {
+            let rows: Vec<[f64; 2]> = legs
+                .people(scan)?
+                .iter()
+                .map(|p| [p[0].hypot(p[1]), p[1].atan2(p[0])])
+                .collect();
+            return Ok(FrontEndOutput {
+                measurements: Measurements::from_rows(2, &rows)?,
+                corrected_pose: detections.as_ref().map(|d| d.pose).or(Some(legs.pose())),
+                detections,
+            });
+        }
         let groups = person_groups(scan, &person_grouping(&self.people))?;
         let groups = match (&detections, self.kind) {
             (Some(d), FrontEnd::Moving) => {
@@ -350,10 +419,25 @@ mod tests {
         let people = PeopleTrackerConfig::for_scanner(0.03, 0.01, 20.0, 1.5, [0.1, 0.0]);
         assert!(PersonFrontEnd::new(FrontEnd::Moving, &people, None).is_err());
         assert_eq!(sensor_mount(&people), [0.1, 0.0]);
-        for f in [FrontEnd::Segments, FrontEnd::Moving] {
+        for f in [FrontEnd::Segments, FrontEnd::Moving, FrontEnd::Legs] {
             assert_eq!(FrontEnd::parse(f.name()).unwrap(), f);
         }
         assert!(FrontEnd::parse("walls").is_err());
+    }
+
+    #[test]
+    fn the_tracker_behind_the_legs_front_end_confirms_late() {
+        let base = PeopleTrackerConfig::for_scanner(0.03, 0.01, 20.0, 1.5, [0.0, 0.0]);
+        let mut legs = base.clone();
+        adapt_tracker_config(&mut legs, FrontEnd::Legs);
+        assert_eq!(legs.confirm_detections, LEGS_CONFIRM_DETECTIONS);
+        assert!(matches!(
+            legs.filter.detection,
+            crate::config::DetectionConfig::FieldOfView { p_inside, .. }
+                if p_inside == LEGS_DETECTION_PROBABILITY
+        ));
+        assert_eq!(legs.filter.clutter, base.filter.clutter);
+        assert_eq!(legs.detectability, None);
     }
 
     #[test]

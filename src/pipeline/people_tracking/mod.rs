@@ -6,7 +6,8 @@
 //! are classed static or dynamic ([`motion_state`]), a whole recording becomes a
 //! [`PeopleRun`] ([`run`]) drawn by [`plot`], and any tracker — the LMB or a baseline of
 //! [`crate::trackers`] — is scored on a simulated run ([`evaluate`], with the innovations of
-//! [`innovation`] for the consistency checks).
+//! [`innovation`] for the consistency checks); a recording with leg annotations is scored by
+//! [`score`].
 //!
 //! Not for: reading or segmenting scans (see [`crate::laser2d`]) or the baseline trackers
 //! themselves (see [`crate::trackers`]).
@@ -20,6 +21,7 @@ pub mod motion_state;
 #[cfg(feature = "plot")]
 pub mod plot;
 pub mod run;
+pub mod score;
 pub mod tracker;
 
 pub use birth::PeopleBirth;
@@ -27,8 +29,8 @@ pub use motion_state::{probability_moving, MotionClassifier, MotionConfig};
 #[cfg(feature = "plot")]
 pub use plot::{write_people_plot, PeoplePlotCounts, PeoplePlotOptions};
 pub use run::{
-    config_for_scans, track_scans, track_scans_with, write_people_json, PeopleRun, PersonTrack,
-    ScanPeople,
+    config_for_scans, track_scans, track_scans_with, track_scans_with_model, write_people_json,
+    PeopleRun, PersonTrack, ScanPeople,
 };
 pub use tracker::{
     centre_noise, person_measurements, person_segments, PeopleTracker, PeopleTrackerConfig,

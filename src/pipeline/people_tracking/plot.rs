@@ -523,6 +523,7 @@ mod tests {
                     person(Label::new(0, 0), k as f64, true, seen),
                     person(Label::new(1, 0), 2.0, false, 1.0),
                 ],
+                detections: Vec::new(),
             });
         }
         let track = |label, scans, dynamic_fraction| PersonTrack {

@@ -19,6 +19,7 @@ use crate::error::{Error, Result};
 use crate::filter::Label;
 use crate::geometry::platform_isometry;
 use crate::geometry::Pose2;
+use crate::laser2d::legs::LegModel;
 use crate::laser2d::Scan;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -36,6 +37,10 @@ pub struct ScanPeople {
     /// Every person of the filter's estimate, visible or not (see
     /// [`PersonEstimate::visibility`]).
     pub people: Vec<PersonEstimate>,
+    /// The front end's people of the scan, `[x, y]` in the sensor frame (what the tracker
+    /// was handed).
+    #[serde(default)]
+    pub detections: Vec<[f64; 2]>,
 }
 
 /// One track over the recording, counted over the scans in which it was reported as visible
@@ -113,8 +118,19 @@ pub fn track_scans(scans: &[Scan], config: PeopleTrackerConfig) -> Result<People
 /// (see the module documentation; the moving detector takes [`default_detector_config`]).
 pub fn track_scans_with(
     scans: &[Scan],
+    config: PeopleTrackerConfig,
+    front_end: FrontEnd,
+) -> Result<PeopleRun> {
+    track_scans_with_model(scans, config, front_end, None)
+}
+
+/// [`track_scans_with`], the legs front end running `leg_model` instead of the shipped model
+/// when one is given.
+pub fn track_scans_with_model(
+    scans: &[Scan],
     mut config: PeopleTrackerConfig,
     front_end: FrontEnd,
+    leg_model: Option<LegModel>,
 ) -> Result<PeopleRun> {
     let min_visibility = config.min_visibility;
     let detector = match (front_end, scans.first()) {
@@ -125,11 +141,20 @@ pub fn track_scans_with(
     };
     adapt_tracker_config(&mut config, front_end);
     let mut fe = PersonFrontEnd::new(front_end, &config, detector)?;
+    if let Some(model) = leg_model {
+        fe.set_leg_model(model)?;
+    }
     let mut tracker = PeopleTracker::new(config)?;
     let mut run = PeopleRun::default();
     for (i, scan) in scans.iter().enumerate() {
         let at = |e: Error| Error::invalid(format!("scan {i} (time {})", scan.time), e.to_string());
         let out = fe.measure(scan, scan.odometry).map_err(at)?;
+        let detections = (0..out.measurements.len())
+            .map(|j| {
+                let z = out.measurements.get(j);
+                [z[0] * z[1].cos(), z[0] * z[1].sin()]
+            })
+            .collect();
         let pose = out.corrected_pose.or(scan.odometry);
         tracker.observe(scan);
         let people = tracker
@@ -140,6 +165,7 @@ pub fn track_scans_with(
             time: scan.time,
             pose: pose.map(|p: Pose2| [p.x, p.y, p.theta]),
             people,
+            detections,
         });
     }
     run.tracks = summarise(&run.scans, min_visibility);
@@ -214,18 +240,21 @@ mod tests {
                 time: 0.0,
                 pose: None,
                 people: vec![person(0.0, 0.9, false)],
+                detections: Vec::new(),
             },
             ScanPeople {
                 scan: 1,
                 time: 0.5,
                 pose: None,
                 people: vec![person(0.5, 0.1, true)],
+                detections: Vec::new(),
             },
             ScanPeople {
                 scan: 2,
                 time: 1.0,
                 pose: None,
                 people: vec![person(1.0, 0.8, true)],
+                detections: Vec::new(),
             },
         ];
         let t = summarise(&scans, 0.5);

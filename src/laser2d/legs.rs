@@ -1,0 +1,472 @@
+//! People in a planar scan found by their legs: segments of returns described by the
+//! geometric features of Arras, Mozos & Burgard (ICRA 2007, [`super::features`]), classed
+//! leg or not by a boosted classifier ([`super::boost`]) trained on annotated recordings,
+//! and legs paired into people.
+//!
+//! 1. **Segments** ([`leg_segments`]): consecutive returns (in beam order, across "no
+//!    return" beams) closer than [`LegDetectorConfig::cluster_distance`] (0.13 m, as the ROS
+//!    `leg_tracker`) are one segment; segments with fewer than `min_points` returns, wider
+//!    than `max_width` or farther than `max_range` are dropped.
+//! 2. **Features** ([`leg_features`], [`NUM_LEG_FEATURES`]): the thirteen shape features of
+//!    [`super::features`] without the speed (number of points, standard deviation, mean
+//!    deviation from the median, jump distances to the preceding and succeeding segments,
+//!    width, linearity, circularity, radius, boundary length and regularity, mean curvature,
+//!    mean angular difference), then the range of the centroid and the occlusion of each end
+//!    (neighbour end range minus own end range, clipped to ±2 m; +2 m with no neighbour),
+//!    and the motion: the scan is aligned onto the previous scan by ICP ([`super::icp`]:
+//!    the scanner's own motion, no odometry needed) and the motion is the mean distance
+//!    from the segment's aligned returns to the nearest return of the previous scan, capped
+//!    at 1 m (−1 on the first scan or when the alignment fails). Walls and furniture stay
+//!    put; a walking person's legs do not.
+//! 3. **Legs**: a segment whose boosted score exceeds [`LegDetectorConfig::leg_score`].
+//! 4. **People** ([`pair_legs`]): legs closer than `pair_distance` are paired, closest pairs
+//!    first, into a person at their mean; a leg left alone is a person only when its score
+//!    exceeds `single_leg_score` (the other leg hidden behind it).
+//!
+//! The shipped model ([`LegModel::shipped`], `leg_model.json` beside this file) is trained
+//! by `cargo run --release --example train_legs` on the annotated recordings of
+//! `../shared/data/laser2d/leg_annotated` (see `docs/people_real.md`).
+//!
+//! Not for: tracking people over scans, or scans in which legs are not visible (a laser at
+//! torso height).
+
+use super::boost::Boosted;
+use super::features::{segment_features, SegmentContext};
+use super::icp::{Icp, IcpConfig};
+use super::scan::Scan;
+use crate::error::{Error, Result};
+use crate::geometry::pose2::{compose, identity, transform_point};
+use crate::geometry::Pose2;
+use serde::{Deserialize, Serialize};
+
+/// Number of features of a leg candidate.
+pub const NUM_LEG_FEATURES: usize = 17;
+
+/// Feature names, in [`leg_features`] order.
+pub const LEG_FEATURE_NAMES: [&str; NUM_LEG_FEATURES] = [
+    "points",
+    "std_dev",
+    "mad_median",
+    "jump_prev",
+    "jump_next",
+    "width",
+    "linearity",
+    "circularity",
+    "radius",
+    "boundary_length",
+    "boundary_regularity",
+    "mean_curvature",
+    "mean_angular_difference",
+    "range",
+    "occlusion_prev",
+    "occlusion_next",
+    "motion",
+];
+
+/// Settings of the detector (see the module documentation).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LegDetectorConfig {
+    /// Consecutive returns closer than this are one segment (m).
+    pub cluster_distance: f64,
+    /// Fewest returns of a leg candidate.
+    pub min_points: usize,
+    /// Widest leg candidate (m).
+    pub max_width: f64,
+    /// Farthest leg candidate (m).
+    pub max_range: f64,
+    /// A candidate is a leg when its score exceeds this.
+    pub leg_score: f64,
+    /// A leg without a partner is a person when its score exceeds this.
+    pub single_leg_score: f64,
+    /// Legs closer than this are one person (m).
+    pub pair_distance: f64,
+}
+
+impl Default for LegDetectorConfig {
+    fn default() -> Self {
+        LegDetectorConfig {
+            cluster_distance: 0.13,
+            min_points: 3,
+            max_width: 0.8,
+            max_range: 8.0,
+            leg_score: 0.0,
+            single_leg_score: 0.025,
+            pair_distance: 0.6,
+        }
+    }
+}
+
+/// One leg candidate.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LegCandidate {
+    /// First and one-past-last beam.
+    pub beams: (usize, usize),
+    /// Centroid of its returns, sensor frame (m).
+    pub centroid: [f64; 2],
+    /// Its features.
+    pub features: [f64; NUM_LEG_FEATURES],
+}
+
+/// The leg candidates of `scan` (steps 1 and 2 of the module documentation); `motion` gives
+/// the motion feature of a segment's returns ([`LegDetector::candidates`] measures it against
+/// the previous scan).
+pub fn leg_segments(
+    scan: &Scan,
+    config: &LegDetectorConfig,
+    motion: &dyn Fn(&[[f64; 2]]) -> f64,
+) -> Result<Vec<LegCandidate>> {
+    // Every segment, filtered or not, so that jumps and occlusions see all neighbours.
+    let mut segs: Vec<Vec<(usize, [f64; 2])>> = Vec::new();
+    let mut last: Option<[f64; 2]> = None;
+    for (i, p) in scan.points() {
+        let near = last.is_some_and(|q| (p[0] - q[0]).hypot(p[1] - q[1]) < config.cluster_distance);
+        if near {
+            segs.last_mut().expect("a segment").push((i, p));
+        } else {
+            segs.push(vec![(i, p)]);
+        }
+        last = Some(p);
+    }
+    let norm = |p: [f64; 2]| p[0].hypot(p[1]);
+    let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+    let mut out = Vec::new();
+    let mut pts: Vec<[f64; 2]> = Vec::new();
+    for (k, s) in segs.iter().enumerate() {
+        if s.len() < config.min_points {
+            continue;
+        }
+        let (first, lastp) = (s[0].1, s[s.len() - 1].1);
+        if dist(first, lastp) > config.max_width {
+            continue;
+        }
+        pts.clear();
+        pts.extend(s.iter().map(|x| x.1));
+        let n = pts.len() as f64;
+        let c = pts
+            .iter()
+            .fold([0.0, 0.0], |a, p| [a[0] + p[0] / n, a[1] + p[1] / n]);
+        let range = norm(c);
+        if range > config.max_range {
+            continue;
+        }
+        let prev = k.checked_sub(1).map(|j| segs[j][segs[j].len() - 1].1);
+        let next = segs.get(k + 1).map(|s| s[0].1);
+        let jump = |q: Option<[f64; 2]>, own: [f64; 2]| q.map_or(5.0, |q| dist(q, own).min(5.0));
+        let occl = |q: Option<[f64; 2]>, own: [f64; 2]| {
+            q.map_or(2.0, |q| (norm(q) - norm(own)).clamp(-2.0, 2.0))
+        };
+        let ctx = SegmentContext {
+            jump_prev: jump(prev, first),
+            jump_next: jump(next, lastp),
+            speed: 0.0,
+        };
+        let f = segment_features(&pts, &ctx).map_err(|e| {
+            Error::invalid(
+                format!("scan at {} s, beam {}", scan.time, s[0].0),
+                e.to_string(),
+            )
+        })?;
+        let mut features = [0.0; NUM_LEG_FEATURES];
+        features[..13].copy_from_slice(&f[..13]);
+        features[13] = range;
+        features[14] = occl(prev, first);
+        features[15] = occl(next, lastp);
+        features[16] = motion(&pts);
+        out.push(LegCandidate {
+            beams: (s[0].0, s[s.len() - 1].0 + 1),
+            centroid: c,
+            features,
+        });
+    }
+    Ok(out)
+}
+
+/// The classifier and the settings it was trained with.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LegModel {
+    /// What the model is and how it was made.
+    pub description: String,
+    /// Feature names, in order.
+    pub features: Vec<String>,
+    /// The segmentation (and decision) settings the model was trained with.
+    pub config: LegDetectorConfig,
+    /// The boosted stumps.
+    pub classifier: Boosted,
+}
+
+impl LegModel {
+    /// The model shipped with the library (`src/laser2d/leg_model.json`).
+    pub fn shipped() -> Result<LegModel> {
+        LegModel::from_json(include_str!("leg_model.json"))
+    }
+
+    /// Parses a model and checks it against this build's features.
+    pub fn from_json(text: &str) -> Result<LegModel> {
+        let m: LegModel =
+            serde_json::from_str(text).map_err(|e| Error::invalid("leg model", e.to_string()))?;
+        if m.features != LEG_FEATURE_NAMES {
+            return Err(Error::invalid(
+                "leg model",
+                format!(
+                    "features {:?} differ from {:?}",
+                    m.features, LEG_FEATURE_NAMES
+                ),
+            ));
+        }
+        if m.classifier
+            .stumps
+            .iter()
+            .any(|s| s.feature >= NUM_LEG_FEATURES)
+        {
+            return Err(Error::invalid("leg model", "a stump names no feature"));
+        }
+        Ok(m)
+    }
+
+    /// Writes the model as pretty JSON.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("serialisable")
+    }
+}
+
+/// A leg found in a scan.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Leg {
+    /// Centroid, sensor frame (m).
+    pub position: [f64; 2],
+    /// Classifier score in `[−1, 1]`.
+    pub score: f64,
+}
+
+/// Legs paired into people (step 4 of the module documentation): positions in the sensor
+/// frame.
+pub fn pair_legs(legs: &[Leg], config: &LegDetectorConfig) -> Vec<[f64; 2]> {
+    let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
+    for i in 0..legs.len() {
+        for j in i + 1..legs.len() {
+            let (a, b) = (legs[i].position, legs[j].position);
+            let d = (a[0] - b[0]).hypot(a[1] - b[1]);
+            if d < config.pair_distance {
+                pairs.push((d, i, j));
+            }
+        }
+    }
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut used = vec![false; legs.len()];
+    let mut people = Vec::new();
+    for (_, i, j) in pairs {
+        if used[i] || used[j] {
+            continue;
+        }
+        used[i] = true;
+        used[j] = true;
+        let (a, b) = (legs[i].position, legs[j].position);
+        people.push([0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])]);
+    }
+    for (l, u) in legs.iter().zip(&used) {
+        if !u && l.score > config.single_leg_score {
+            people.push(l.position);
+        }
+    }
+    people
+}
+
+/// The detector: a model, the settings it runs with, and the previous scan for the motion
+/// feature. Hand it the scans of one scanner in order.
+#[derive(Debug)]
+pub struct LegDetector {
+    model: LegModel,
+    /// The settings (initially the model's).
+    pub config: LegDetectorConfig,
+    icp: Icp,
+    previous: Vec<[f64; 2]>,
+    current: Vec<[f64; 2]>,
+    pose: Pose2,
+}
+
+/// Motion feature when it cannot be measured.
+pub const UNKNOWN_MOTION: f64 = -1.0;
+
+impl LegDetector {
+    /// A detector running `model` with its own settings.
+    pub fn new(model: LegModel) -> Result<Self> {
+        let config = model.config;
+        Ok(LegDetector {
+            model,
+            config,
+            icp: Icp::new(IcpConfig::default())?,
+            previous: Vec::new(),
+            current: Vec::new(),
+            pose: identity(),
+        })
+    }
+
+    /// The shipped model's detector.
+    pub fn shipped() -> Result<Self> {
+        LegDetector::new(LegModel::shipped()?)
+    }
+
+    /// The leg candidates of the next scan, with the motion feature measured against the
+    /// scan before it.
+    pub fn candidates(&mut self, scan: &Scan) -> Result<Vec<LegCandidate>> {
+        self.current.clear();
+        self.current.extend(scan.points().map(|(_, p)| p));
+        let fit = if self.previous.len() >= 10 && self.current.len() >= 10 {
+            self.icp.set_target(&self.previous)?;
+            self.icp.align(&self.current, identity()).ok()
+        } else {
+            None
+        };
+        let icp = &self.icp;
+        let motion = |pts: &[[f64; 2]]| match fit {
+            Some(f) => {
+                pts.iter()
+                    .map(|&p| {
+                        icp.nearest_target_distance(transform_point(f.transform, p))
+                            .map_or(1.0, |d| d.min(1.0))
+                    })
+                    .sum::<f64>()
+                    / pts.len() as f64
+            }
+            None => UNKNOWN_MOTION,
+        };
+        let out = leg_segments(scan, &self.config, &motion)?;
+        if let Some(f) = fit {
+            self.pose = compose(self.pose, f.transform);
+        }
+        std::mem::swap(&mut self.previous, &mut self.current);
+        Ok(out)
+    }
+
+    /// The scanner's pose in the frame of the first scan, chained from the scan-to-scan
+    /// alignments (a failed alignment counts as standing still): odometry for a scanner
+    /// that has none.
+    pub fn pose(&self) -> Pose2 {
+        self.pose
+    }
+
+    /// The model's score of a candidate.
+    pub fn score(&self, candidate: &LegCandidate) -> f64 {
+        self.model.classifier.score(&candidate.features)
+    }
+
+    /// The legs of the next scan.
+    pub fn legs(&mut self, scan: &Scan) -> Result<Vec<Leg>> {
+        let c = self.candidates(scan)?;
+        Ok(c.iter()
+            .map(|c| Leg {
+                position: c.centroid,
+                score: self.score(c),
+            })
+            .filter(|l| l.score > self.config.leg_score)
+            .collect())
+    }
+
+    /// The people of the next scan, sensor frame.
+    pub fn people(&mut self, scan: &Scan) -> Result<Vec<[f64; 2]>> {
+        let legs = self.legs(scan)?;
+        Ok(pair_legs(&legs, &self.config))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A scan of a wall at 4 m with two leg-sized discs in front of it at 2 m.
+    fn scan_with_legs() -> Scan {
+        let n = 401;
+        let (a0, inc) = (-0.7f64, 0.0035f64);
+        let mut ranges = vec![4.0f32; n];
+        for (i, r) in ranges.iter_mut().enumerate() {
+            let b = a0 + inc * i as f64;
+            for cy in [0.0, 0.25] {
+                // Ray from the origin against a disc of radius 0.06 at (2, cy).
+                let (dx, dy) = (b.cos(), b.sin());
+                let t = 2.0 * dx + cy * dy;
+                let d2 = 4.0 + cy * cy - t * t;
+                if d2 < 0.06 * 0.06 {
+                    let hit = t - (0.06f64 * 0.06 - d2).sqrt();
+                    *r = r.min(hit as f32);
+                }
+            }
+        }
+        Scan::new(0.0, a0, inc, ranges, 0.0, 30.0).unwrap()
+    }
+
+    #[test]
+    fn leg_sized_discs_are_candidates_with_their_features() {
+        let s = scan_with_legs();
+        let c = leg_segments(&s, &LegDetectorConfig::default(), &|_| 0.5).unwrap();
+        let near: Vec<_> = c.iter().filter(|c| c.features[13] < 3.0).collect();
+        assert_eq!(near.len(), 2, "{c:?}");
+        for l in near {
+            assert!(l.features[0] >= 3.0);
+            assert!(l.features[5] < 0.13, "width {}", l.features[5]);
+            // The wall lies 2 m behind on both sides.
+            assert!(l.features[14] > 1.5 && l.features[15] > 1.5);
+            assert!(
+                l.features[8] > 0.02 && l.features[8] < 0.2,
+                "radius {}",
+                l.features[8]
+            );
+            assert_eq!(l.features[16], 0.5);
+        }
+        // The wall itself is far wider than max_width: split into pieces or dropped.
+        assert!(c.iter().all(|c| c.features[5] <= 0.8));
+    }
+
+    #[test]
+    fn legs_pair_into_people_and_lone_legs_need_a_high_score() {
+        let cfg = LegDetectorConfig::default();
+        let leg = |x: f64, y: f64, score: f64| Leg {
+            position: [x, y],
+            score,
+        };
+        let people = pair_legs(
+            &[
+                leg(2.0, 0.0, 0.1),
+                leg(2.0, 0.3, 0.1),
+                leg(4.0, 0.0, 0.1),
+                leg(5.0, 0.0, 0.5),
+            ],
+            &LegDetectorConfig {
+                single_leg_score: 0.3,
+                ..cfg
+            },
+        );
+        assert_eq!(people.len(), 2);
+        assert!((people[0][1] - 0.15).abs() < 1e-12);
+        assert_eq!(people[1], [5.0, 0.0]);
+        // Three legs in a row: the closest two pair, the third stands alone.
+        let p = pair_legs(
+            &[leg(1.0, 0.0, 0.9), leg(1.0, 0.2, 0.9), leg(1.0, 0.5, 0.9)],
+            &cfg,
+        );
+        assert_eq!(p.len(), 2);
+        assert!((p[0][1] - 0.1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn motion_is_unknown_first_and_small_for_a_still_scene() {
+        let s = scan_with_legs();
+        let mut d = LegDetector::shipped().unwrap();
+        let first = d.candidates(&s).unwrap();
+        assert!(first.iter().all(|c| c.features[16] == UNKNOWN_MOTION));
+        let again = d.candidates(&s).unwrap();
+        assert!(
+            again.iter().all(|c| (0.0..0.01).contains(&c.features[16])),
+            "{again:?}"
+        );
+    }
+
+    #[test]
+    fn the_shipped_model_loads_and_a_wrong_one_is_refused() {
+        let m = LegModel::shipped().unwrap();
+        assert!(!m.classifier.stumps.is_empty());
+        let mut other = m.clone();
+        other.features.pop();
+        assert!(LegModel::from_json(&other.to_json()).is_err());
+        assert!(LegModel::from_json("{").is_err());
+    }
+}
