@@ -9,7 +9,7 @@ use smc_lmb::cloud::{write_las_labelled, write_ply_labelled};
 use smc_lmb::kitti::{OdometrySequence, RawDrive, TrackingSequence};
 use smc_lmb::pipeline::drive_tracking::{
     drive_plot, point_labels, track_drive, track_odometry_sequence, track_tracking_sequence,
-    DriveTracks, EgoModel, FrameView, TrackingConfig,
+    DriveTracks, EgoModel, FrameView, PoseSource, TrackingConfig,
 };
 use std::ops::Range;
 use std::path::PathBuf;
@@ -61,9 +61,38 @@ pub struct Args {
     /// Move walls by a per-particle draw of the vehicle model instead of the measured poses.
     #[arg(long)]
     ect: bool,
+    /// Where the poses come from: the recording's own (OXTS, `poses/NN.txt`), lidar odometry
+    /// on the scans, `auto` (recorded when the recording has them, lidar odometry otherwise)
+    /// or `static` (a sensor that does not move). The output's `ego` says which was used.
+    #[arg(long, value_enum, default_value_t = Ego::Auto)]
+    ego: Ego,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
+}
+
+/// Source of the poses, as `--ego` names it.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Ego {
+    /// Recorded poses when there are any, lidar odometry otherwise.
+    Auto,
+    /// The recording's poses (fails without them).
+    Recorded,
+    /// Lidar odometry (KISS-ICP's recipe) on the recording's scans.
+    Lidar,
+    /// Every frame at the origin.
+    Static,
+}
+
+impl From<Ego> for PoseSource {
+    fn from(e: Ego) -> PoseSource {
+        match e {
+            Ego::Auto => PoseSource::Auto,
+            Ego::Recorded => PoseSource::Recorded,
+            Ego::Lidar => PoseSource::Lidar,
+            Ego::Static => PoseSource::Static,
+        }
+    }
 }
 
 fn parse_range(text: &str) -> Result<Range<usize>> {
@@ -99,6 +128,7 @@ pub fn run(args: Args) -> Result<()> {
             sigma_turn_accel: 0.1,
         };
     }
+    config.poses = args.ego.into();
     let frames = args.frames.as_deref().map(parse_range).transpose()?;
     for dir in [&args.las, &args.ply].into_iter().flatten() {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
@@ -180,12 +210,17 @@ pub fn print_summary(tracks: &DriveTracks) {
         s.mean_planes, s.mean_clusters, s.plane_labels, s.cluster_labels
     );
     println!(
-        "ms/frame: read {:.1}, planes {:.1}, clusters {:.1}, filter {:.1}, total {:.1}",
+        "ms/frame: read {:.1}, planes {:.1}, clusters {:.1}, filter {:.1}, total {:.1}{}",
         t.read_ms,
         t.planes_ms,
         t.clusters_ms,
         t.filter_ms,
-        t.read_ms + t.planes_ms + t.clusters_ms + t.filter_ms
+        t.read_ms + t.planes_ms + t.clusters_ms + t.filter_ms,
+        if t.ego_ms > 0.0 {
+            format!(" (+ lidar odometry {:.1})", t.ego_ms)
+        } else {
+            String::new()
+        }
     );
     let pairs = smc_lmb::pipeline::drive_tracking::tracked_wall_pairs(tracks);
     if !pairs.is_empty() {

@@ -59,7 +59,9 @@ fn tracks_a_drive_and_writes_every_output() {
         serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
     assert_eq!(json["frames"].as_array().unwrap().len(), 3);
     assert_eq!(json["particles"], 200);
-    assert_eq!(json["ego"], "none");
+    // No OXTS: the poses come from lidar odometry on the scans (copies of one scan, so the
+    // sensor stands still).
+    assert_eq!(json["ego"], "lidar");
     assert!(las.join("0000000002.las").is_file());
     assert!(!las.join("0000000001.las").exists());
     assert!(ply.join("0000000002.ply").is_file());
@@ -122,4 +124,45 @@ fn bad_inputs_fail_with_clear_messages() {
     ]);
     assert!(!ok && stderr.contains("0000000001.bin"), "{stderr}");
     assert!(!out.exists());
+}
+
+#[test]
+fn the_ego_flag_picks_the_pose_source_and_refuses_what_is_not_there() {
+    let tmp = tempfile::tempdir().unwrap();
+    let drive = static_drive(tmp.path(), 2);
+    let out = tmp.path().join("t.json");
+    let args = |ego: &'static str| {
+        vec![
+            "track".to_string(),
+            "--drive".into(),
+            drive.to_str().unwrap().into(),
+            "--particles".into(),
+            "50".into(),
+            "--ego".into(),
+            ego.into(),
+            "--quiet".into(),
+            "--out".into(),
+            out.to_str().unwrap().into(),
+        ]
+    };
+    let run_with = |ego| {
+        let a = args(ego);
+        let a: Vec<&str> = a.iter().map(String::as_str).collect();
+        run(&a)
+    };
+    let (ok, _, stderr) = run_with("recorded");
+    assert!(
+        !ok && stderr.contains("no recorded poses") && stderr.contains("2011_09_26_drive_0000"),
+        "{stderr}"
+    );
+    assert!(!out.exists());
+    let (ok, stdout, stderr) = run_with("static");
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("ego none"), "{stdout}");
+    let (ok, stdout, stderr) = run_with("lidar");
+    assert!(ok, "{stderr}");
+    assert!(
+        stdout.contains("ego lidar") && stdout.contains("lidar odometry"),
+        "{stdout}"
+    );
 }

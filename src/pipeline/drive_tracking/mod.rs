@@ -35,6 +35,7 @@ pub use output::{
 pub use repeatability::tracked_wall_pairs;
 pub use tracker::DriveTracker;
 
+use crate::cloud::odometry::{LidarOdometry, OdometryConfig};
 use crate::cloud::planes::PlaneConfig;
 use crate::cloud::PointCloud;
 use crate::error::{ensure_positive, ensure_probability, Error, Result};
@@ -59,6 +60,23 @@ pub enum EgoModel {
         /// Yaw acceleration noise (rad/s²).
         sigma_turn_accel: f64,
     },
+}
+
+/// Where the sensor poses (frame k → first frame) come from.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PoseSource {
+    /// The recording's own poses (OXTS, `poses/NN.txt`) when it has them, lidar odometry on
+    /// the scans otherwise.
+    #[default]
+    Auto,
+    /// The recording's own poses; a recording without them is an error.
+    Recorded,
+    /// Lidar odometry ([`crate::cloud::odometry::LidarOdometry`], default settings) on the
+    /// scans, registered as they are read; poses are relative to the first tracked frame.
+    Lidar,
+    /// Every frame at the origin: a sensor that does not move.
+    Static,
 }
 
 /// Wall models: process noise, measurement noise, detection, clutter and birth spread.
@@ -218,6 +236,8 @@ pub struct TrackingConfig {
     pub filter: LmbConfig,
     /// How walls follow the ego motion. Default: measured poses.
     pub ego: EgoModel,
+    /// Where the poses come from. Default: the recording's, else lidar odometry.
+    pub poses: PoseSource,
     /// Wall models.
     pub plane: PlaneTuning,
     /// Cluster models.
@@ -241,6 +261,7 @@ impl Default for TrackingConfig {
                 ..LmbConfig::default()
             },
             ego: EgoModel::Measured,
+            poses: PoseSource::Auto,
             plane: PlaneTuning::default(),
             cluster: ClusterTuning::default(),
             birth: BirthTuning::default(),
@@ -301,8 +322,8 @@ struct Recording<'a> {
     frames: usize,
     /// Reads scan k.
     read: &'a dyn Fn(usize) -> Result<PointCloud>,
-    /// Velodyne poses (frame k → frame 0), one per scan.
-    poses: Vec<Isometry3<f64>>,
+    /// Velodyne poses (frame k → frame 0), one per scan; `None`: lidar odometry on the scans.
+    poses: Option<Vec<Isometry3<f64>>>,
     /// Where the poses come from, e.g. `oxts` (`none` when every pose is the identity).
     ego: String,
     /// Vehicle states [X, Ẋ, Y, Ẏ, φ, φ̇] for the ECT ego model, one per scan.
@@ -316,6 +337,26 @@ fn ego_name(source: &str, config: &TrackingConfig) -> String {
     match config.ego {
         EgoModel::Measured => source.to_string(),
         EgoModel::Ect { .. } => format!("{source}+ect"),
+    }
+}
+
+/// The poses of a recording (`None`: lidar odometry) and their source's name, given whether
+/// it has poses of its own and how to read them.
+fn choose_poses(
+    config: &TrackingConfig,
+    what: &str,
+    n: usize,
+    recorded: Option<&dyn Fn() -> Result<Vec<Isometry3<f64>>>>,
+    recorded_name: &str,
+) -> Result<(Option<Vec<Isometry3<f64>>>, String)> {
+    match (config.poses, recorded) {
+        (PoseSource::Static, _) => Ok((Some(vec![Isometry3::identity(); n]), "none".into())),
+        (PoseSource::Lidar, _) | (PoseSource::Auto, None) => Ok((None, ego_name("lidar", config))),
+        (PoseSource::Recorded, None) => Err(Error::invalid(
+            what.to_string(),
+            "has no recorded poses (OXTS or a poses file); use lidar odometry or a static sensor",
+        )),
+        (_, Some(read)) => Ok((Some(read()?), ego_name(recorded_name, config))),
     }
 }
 
@@ -353,17 +394,24 @@ pub fn track_drive(
     }
     let n = drive.velodyne_count();
     check_frame_range(frames.as_ref(), n, &format!("drive {name}"))?;
-    let (poses, ego) = if drive.has_oxts() {
-        (drive.poses()?, ego_name("oxts", config))
-    } else {
+    if !drive.has_oxts() {
         if let EgoModel::Ect { .. } = config.ego {
             return Err(Error::invalid(
                 format!("drive {name}"),
                 "the ECT ego model needs OXTS packets (oxts/data)",
             ));
         }
-        (vec![Isometry3::identity(); n], "none".to_string())
-    };
+    }
+    let oxts_poses = || drive.poses();
+    let (poses, ego) = choose_poses(
+        config,
+        &format!("drive {name}"),
+        n,
+        drive
+            .has_oxts()
+            .then_some(&oxts_poses as &dyn Fn() -> Result<Vec<Isometry3<f64>>>),
+        "oxts",
+    )?;
     let vehicle = ect_states(config, || drive.vehicle_states())?;
     let times: Vec<f64> = if drive.velodyne_timestamps_path().is_file() {
         let t = drive.timestamps()?;
@@ -416,13 +464,23 @@ pub fn track_tracking_sequence(
     }
     let n = sequence.velodyne_count();
     check_frame_range(frames.as_ref(), n, &name)?;
+    let oxts_poses = || sequence.poses();
+    let (poses, ego) = choose_poses(
+        config,
+        &name,
+        n,
+        sequence
+            .has_oxts()
+            .then_some(&oxts_poses as &dyn Fn() -> Result<Vec<Isometry3<f64>>>),
+        "oxts",
+    )?;
     let read = |k: usize| sequence.velodyne(k);
     let recording = Recording {
         name: format!("tracking_{}", sequence.name()),
         frames: n,
         read: &read,
-        poses: sequence.poses()?,
-        ego: ego_name("oxts", config),
+        poses,
+        ego,
         vehicle: ect_states(config, || sequence.vehicle_states())?,
         times: sequence.times(),
     };
@@ -457,13 +515,26 @@ pub fn track_odometry_sequence(
         ));
     }
     check_frame_range(frames.as_ref(), n, &name)?;
-    let poses = sequence.velodyne_poses()?;
-    if poses.len() < n {
-        return Err(Error::invalid(
-            format!("{}", sequence.poses_path().display()),
-            format!("has {} poses for {n} scans", poses.len()),
-        ));
-    }
+    let file_poses = || -> Result<Vec<Isometry3<f64>>> {
+        let poses = sequence.velodyne_poses()?;
+        if poses.len() < n {
+            return Err(Error::invalid(
+                format!("{}", sequence.poses_path().display()),
+                format!("has {} poses for {n} scans", poses.len()),
+            ));
+        }
+        Ok(poses)
+    };
+    let (poses, ego) = choose_poses(
+        config,
+        &name,
+        n,
+        sequence
+            .poses_path()
+            .is_file()
+            .then_some(&file_poses as &dyn Fn() -> Result<Vec<Isometry3<f64>>>),
+        "odometry",
+    )?;
     let times = if sequence.times_path().is_file() {
         let t = sequence.times()?;
         if t.len() < n {
@@ -482,7 +553,7 @@ pub fn track_odometry_sequence(
         frames: n,
         read: &read,
         poses,
-        ego: "odometry".to_string(),
+        ego,
         vehicle: None,
         times,
     };
@@ -515,6 +586,10 @@ fn track_recording(
     let range = frames.unwrap_or(0..rec.frames);
     let (poses, times, vehicle) = (&rec.poses, &rec.times, &rec.vehicle);
     let mut tracker = DriveTracker::new(config, seed)?;
+    let mut odometry = match rec.poses {
+        Some(_) => None,
+        None => Some(LidarOdometry::new(OdometryConfig::default())?),
+    };
     let mut out = Vec::with_capacity(range.len());
     let total = range.len();
     for k in range.clone() {
@@ -525,8 +600,25 @@ fn track_recording(
         let previous_state = vehicle
             .as_ref()
             .map(|v| v[if k > range.start { k - 1 } else { k }]);
-        let mut tracked = tracker.step(k, times[k], poses[k], previous_state, &detections)?;
+        let start = Instant::now();
+        let pose = match (poses, odometry.as_mut()) {
+            (Some(p), _) => p[k],
+            (None, Some(o)) => {
+                o.register(&cloud)
+                    .map_err(|e| {
+                        Error::invalid(
+                            format!("lidar odometry on frame {k} of {}", rec.name),
+                            e.to_string(),
+                        )
+                    })?
+                    .pose
+            }
+            (None, None) => unreachable!("odometry is set up when there are no poses"),
+        };
+        let ego_ms = start.elapsed().as_secs_f64() * 1e3;
+        let mut tracked = tracker.step(k, times[k], pose, previous_state, &detections)?;
         tracked.times.read_ms = read_ms;
+        tracked.times.ego_ms = ego_ms;
         on_frame(&FrameView {
             cloud: &cloud,
             detections: &detections,

@@ -69,6 +69,9 @@ pub struct StageTimes {
     pub clusters_ms: f64,
     /// Filter step and estimate extraction.
     pub filter_ms: f64,
+    /// Lidar odometry, when the ego motion comes from the scans (0 otherwise).
+    #[serde(default)]
+    pub ego_ms: f64,
 }
 
 /// One frame of the tracking output.
@@ -126,6 +129,7 @@ impl TrackingSummary {
             planes.extend(f.planes.iter().map(|p| p.label));
             clusters.extend(f.clusters.iter().map(|c| c.label));
             t.read_ms += f.times.read_ms / nf;
+            t.ego_ms += f.times.ego_ms / nf;
             t.planes_ms += f.times.planes_ms / nf;
             t.clusters_ms += f.times.clusters_ms / nf;
             t.filter_ms += f.times.filter_ms / nf;

@@ -165,6 +165,7 @@ impl DriveTracker {
             clusters,
             times: StageTimes {
                 read_ms: 0.0,
+                ego_ms: 0.0,
                 planes_ms: detections.planes_ms,
                 clusters_ms: detections.clusters_ms,
                 filter_ms,
