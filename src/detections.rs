@@ -10,7 +10,8 @@
 //! `frame,time,z0,z1[,z2...][,sensor_x,sensor_y,sensor_heading][,id]`. Columns are found by
 //! name in the header (`z0`, `z1`, … for the measurement). A line whose `z` fields are all
 //! empty declares an empty frame. Frames must appear in non-decreasing order of `frame`;
-//! missing frame numbers in between are empty frames.
+//! missing frame numbers in between are empty frames, their times interpolated between the
+//! neighbouring listed frames' (at most [`MAX_FRAME_GAP`] of them in a row).
 //!
 //! Estimates are written as JSON (`{"frames": [{"frame", "time", "estimates": [{"label":
 //! {"birth_step", "index"}, "existence", "state", "age"}]}]}`) or CSV
@@ -22,6 +23,30 @@ use crate::error::{Error, Result};
 use crate::filter::Estimate;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
+
+/// The most empty frames a CSV file may leave between two listed frame numbers (or before
+/// its first one): a larger gap is refused as a typo rather than allocated.
+pub const MAX_FRAME_GAP: usize = 1_000_000;
+
+/// Appends empty frames up to and including `frame` (when it is not there yet). A frame
+/// inside a gap gets its time interpolated linearly between the last listed frame's and
+/// `time`; frames before the file's first listed frame get `time`.
+fn push_gap_frames(frames: &mut Vec<DetectionFrame>, frame: usize, time: f64) {
+    let last = frames.len().checked_sub(1).map(|k| (k, frames[k].time));
+    while frames.len() <= frame {
+        let k = frames.len();
+        let t = match last {
+            Some((k0, t0)) => t0 + (time - t0) * (k - k0) as f64 / (frame - k0) as f64,
+            None => time,
+        };
+        frames.push(DetectionFrame {
+            time: if k == frame { time } else { t },
+            measurements: Vec::new(),
+            sensor_pose: None,
+            ids: None,
+        });
+    }
+}
 
 /// One frame of a detections (or truth) file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -259,7 +284,7 @@ fn parse_csv(
             )
         })?;
         let time = num(time_col)?;
-        if frame + 1 < frames.len() {
+        if frame < frames.len().saturating_sub(1) {
             return Err(Error::parse(
                 path,
                 line_no,
@@ -267,14 +292,19 @@ fn parse_csv(
                 format!("frame {frame} after frame {}", frames.len() - 1),
             ));
         }
-        while frames.len() <= frame {
-            frames.push(DetectionFrame {
-                time,
-                measurements: Vec::new(),
-                sensor_pose: None,
-                ids: None,
-            });
+        let gap = frame.saturating_sub(frames.len());
+        if gap > MAX_FRAME_GAP {
+            return Err(Error::parse(
+                path,
+                line_no,
+                "frame",
+                format!(
+                    "frame {frame} would leave {gap} empty frames before it; at most \
+                     {MAX_FRAME_GAP} are accepted"
+                ),
+            ));
         }
+        push_gap_frames(&mut frames, frame, time);
         let f = frames.last_mut().expect("just pushed");
         if f.time != time {
             return Err(Error::parse(
@@ -378,6 +408,32 @@ mod tests {
         let p = dir.join(name);
         std::fs::write(&p, content).unwrap();
         p
+    }
+
+    #[test]
+    fn hostile_frame_numbers_are_refused_and_gaps_interpolated() {
+        let p = tmp("gap.csv", "frame,time,z0,z1\n0,0.0,1,2\n4,2.0,1,2\n");
+        let f = read_frames(&p).unwrap();
+        let times: Vec<f64> = f.iter().map(|f| f.time).collect();
+        assert_eq!(times, vec![0.0, 0.5, 1.0, 1.5, 2.0]);
+        assert!(f[1..4].iter().all(|f| f.measurements.is_empty()));
+        for frame in ["4000000000", "18446744073709551615"] {
+            let p = tmp(
+                "huge.csv",
+                &format!("frame,time,z0,z1\n0,0.0,1,2\n{frame},1.0,1,2\n"),
+            );
+            let e = read_frames(&p).unwrap_err().to_string();
+            assert!(e.contains("huge.csv:3") && e.contains("at most"), "{e}");
+        }
+        let p = tmp(
+            "over.csv",
+            "frame,time,z0,z1\n18446744073709551616,1.0,1,2\n",
+        );
+        let e = read_frames(&p).unwrap_err().to_string();
+        assert!(
+            e.contains("over.csv:2") && e.contains("not a frame number"),
+            "{e}"
+        );
     }
 
     #[test]

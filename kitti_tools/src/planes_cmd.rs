@@ -111,7 +111,11 @@ pub fn run(args: Args) -> Result<()> {
     let frames = if args.all {
         None
     } else {
-        Some(args.frame..args.frame + 1)
+        let end = args
+            .frame
+            .checked_add(1)
+            .with_context(|| format!("--frame {} is past any recording", args.frame))?;
+        Some(args.frame..end)
     };
     let mut rng = smc_lmb::rng::seeded(args.seed);
     let source = match (&args.drive, &args.odometry, &args.tracking, args.sequence) {
@@ -169,7 +173,9 @@ pub fn run(args: Args) -> Result<()> {
     };
     let results: Vec<PairPrediction> = if lidar {
         let count = input.scan_count();
-        let end = frames.as_ref().map_or(count, |r| (r.end + 1).min(count));
+        let end = frames
+            .as_ref()
+            .map_or(count, |r| r.end.saturating_add(1).min(count));
         let poses = smc_lmb::cloud::odometry::odometry_of_frames(
             end,
             &|k| input.load(k),

@@ -147,4 +147,16 @@ fn ego_motion_source_is_chosen_and_said() {
     let refused = run(&["planes", "--drive", d, "--frame", "0", "--ego", "recorded"]);
     assert!(!refused.status.success());
     assert!(String::from_utf8_lossy(&refused.stderr).contains("oxts"));
+    // A frame number at the top of the integers is an error, not an overflow.
+    let huge = run(&[
+        "planes",
+        "--drive",
+        d,
+        "--frame",
+        "18446744073709551615",
+        "--measured",
+    ]);
+    assert!(!huge.status.success());
+    let stderr = String::from_utf8_lossy(&huge.stderr);
+    assert!(stderr.contains("18446744073709551615"), "{stderr}");
 }

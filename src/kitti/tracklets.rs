@@ -401,6 +401,12 @@ pub fn parse_tracklets(path: &Path, xml: &str) -> Result<Tracklets> {
                 let first_frame = c
                     .first_frame
                     .ok_or_else(|| err(f("first_frame"), "missing".into()))?;
+                if first_frame.checked_add(c.poses.len()).is_none() {
+                    return Err(err(
+                        f("first_frame"),
+                        format!("{first_frame} plus {} poses overflows", c.poses.len()),
+                    ));
+                }
                 out.items.push(Tracklet {
                     object_type,
                     h: hwl[0],
@@ -602,6 +608,26 @@ mod tests {
         assert!((at2[0].center().z - (-1.7 + 0.75)).abs() < 1e-12);
         assert!(back.objects_at(4).is_empty());
         assert_eq!(back.end_frame(), 4);
+    }
+
+    #[test]
+    fn a_first_frame_that_overflows_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("t.xml");
+        write_tracklets(&p, &two()).unwrap();
+        let good = std::fs::read_to_string(&p).unwrap();
+        let first = good.find("<first_frame>").unwrap();
+        let end = good[first..].find("</first_frame>").unwrap() + first;
+        let bad = format!(
+            "{}<first_frame>{}{}",
+            &good[..first],
+            usize::MAX,
+            &good[end..]
+        );
+        let msg = parse_tracklets(Path::new("t.xml"), &bad)
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("t.xml") && msg.contains("overflows"), "{msg}");
     }
 
     #[test]
