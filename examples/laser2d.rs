@@ -107,6 +107,10 @@ struct Args {
     /// Track a CARMEN log (FLASER scans, odometry from the laser lines) instead of simulating.
     #[arg(long)]
     carmen: Option<std::path::PathBuf>,
+    /// Read the CARMEN log as if the robot had no odometry: the poses come from the front
+    /// end's scan matching alone.
+    #[arg(long, requires = "carmen")]
+    ignore_odometry: bool,
     /// Track a ROS1 bag (sensor_msgs/LaserScan) instead of simulating.
     #[arg(long)]
     bag: Option<std::path::PathBuf>,
@@ -540,6 +544,7 @@ mod recording {
             // fewest scans that leave time in order.
             let options = CarmenOptions {
                 time_order: TimeOrder::DropFewest,
+                ignore_odometry: args.ignore_odometry,
                 ..CarmenOptions::default()
             };
             let log = read_carmen(path, options)

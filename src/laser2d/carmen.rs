@@ -93,6 +93,10 @@ pub struct CarmenOptions {
     pub time_order: TimeOrder,
     /// `range_max` given to `FLASER` scans (m); ranges at or above it are "no return".
     pub flaser_range_max: f64,
+    /// Read the scans as if the robot had no odometry: scans carry no odometry or laser
+    /// pose, and `ODOM` lines are passed over (counted as ignored). For recordings whose
+    /// odometry is missing or not to be trusted, and to test what the scans alone give.
+    pub ignore_odometry: bool,
 }
 
 impl Default for CarmenOptions {
@@ -101,6 +105,7 @@ impl Default for CarmenOptions {
             on_malformed: OnMalformed::Error,
             time_order: TimeOrder::Error,
             flaser_range_max: 80.0,
+            ignore_odometry: false,
         }
     }
 }
@@ -399,6 +404,19 @@ impl<R: BufRead> CarmenReader<R> {
                 }
             }
             self.last[kind] = Some((t, self.line));
+            let record = match record {
+                CarmenRecord::Odometry(_) if self.options.ignore_odometry => {
+                    self.stats.ignored += 1;
+                    continue;
+                }
+                CarmenRecord::Flaser(s) if self.options.ignore_odometry => {
+                    CarmenRecord::Flaser(without_odometry(s))
+                }
+                CarmenRecord::RobotLaser(s) if self.options.ignore_odometry => {
+                    CarmenRecord::RobotLaser(without_odometry(s))
+                }
+                r => r,
+            };
             match &record {
                 CarmenRecord::Flaser(_) => self.stats.flaser += 1,
                 CarmenRecord::RobotLaser(_) => self.stats.robot_laser += 1,
@@ -406,6 +424,14 @@ impl<R: BufRead> CarmenReader<R> {
             }
             return Ok(Some(record));
         }
+    }
+}
+
+fn without_odometry(scan: Scan) -> Scan {
+    Scan {
+        odometry: None,
+        laser_pose: None,
+        ..scan
     }
 }
 
@@ -849,6 +875,26 @@ mod tests {
             proptest::prop_assert!(kept.windows(2).all(|w| w[0] <= w[1]));
             proptest::prop_assert_eq!(kept.len(), brute_longest(&t));
         }
+    }
+
+    #[test]
+    fn ignoring_odometry_strips_poses_and_passes_over_odom_lines() {
+        let text = "ODOM 1.0 2.0 0.5 0 0 0 10.0 h 10.0\n\
+                    FLASER 3 1.0 2.0 3.0 1.0 2.0 0.5 1.0 2.0 0.5 10.1 h 10.1\n";
+        let options = CarmenOptions {
+            ignore_odometry: true,
+            ..CarmenOptions::default()
+        };
+        let (recs, stats) = read(text, options).unwrap();
+        assert_eq!(recs.len(), 1);
+        let CarmenRecord::Flaser(s) = &recs[0] else {
+            panic!("{recs:?}")
+        };
+        assert!(s.odometry.is_none() && s.laser_pose.is_none());
+        assert_eq!(s.ranges, vec![1.0, 2.0, 3.0]);
+        assert_eq!((stats.odometry, stats.ignored), (0, 1));
+        let (recs, _) = read(text, CarmenOptions::default()).unwrap();
+        assert_eq!(recs.len(), 2);
     }
 
     #[test]

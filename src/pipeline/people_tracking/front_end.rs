@@ -30,6 +30,7 @@ use super::tracker::{person_grouping, PeopleTrackerConfig};
 use crate::config::MeasurementConfig;
 use crate::error::{Error, Result};
 use crate::filter::Measurements;
+use crate::geometry::pose2::{between, compose};
 use crate::geometry::Pose2;
 use crate::laser2d::legs::{LegDetector, LegModel};
 use crate::laser2d::moving::{
@@ -102,6 +103,20 @@ pub struct PersonFrontEnd {
     /// [`MovingEvidence::MovingClusters`].
     pub evidence: MovingEvidence,
     moving_beams: Vec<bool>,
+    /// Without odometry: the stand-in odometry handed to the detector last time, the
+    /// detector's corrected pose then, and the motion between its last two corrected poses.
+    dead_reckoning: Option<DeadReckoning>,
+}
+
+/// Constant-velocity stand-in for odometry when a recording has none: the next scan is
+/// predicted to move as much as the last two corrected poses did, and the detector's ICP
+/// corrects from there (a turning robot stays registered where a standing-still guess would
+/// have to recover the whole turn each scan).
+#[derive(Clone, Copy, Debug)]
+struct DeadReckoning {
+    odometry: Pose2,
+    corrected: Pose2,
+    step: Pose2,
 }
 
 /// Which returns of the detector's output the moving front end counts as moving.
@@ -244,6 +259,7 @@ impl PersonFrontEnd {
             min_moving_share: 0.5,
             evidence: MovingEvidence::MovingClusters,
             moving_beams: Vec::new(),
+            dead_reckoning: None,
         })
     }
 
@@ -268,11 +284,30 @@ impl PersonFrontEnd {
         self.kind
     }
 
-    /// One scan with the robot's odometry pose at its time (the detector takes the origin
-    /// when there is none: a scanner standing still).
+    /// One scan with the robot's odometry pose at its time. Without odometry the detector is
+    /// handed a constant-velocity prediction from its own last two corrected poses (the
+    /// origin at first), which its scan-to-map ICP then corrects.
     pub fn measure(&mut self, scan: &Scan, odometry: Option<Pose2>) -> Result<FrontEndOutput> {
         let detections = match &mut self.detector {
-            Some(det) => Some(det.process(scan, odometry.unwrap_or(Pose2::new(0.0, 0.0, 0.0)))?),
+            Some(det) => {
+                let stand_in = match (odometry, self.dead_reckoning) {
+                    (Some(odo), _) => odo,
+                    (None, Some(d)) => compose(d.odometry, d.step),
+                    (None, None) => Pose2::new(0.0, 0.0, 0.0),
+                };
+                let out = det.process(scan, stand_in)?;
+                if odometry.is_none() {
+                    let step = self
+                        .dead_reckoning
+                        .map_or(Pose2::new(0.0, 0.0, 0.0), |d| between(d.corrected, out.pose));
+                    self.dead_reckoning = Some(DeadReckoning {
+                        odometry: stand_in,
+                        corrected: out.pose,
+                        step,
+                    });
+                }
+                Some(out)
+            }
             None => None,
         };
         if let Some(legs) = &mut self.legs {
