@@ -601,21 +601,22 @@ fn track_recording(
             .as_ref()
             .map(|v| v[if k > range.start { k - 1 } else { k }]);
         let start = Instant::now();
-        let pose = match (poses, odometry.as_mut()) {
-            (Some(p), _) => p[k],
+        let (pose, ego_ms) = match (poses, odometry.as_mut()) {
+            (Some(p), _) => (p[k], 0.0),
             (None, Some(o)) => {
-                o.register(&cloud)
+                let pose = o
+                    .register(&cloud)
                     .map_err(|e| {
                         Error::invalid(
                             format!("lidar odometry on frame {k} of {}", rec.name),
                             e.to_string(),
                         )
                     })?
-                    .pose
+                    .pose;
+                (pose, start.elapsed().as_secs_f64() * 1e3)
             }
             (None, None) => unreachable!("odometry is set up when there are no poses"),
         };
-        let ego_ms = start.elapsed().as_secs_f64() * 1e3;
         let mut tracked = tracker.step(k, times[k], pose, previous_state, &detections)?;
         tracked.times.read_ms = read_ms;
         tracked.times.ego_ms = ego_ms;

@@ -108,6 +108,15 @@ pub struct PersonFrontEnd {
     dead_reckoning: Option<DeadReckoning>,
 }
 
+/// Without odometry, the farthest the detector's ICP may move a scan from the
+/// constant-velocity guess (m): a robot at walking pace changing speed by 1 m/s within a
+/// 5 Hz log's scan interval moves 0.2 m from it; five times that leaves room for rougher
+/// starts and stops.
+pub const NO_ODOMETRY_MAX_CORRECTION: f64 = 1.0;
+/// ... and the farthest it may turn it (rad, 20°: a turn rate changing by 100°/s between
+/// two scans of a 5 Hz log).
+pub const NO_ODOMETRY_MAX_CORRECTION_ANGLE: f64 = 0.35;
+
 /// Constant-velocity stand-in for odometry when a recording has none: the next scan is
 /// predicted to move as much as the last two corrected poses did, and the detector's ICP
 /// corrects from there (a turning robot stays registered where a standing-still guess would
@@ -290,6 +299,16 @@ impl PersonFrontEnd {
     pub fn measure(&mut self, scan: &Scan, odometry: Option<Pose2>) -> Result<FrontEndOutput> {
         let detections = match &mut self.detector {
             Some(det) => {
+                if odometry.is_none() && self.dead_reckoning.is_none() {
+                    // The first scan of a recording without odometry: the scan matcher alone
+                    // must follow the robot, so its correction may go farther from the
+                    // constant-velocity guess than from an odometry reading.
+                    let mut c = *det.config();
+                    c.max_correction = c.max_correction.max(NO_ODOMETRY_MAX_CORRECTION);
+                    c.max_correction_angle =
+                        c.max_correction_angle.max(NO_ODOMETRY_MAX_CORRECTION_ANGLE);
+                    *det = MovingObjectDetector::new(c)?;
+                }
                 let stand_in = match (odometry, self.dead_reckoning) {
                     (Some(odo), _) => odo,
                     (None, Some(d)) => compose(d.odometry, d.step),
@@ -297,9 +316,9 @@ impl PersonFrontEnd {
                 };
                 let out = det.process(scan, stand_in)?;
                 if odometry.is_none() {
-                    let step = self
-                        .dead_reckoning
-                        .map_or(Pose2::new(0.0, 0.0, 0.0), |d| between(d.corrected, out.pose));
+                    let step = self.dead_reckoning.map_or(Pose2::new(0.0, 0.0, 0.0), |d| {
+                        between(d.corrected, out.pose)
+                    });
                     self.dead_reckoning = Some(DeadReckoning {
                         odometry: stand_in,
                         corrected: out.pose,
