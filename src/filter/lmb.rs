@@ -394,10 +394,10 @@ impl LmbFilter {
         let z = &frame.measurements;
         let seed = rng.next_u64();
 
-        self.predict(&ctx, seed);
+        self.predict(&ctx, seed)?;
         self.add_births(&ctx, seed);
         let predicted = self.predicted_copies();
-        let likelihoods = self.likelihoods(z, &ctx);
+        let likelihoods = self.likelihoods(z, &ctx)?;
         let marginals = self.associate(z, &ctx, &likelihoods, seed);
         let assigned = self.update(&likelihoods, &marginals, z.len());
         let resampled = self.resample(seed);
@@ -457,26 +457,48 @@ impl LmbFilter {
     }
 
     /// Prediction: survival reweighting r₊ = r·Σ wᵢ p_S(xᵢ), then the transition, per track.
-    fn predict(&mut self, ctx: &StepContext, seed: u64) {
+    /// Survival and transition of every track, in parallel. A transition model that leaves a
+    /// particle with a non-finite state component is an error naming the track (the first such
+    /// track in track order, whatever the thread count), never a silently lost track.
+    fn predict(&mut self, ctx: &StepContext, seed: u64) -> Result<()> {
         if self.previous.is_none() {
-            return;
+            return Ok(());
         }
         let m = &self.models;
-        self.tracks.par_iter_mut().for_each(|t| {
-            let mut rng = stream(seed, KEY_PREDICT ^ t.label.key());
-            let mut ps = vec![0.0; t.particles.len()];
-            m.survival.survival_probability(&t.particles, ctx, &mut ps);
-            ps.iter_mut()
-                .for_each(|p| *p = if p.is_nan() { 0.0 } else { p.clamp(0.0, 1.0) });
-            // η_S = Σ wᵢ p_S(xᵢ); a constant p_S leaves the weights as they are.
-            let eta_s = match ps.first() {
-                Some(&p0) if ps.iter().all(|&p| p == p0) => p0,
-                _ => t.particles.reweight(&ps),
-            };
-            t.existence *= eta_s.clamp(0.0, 1.0);
-            m.transition.predict(&mut t.particles, ctx, &mut rng);
-            t.age += 1;
-        });
+        let step = self.step;
+        let bad: Vec<Option<String>> = self
+            .tracks
+            .par_iter_mut()
+            .map(|t| {
+                let mut rng = stream(seed, KEY_PREDICT ^ t.label.key());
+                let mut ps = vec![0.0; t.particles.len()];
+                m.survival.survival_probability(&t.particles, ctx, &mut ps);
+                ps.iter_mut()
+                    .for_each(|p| *p = if p.is_nan() { 0.0 } else { p.clamp(0.0, 1.0) });
+                // η_S = Σ wᵢ p_S(xᵢ); a constant p_S leaves the weights as they are.
+                let eta_s = match ps.first() {
+                    Some(&p0) if ps.iter().all(|&p| p == p0) => p0,
+                    _ => t.particles.reweight(&ps),
+                };
+                t.existence *= eta_s.clamp(0.0, 1.0);
+                m.transition.predict(&mut t.particles, ctx, &mut rng);
+                t.age += 1;
+                (0..t.particles.dim()).find_map(|c| {
+                    let v = t.particles.component(c);
+                    v.iter().position(|x| !x.is_finite()).map(|i| {
+                        format!(
+                            "the transition model left particle {i} of track {} with component \
+                         {c} = {}",
+                            t.label, v[i]
+                        )
+                    })
+                })
+            })
+            .collect();
+        match bad.into_iter().flatten().next() {
+            Some(why) => Err(Error::invalid(format!("prediction of step {step}"), why)),
+            None => Ok(()),
+        }
     }
 
     /// Appends the birth tracks of this step, labelled (step, index).
@@ -513,9 +535,13 @@ impl LmbFilter {
     }
 
     /// Gating and the particle sums η_j(ℓ) and η_miss(ℓ) for every track, in parallel.
-    fn likelihoods(&self, z: &Measurements, ctx: &StepContext) -> Vec<TrackLikelihoods> {
+    /// A measurement model that returns NaN or +∞ as a log-likelihood is an error naming the
+    /// track and measurement (the first in track order); −∞ is a valid "impossible".
+    fn likelihoods(&self, z: &Measurements, ctx: &StepContext) -> Result<Vec<TrackLikelihoods>> {
         let m = &self.models;
-        self.tracks
+        let step = self.step;
+        let all: Vec<Result<TrackLikelihoods>> = self
+            .tracks
             .par_iter()
             .map(|t| {
                 let p = &t.particles;
@@ -537,6 +563,18 @@ impl LmbFilter {
                 let mut scaled_g = vec![vec![0.0; n]; zs.len()];
                 m.measurement
                     .log_likelihood_batch(&zs, p, ctx, &mut scaled_g);
+                for (g, &j) in scaled_g.iter().zip(&gated) {
+                    if let Some(i) = g.iter().position(|v| v.is_nan() || *v == f64::INFINITY) {
+                        return Err(Error::invalid(
+                            format!("update of step {step}"),
+                            format!(
+                                "the measurement model's log-likelihood of measurement {j} for \
+                                 particle {i} of track {} is {}",
+                                t.label, g[i]
+                            ),
+                        ));
+                    }
+                }
                 let (mut log_eta, mut scaled_eta) =
                     (Vec::with_capacity(zs.len()), Vec::with_capacity(zs.len()));
                 for g in &mut scaled_g {
@@ -563,16 +601,17 @@ impl LmbFilter {
                 scaled_g.retain(|_| *k.next().expect("one flag per pair"));
                 log_eta.retain(|e| *e > f64::NEG_INFINITY);
                 scaled_eta.retain(|s| *s > 0.0);
-                TrackLikelihoods {
+                Ok(TrackLikelihoods {
                     pd,
                     eta_miss,
                     gated,
                     log_eta,
                     scaled_g,
                     scaled_eta,
-                }
+                })
             })
-            .collect()
+            .collect();
+        all.into_iter().collect()
     }
 
     /// Association: independent groups, each solved by the associator, in parallel.

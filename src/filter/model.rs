@@ -102,7 +102,8 @@ pub trait SurvivalModel: Send + Sync {
 pub trait MeasurementModel: Send + Sync {
     /// Dimension of one measurement vector.
     fn measurement_dim(&self) -> usize;
-    /// Writes log g(z | xᵢ) of every particle into `out`. Must be finite or −∞, never NaN.
+    /// Writes log g(z | xᵢ) of every particle into `out`. Must be finite or −∞: NaN or +∞
+    /// makes the filter step fail with an error naming the track.
     fn log_likelihood(
         &self,
         z: &[f64],
