@@ -21,6 +21,10 @@
 //! always in view of a roof-mounted scanner; only the bottom is cut by ground removal, and the
 //! height is measured from the ground when it is known).
 //!
+//! The height profile enters through the top's height above the ground; the height of the
+//! point mass ([`BoxFit::mass_height`]) is kept by the fit but not used here, for want of
+//! published per-class statistics to set its likelihood from.
+//!
 //! Not for: fitting the box (see [`super::boxes`]), tracking (the track's motion enters only
 //! through the optional speed), or KITTI's label types (see [`crate::kitti::labels`]).
 
