@@ -70,7 +70,8 @@ pub struct SizePrior {
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct BoxFit {
     /// The points' bounding box at the fitted heading (length = the longer side unless a
-    /// size prior decided otherwise), bottom at the lowest point, top at the highest.
+    /// size prior decided otherwise), bottom at the lowest point, top at the highest. Its yaw
+    /// lies in (−π/2, π/2]: one frame's points cannot tell the front from the back.
     pub fitted: Box3,
     /// The box with the visible-face model applied: sides extended away from the sensor to
     /// the size prior, bottom at the ground when one was given. Equal to `fitted` (except for
@@ -258,8 +259,9 @@ fn heading_mod_pi(a: f64) -> f64 {
     }
 }
 
-/// The heading in [0, π/2) maximising the closeness criterion over the interleaved centred
-/// x–y coordinates `xy` (see the module notes). The first maximum wins on ties.
+/// The heading in [0, π/2) maximising the closeness criterion over the interleaved x–y
+/// coordinates `xy`, centred on their mean (see the module notes). The first maximum wins on
+/// ties.
 pub fn lshape_heading(xy: &[f64], params: &BoxFitParams) -> f64 {
     let steps = ((FRAC_PI_2 / params.angle_step).ceil() as usize).max(1);
     let d0 = params.min_distance;
@@ -271,17 +273,11 @@ pub fn lshape_heading(xy: &[f64], params: &BoxFitParams) -> f64 {
         }
         let (s, c) = theta.sin_cos();
         let r = Rect::bounding_sc(xy, s, c);
-        // Per axis, the edge whose distance vector has the smaller norm.
-        let (mut lo1, mut hi1, mut lo2, mut hi2) = (0.0, 0.0, 0.0, 0.0);
-        for p in xy.chunks_exact(2) {
-            let (a, b) = (c * p[0] + s * p[1], -s * p[0] + c * p[1]);
-            lo1 += (a - r.lo[0]) * (a - r.lo[0]);
-            hi1 += (r.hi[0] - a) * (r.hi[0] - a);
-            lo2 += (b - r.lo[1]) * (b - r.lo[1]);
-            hi2 += (r.hi[1] - b) * (r.hi[1] - b);
-        }
-        let use_lo1 = lo1 <= hi1;
-        let use_lo2 = lo2 <= hi2;
+        // Per axis, the edge whose distance vector has the smaller norm: Σ(a − lo)² ≤
+        // Σ(hi − a)² ⟺ 2·Σa ≤ n·(lo + hi), and Σa = 0 for the centred points, so the lower
+        // edge wins when lo + hi ≥ 0 (the mean lies in the rectangle's lower half).
+        let use_lo1 = r.lo[0] + r.hi[0] >= 0.0;
+        let use_lo2 = r.lo[1] + r.hi[1] >= 0.0;
         let mut score = 0.0;
         for p in xy.chunks_exact(2) {
             let (a, b) = (c * p[0] + s * p[1], -s * p[0] + c * p[1]);
