@@ -12,6 +12,7 @@ pub mod drive;
 pub mod frames;
 pub mod issue;
 pub mod labels;
+pub mod object;
 pub mod odometry;
 pub mod oxts;
 pub mod poses;
