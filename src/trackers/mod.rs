@@ -21,6 +21,7 @@
 //! Not for: segmentation (see [`crate::pipeline::people_tracking::person_measurements`]) or scoring (see
 //! [`crate::pipeline::people_tracking::evaluate`]).
 
+pub mod ab3dmot;
 pub mod ekf;
 pub mod gnn;
 pub mod imm;
