@@ -2,17 +2,21 @@
 //! `../shared/data/kitti_tracking/training`; a failure under `CI=true` when absent, a skip
 //! with a note otherwise): every label of the sequence taken into the Velodyne frame and
 //! written back as a result reproduces its 3-D fields and alpha, and its annotated 2-D box
-//! within a few pixels; a whole sequence's results file reads back.
+//! within a few pixels; a whole sequence's results file reads back; AB3DMOT fed the
+//! sequence's true boxes keeps one id per object.
 
 mod common;
 
 use nalgebra::Point3;
 use smc_lmb::geometry::wrap_angle;
-use smc_lmb::kitti::labels::{read_tracking_labels, TrackingLabel};
-use smc_lmb::kitti::tracking::{TrackingCalib, IMAGE_SIZE};
+use smc_lmb::kitti::labels::{label_frame_count, read_tracking_labels, ObjectType, TrackingLabel};
+use smc_lmb::kitti::tracking::{TrackingCalib, TrackingSequence, IMAGE_SIZE};
+use smc_lmb::pipeline::box_baseline::{baseline_results, move_box, run_box_baseline, FrameBoxes};
 use smc_lmb::pipeline::kitti_results::{
     image_box, result_label, results_path, write_tracking_results, ResultObject,
 };
+use smc_lmb::trackers::ab3dmot::Ab3dmotConfig;
+use std::collections::BTreeMap;
 
 fn sequence_0000() -> Option<(TrackingCalib, Vec<TrackingLabel>)> {
     let root = common::shared_data("kitti_tracking/training")?;
@@ -149,4 +153,88 @@ fn a_sequence_file_reads_back() {
     // No objects: an empty file still exists.
     write_tracking_results(&path, &[], &calib).unwrap();
     assert_eq!(std::fs::read_to_string(&path).unwrap(), "");
+}
+
+#[test]
+fn ab3dmot_on_the_true_boxes_of_sequence_0000() {
+    // KITTI's own boxes as detections (world frame through the OXTS poses): every labelled
+    // object seen in 3 frames in a row is reported, with one track id per object over each
+    // unbroken run of frames, and the results file holds one line per reported track.
+    let Some(root) = common::shared_data("kitti_tracking/training") else {
+        return;
+    };
+    let seq = TrackingSequence::open(&root, 0).unwrap();
+    let calib = seq.calib().unwrap();
+    let poses = seq.poses().unwrap();
+    let labels = seq.labels().unwrap();
+    let frames = label_frame_count(&labels);
+    assert!(poses.len() >= frames);
+    let rect_from_velo = calib.rect_from_velo();
+    let mut detections: Vec<FrameBoxes> = vec![Vec::new(); frames];
+    let mut truth: Vec<Vec<(i64, Point3<f64>)>> = vec![Vec::new(); frames];
+    for l in labels.iter().filter(|l| l.is_object()) {
+        let world = move_box(&l.to_velodyne(&rect_from_velo).to_box3(), &poses[l.frame]);
+        detections[l.frame].push((world, l.object_type.name().to_string(), 1.0));
+        truth[l.frame].push((l.track_id, world.center));
+    }
+    let tracks = run_box_baseline(&detections, &Ab3dmotConfig::default()).unwrap();
+    // Which track reported each labelled object, frame by frame.
+    let mut runs: BTreeMap<i64, Vec<(usize, Option<u64>)>> = BTreeMap::new();
+    for (k, objects) in truth.iter().enumerate() {
+        for &(id, centre) in objects {
+            let t = tracks[k]
+                .iter()
+                .find(|t| t.detected && (t.bbox.center - centre).norm() < 0.5);
+            runs.entry(id).or_default().push((k, t.map(|t| t.id)));
+        }
+    }
+    let (mut switches, mut reported, mut seen) = (0, 0, 0);
+    for (id, run) in &runs {
+        let mut streak = 0;
+        let mut previous: Option<(usize, u64)> = None;
+        for (i, &(k, track)) in run.iter().enumerate() {
+            streak = if i > 0 && run[i - 1].0 + 1 == k {
+                streak + 1
+            } else {
+                1
+            };
+            seen += 1;
+            if let Some(t) = track {
+                reported += 1;
+                if let Some((pk, pt)) = previous {
+                    // A new id is only allowed after a gap long enough to end the track.
+                    if pt != t && k - pk <= 2 {
+                        switches += 1;
+                    }
+                }
+                previous = Some((k, t));
+            } else {
+                assert!(
+                    streak < 3,
+                    "object {id} in frame {k}: seen {streak} frames in a row, not reported"
+                );
+            }
+        }
+    }
+    eprintln!(
+        "sequence 0000, true boxes through AB3DMOT: {} objects, {reported} of {seen} \
+         object-frames reported, {switches} id switches",
+        runs.len()
+    );
+    assert_eq!(switches, 0);
+    assert!(runs.len() >= 4, "{} objects", runs.len());
+    // The results file: one line per reported track the camera sees.
+    let velo_from_world: Vec<_> = poses.iter().map(|p| p.inverse()).collect();
+    let results = baseline_results(&tracks, &velo_from_world, ObjectType::from_name).unwrap();
+    let reported_tracks: usize = tracks.iter().map(Vec::len).sum();
+    assert_eq!(results.len(), reported_tracks);
+    let dir = tempfile::tempdir().unwrap();
+    let path = results_path(dir.path(), 0);
+    let written = write_tracking_results(&path, &results, &calib).unwrap();
+    let back = read_tracking_labels(&path).unwrap();
+    assert_eq!(back.len(), written);
+    assert!(
+        written * 10 >= reported_tracks * 8,
+        "{written} of {reported_tracks}"
+    );
 }
