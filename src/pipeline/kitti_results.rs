@@ -87,7 +87,7 @@ pub fn result_label(
     }
     let track_id = i64::try_from(obj.track_id)
         .map_err(|_| Error::invalid(what(), "the track id does not fit a label"))?;
-    if !(image_size.iter().all(|s| s.is_finite() && *s >= 1.0)) {
+    if !image_size.iter().all(|s| s.is_finite() && *s >= 1.0) {
         return Err(Error::invalid(
             "image size",
             format!("{image_size:?} (must be at least one pixel each way)"),
@@ -126,13 +126,16 @@ pub fn result_label(
 }
 
 /// The 2-D box (left, top, right, bottom) in camera 2's image of a label's 3-D box, clipped
-/// to the image; `None` when no part of the box lies beyond [`NEAR_PLANE`] or its projection
-/// misses the image.
+/// to the image; `None` when no part of the box lies beyond [`NEAR_PLANE`], its projection
+/// misses the image, or the image size is less than a pixel (or not finite).
 pub fn image_box(
     label: &TrackingLabel,
     calib: &TrackingCalib,
     image_size: [f64; 2],
 ) -> Option<[f64; 4]> {
+    if !image_size.iter().all(|s| s.is_finite() && *s >= 1.0) {
+        return None;
+    }
     let [h, w, l] = label.dimensions;
     let [x, y, z] = label.location;
     let (s, c) = label.rotation_y.sin_cos();
@@ -320,5 +323,10 @@ mod tests {
         let mut o = object(10.0, 0.0, 0.0, 0.0);
         o.track_id = u64::MAX;
         assert!(result_label(&o, &calib, IMAGE_SIZE).is_err());
+        let o = object(10.0, 0.0, 0.0, 0.0);
+        assert!(result_label(&o, &calib, [0.5, 375.0]).is_err());
+        let l = result_label(&o, &calib, IMAGE_SIZE).unwrap().unwrap();
+        assert!(image_box(&l, &calib, [f64::NAN, 375.0]).is_none());
+        assert_eq!(image_box(&l, &calib, IMAGE_SIZE), Some(l.bbox));
     }
 }
