@@ -26,6 +26,11 @@ pub use drive_tracking::{
 #[cfg(feature = "kitti")]
 pub mod drive_evaluation;
 
+#[cfg(feature = "kitti")]
+pub mod box_baseline;
+#[cfg(feature = "kitti")]
+pub mod kitti_results;
+
 #[cfg(feature = "laser2d")]
 pub mod people_tracking;
 #[cfg(feature = "kitti")]

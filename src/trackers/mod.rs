@@ -17,10 +17,12 @@
 //! * [`imm`]: interacting multiple models (CV and coordinated turn) on one track.
 //! * [`jpda_imm`]: joint probabilistic data association over IMM tracks.
 //! * [`LmbTracker`]: the LMB filter behind [`PointTracker`].
+//! * [`ab3dmot`]: AB3DMOT, Kalman-filtered oriented 3-D boxes (fed boxes, not a [`PointTracker`]).
 //!
 //! Not for: segmentation (see [`crate::pipeline::people_tracking::person_measurements`]) or scoring (see
 //! [`crate::pipeline::people_tracking::evaluate`]).
 
+pub mod ab3dmot;
 pub mod ekf;
 pub mod gnn;
 pub mod imm;
