@@ -11,6 +11,10 @@ use smc_lmb::pipeline::drive_tracking::{
     drive_plot, point_labels, track_drive, track_odometry_sequence, track_tracking_sequence,
     DriveTracks, EgoModel, FrameView, PoseSource, TrackingConfig,
 };
+use smc_lmb::kitti::tracking::TrackingCalib;
+use smc_lmb::pipeline::drive_tracking::kitti_out::{lmb_results, BaselineBoxes};
+use smc_lmb::pipeline::kitti_results::{results_path, write_tracking_results, ResultObject};
+use smc_lmb::trackers::ab3dmot::Ab3dmotConfig;
 use std::ops::Range;
 use std::path::PathBuf;
 
@@ -66,6 +70,18 @@ pub struct Args {
     /// or `static` (a sensor that does not move). The output's `ego` says which was used.
     #[arg(long, value_enum, default_value_t = Ego::Auto)]
     ego: Ego,
+    /// Report every confirmed cluster, also static ones of class `Other` (poles, trunks,
+    /// hedges), which are left out of the road users by default.
+    #[arg(long)]
+    all_clusters: bool,
+    /// Write the road users as KITTI tracking results, `DIR/NNNN.txt` in the label_02 format
+    /// (tracking layout only: the 2-D boxes need the sequence's calibration).
+    #[arg(long, requires = "tracking")]
+    kitti_out: Option<PathBuf>,
+    /// Also run the AB3DMOT-style baseline on the same detections and write its results to
+    /// `DIR/NNNN.txt` (tracking layout only).
+    #[arg(long, requires = "tracking")]
+    baseline_out: Option<PathBuf>,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -129,6 +145,8 @@ pub fn run(args: Args) -> Result<()> {
         };
     }
     config.poses = args.ego.into();
+    config.all_clusters = args.all_clusters;
+    let baseline = std::cell::RefCell::new(BaselineBoxes::new());
     let frames = args.frames.as_deref().map(parse_range).transpose()?;
     for dir in [&args.las, &args.ply].into_iter().flatten() {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
@@ -151,6 +169,9 @@ pub fn run(args: Args) -> Result<()> {
             view.tracked.planes.len(),
             view.tracked.clusters.len()
         ));
+        if args.baseline_out.is_some() {
+            baseline.borrow_mut().add(view);
+        }
         let k = view.tracked.frame;
         if args.export_frames.is_empty() || args.export_frames.contains(&k) {
             let labels = point_labels(view.cloud.len(), view.detections, view.tracked);
@@ -194,7 +215,33 @@ pub fn run(args: Args) -> Result<()> {
     }
     print_summary(&tracks);
     println!("wrote {}", args.out.display());
+    if let (Some(root), Some(n)) = (&args.tracking, args.sequence) {
+        let calib = TrackingSequence::open(root, n)?.calib()?;
+        if let Some(dir) = &args.kitti_out {
+            let path = write_results(dir, n, &lmb_results(&tracks), &calib)?;
+            println!("wrote {path}");
+        }
+        if let Some(dir) = &args.baseline_out {
+            let objects = baseline.borrow().results(&Ab3dmotConfig::default())?;
+            let path = write_results(dir, n, &objects, &calib)?;
+            println!("wrote {path} (AB3DMOT-style baseline on the same detections)");
+        }
+    }
     Ok(())
+}
+
+/// Writes `objects` as `DIR/NNNN.txt`; returns the path and line count as text.
+fn write_results(
+    dir: &std::path::Path,
+    sequence: u32,
+    objects: &[ResultObject],
+    calib: &TrackingCalib,
+) -> Result<String> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let path = results_path(dir, sequence);
+    let lines = write_tracking_results(&path, objects, calib)
+        .with_context(|| format!("writing {}", path.display()))?;
+    Ok(format!("{} ({lines} result lines)", path.display()))
 }
 
 /// Prints what a tracking run confirmed and how long its stages took.

@@ -13,7 +13,10 @@
 use super::TrackingConfig;
 use crate::cloud::cluster::{euclidean_clusters_of, ClusterParams};
 use crate::cloud::planes::extract_planes;
+use crate::cloud::boxes::BoxScratch;
+use crate::cloud::classes::ClassModel;
 use crate::cloud::PointCloud;
+use crate::pipeline::drive_tracking::road_users::{shape_of, ClusterShape};
 use crate::error::Result;
 use crate::filter::Measurements;
 use crate::geometry::PlanePatch;
@@ -21,6 +24,7 @@ use crate::pipeline::drive_tracking::mixed::{
     cluster_measurement, plane_measurement, MEASUREMENT_DIM,
 };
 use crate::rng::FilterRng;
+use rayon::prelude::*;
 use std::time::Instant;
 
 /// One cluster detection in the sensor frame.
@@ -34,9 +38,20 @@ pub struct ClusterDetection {
     pub max: [f64; 3],
     /// Indices of the member points in the frame's cloud (empty for detections built by hand).
     pub indices: Vec<u32>,
+    /// Oriented box and class evidence (`None` for detections built by hand without points).
+    pub shape: Option<ClusterShape>,
 }
 
 impl ClusterDetection {
+    /// The measured position: the centre of the box with the visible-face model when there is
+    /// one, the centroid otherwise.
+    pub fn position(&self) -> [f64; 3] {
+        match &self.shape {
+            Some(s) => [s.bbox.center.x, s.bbox.center.y, s.bbox.center.z],
+            None => self.centroid,
+        }
+    }
+
     /// A detection with a box of `size` around `centroid` and no points (for benchmarks and
     /// tests that bypass the point cloud).
     pub fn around(centroid: [f64; 3], size: [f64; 3]) -> Self {
@@ -45,6 +60,7 @@ impl ClusterDetection {
             min: std::array::from_fn(|i| centroid[i] - 0.5 * size[i]),
             max: std::array::from_fn(|i| centroid[i] + 0.5 * size[i]),
             indices: Vec::new(),
+            shape: None,
         }
     }
 }
@@ -82,7 +98,7 @@ impl FrameDetections {
             m.push(&plane_measurement(w.patch.plane.as_vector()))?;
         }
         for c in &self.clusters {
-            m.push(&cluster_measurement(c.centroid))?;
+            m.push(&cluster_measurement(c.position()))?;
         }
         Ok(m)
     }
@@ -145,11 +161,24 @@ pub fn detect_objects(
             min: k.min.map(f64::from),
             max: k.max.map(f64::from),
             indices: k.indices,
+            shape: None,
         })
         .collect();
     let range = |d: &ClusterDetection| d.centroid[0].hypot(d.centroid[1]);
     clusters.sort_by(|a, b| range(a).total_cmp(&range(b)));
     clusters.truncate(c.max_clusters);
+    let ground_z = |x: f64, y: f64| -> Option<f64> {
+        let g = ground.as_ref()?;
+        (g.normal.z.abs() > 0.5).then(|| -(g.normal.x * x + g.normal.y * y + g.offset) / g.normal.z)
+    };
+    let model = ClassModel::default();
+    clusters
+        .par_iter_mut()
+        .try_for_each_init(BoxScratch::default, |scratch, d| -> Result<()> {
+            let z0 = ground_z(d.centroid[0], d.centroid[1]).or(Some(-c.sensor_height));
+            d.shape = Some(shape_of(cloud, &d.indices, z0, &model, scratch)?);
+            Ok(())
+        })?;
     let clusters_ms = start.elapsed().as_secs_f64() * 1e3;
 
     Ok(FrameDetections {

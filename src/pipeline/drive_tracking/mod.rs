@@ -23,6 +23,8 @@ pub mod export;
 pub mod mixed;
 pub mod output;
 pub mod repeatability;
+pub mod kitti_out;
+pub mod road_users;
 pub mod tracker;
 
 pub use detect::{detect_objects, ClusterDetection, FrameDetections, WallDetection};
@@ -248,6 +250,10 @@ pub struct TrackingConfig {
     pub clusters: ClusterDetectionConfig,
     /// Frame interval when the drive has no Velodyne timestamps (s). Default 0.1.
     pub dt: f64,
+    /// Report every confirmed cluster, not only road users (see
+    /// [`road_users::RoadUserState::is_road_user`]: static clusters of class `Other` are left
+    /// out by default).
+    pub all_clusters: bool,
     /// Plane segmentation.
     #[serde(skip)]
     pub planes: PlaneConfig,
@@ -267,6 +273,7 @@ impl Default for TrackingConfig {
             birth: BirthTuning::default(),
             clusters: ClusterDetectionConfig::default(),
             dt: 0.1,
+            all_clusters: false,
             planes: PlaneConfig::default(),
         }
     }

@@ -56,6 +56,45 @@ pub struct TrackedCluster {
     pub existence: f64,
     /// Index of the cluster detection of this frame matched to the track, if any.
     pub detection: Option<usize>,
+    /// Most likely class (`Car`, `Van`, `Truck`, `Pedestrian`, `Cyclist`, `Other`) of the
+    /// track's class posterior; `None` before any matched detection with a shape.
+    #[serde(default)]
+    pub class: Option<String>,
+    /// Posterior probability of `class`.
+    #[serde(default)]
+    pub class_probability: f64,
+    /// Oriented box in the world frame: centre at the position estimate, size averaged over
+    /// the matched detections, heading along the direction of travel once moving.
+    #[serde(default)]
+    pub box_world: Option<OrientedBox>,
+    /// The same box in the sensor frame of this frame.
+    #[serde(default)]
+    pub box_sensor: Option<OrientedBox>,
+    /// Whether the track counts as a road user (not static clutter of class `Other`).
+    #[serde(default = "yes")]
+    pub road_user: bool,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// An oriented box upright about z.
+#[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct OrientedBox {
+    /// Centre of the box (m).
+    pub center: [f64; 3],
+    /// Length (along the heading), width, height (m).
+    pub size: [f64; 3],
+    /// Heading of the length axis about z, counter-clockwise from x (rad).
+    pub yaw: f64,
+}
+
+impl OrientedBox {
+    /// As a [`crate::geometry::Box3`].
+    pub fn to_box3(&self) -> crate::geometry::Box3 {
+        crate::geometry::Box3::new(self.center.into(), self.size, self.yaw)
+    }
 }
 
 /// Milliseconds spent per stage on one frame.

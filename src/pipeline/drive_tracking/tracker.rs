@@ -12,7 +12,10 @@
 //! Not for: reading drives or segmenting clouds (see [`super::detect`], [`super::track_drive`]).
 
 use super::detect::FrameDetections;
-use super::output::{StageTimes, TrackedCluster, TrackedFrame, TrackedPlane};
+use super::output::{OrientedBox, StageTimes, TrackedCluster, TrackedFrame, TrackedPlane};
+use super::road_users::RoadUserState;
+use crate::cloud::classes::ClassModel;
+use crate::geometry::wrap_angle;
 use super::{EgoModel, TrackingConfig};
 use crate::error::Result;
 use crate::filter::{AdaptiveBirth, Estimate, Frame, Label, LmbFilter};
@@ -43,6 +46,9 @@ pub struct DriveTracker {
     ids: HashMap<Label, u32>,
     wall_corners: HashMap<Label, [Point3<f64>; 4]>,
     cluster_extent: HashMap<Label, [f64; 3]>,
+    road_users: HashMap<Label, RoadUserState>,
+    class_model: ClassModel,
+    all_clusters: bool,
 }
 
 impl std::fmt::Debug for DriveTracker {
@@ -116,6 +122,9 @@ impl DriveTracker {
             ids: HashMap::new(),
             wall_corners: HashMap::new(),
             cluster_extent: HashMap::new(),
+            road_users: HashMap::new(),
+            class_model: ClassModel::default(),
+            all_clusters: config.all_clusters,
         })
     }
 
@@ -150,7 +159,7 @@ impl DriveTracker {
             },
             &mut self.rng,
         )?;
-        let (planes, clusters) = self.report(&estimates, &pose, detections);
+        let (planes, clusters) = self.report(&estimates, &pose, detections)?;
         let filter_ms = start.elapsed().as_secs_f64() * 1e3;
         let (_, _, yaw) = pose.rotation.euler_angles();
         let t = pose.translation.vector;
@@ -183,7 +192,7 @@ impl DriveTracker {
         estimates: &[Estimate],
         pose: &Isometry3<f64>,
         det: &FrameDetections,
-    ) -> (Vec<TrackedPlane>, Vec<TrackedCluster>) {
+    ) -> Result<(Vec<TrackedPlane>, Vec<TrackedCluster>)> {
         let inv = pose.inverse();
         let mut planes: Vec<(&Estimate, [f64; 4])> = Vec::new();
         let mut clusters: Vec<(&Estimate, Point3<f64>)> = Vec::new();
@@ -215,7 +224,7 @@ impl DriveTracker {
         for (i, (_, w)) in clusters.iter().enumerate() {
             let s = inv * w;
             for (j, c) in det.clusters.iter().enumerate() {
-                let d = (s - Point3::from(c.centroid)).norm();
+                let d = (s - Point3::from(c.position())).norm();
                 if d <= MATCH_DISTANCE {
                     cluster_pairs.push((d, i, j));
                 }
@@ -253,27 +262,69 @@ impl DriveTracker {
                 detection: m,
             });
         }
+        let ego_yaw = yaw_of(pose);
         let mut out_clusters = Vec::with_capacity(clusters.len());
         for ((e, w), m) in clusters.iter().zip(cluster_match) {
+            let velocity = [e.state[1], e.state[3], e.state[5]];
+            let speed = velocity[0].hypot(velocity[1]);
             if let Some(j) = m {
                 let c = &det.clusters[j];
                 self.cluster_extent
                     .insert(e.label, std::array::from_fn(|a| c.max[a] - c.min[a]));
+                if let Some(shape) = &c.shape {
+                    let world_yaw = wrap_angle(shape.bbox.yaw + ego_yaw);
+                    match self.road_users.get_mut(&e.label) {
+                        Some(state) => state.update(shape, world_yaw, speed, &self.class_model)?,
+                        None => {
+                            let state =
+                                RoadUserState::new(shape, world_yaw, speed, &self.class_model)?;
+                            self.road_users.insert(e.label, state);
+                        }
+                    }
+                }
+            }
+            let state = self.road_users.get(&e.label);
+            let road_user = state.is_none_or(|st| st.is_road_user(speed));
+            if !road_user && !self.all_clusters {
+                continue;
             }
             let s = inv * w;
+            let (class, class_probability, box_world, box_sensor) = match state {
+                Some(st) => {
+                    let (class, p) = st.class();
+                    let yaw = st.heading([velocity[0], velocity[1]]);
+                    let world = OrientedBox {
+                        center: [w.x, w.y, w.z],
+                        size: st.size(),
+                        yaw,
+                    };
+                    let sensor = OrientedBox {
+                        center: [s.x, s.y, s.z],
+                        size: st.size(),
+                        yaw: wrap_angle(yaw - ego_yaw),
+                    };
+                    (Some(class.name().to_string()), p, Some(world), Some(sensor))
+                }
+                None => (None, 0.0, None, None),
+            };
             let id = self.id_of(e.label);
             out_clusters.push(TrackedCluster {
                 id,
                 label: e.label,
                 position_world: [w.x, w.y, w.z],
                 position_sensor: [s.x, s.y, s.z],
-                velocity: [e.state[1], e.state[3], e.state[5]],
+                velocity,
                 extent: self.cluster_extent.get(&e.label).copied(),
                 existence: e.existence,
                 detection: m,
+                class,
+                class_probability,
+                box_world,
+                box_sensor,
+                road_user,
             });
         }
-        (out_planes, out_clusters)
+        Ok((out_planes, out_clusters))
     }
 }
 
@@ -290,6 +341,12 @@ fn greedy(mut pairs: Vec<(f64, usize, usize)>, rows: usize, cols: usize) -> Vec<
         }
     }
     row
+}
+
+/// Heading (rad) of a pose's x axis about z.
+fn yaw_of(pose: &Isometry3<f64>) -> f64 {
+    let x = pose.rotation * Vector3::x();
+    x.y.atan2(x.x)
 }
 
 /// Area of the rectangle v0 v1 v2 v3.

@@ -1,0 +1,234 @@
+//! Road users among the clusters: the oriented box and class evidence of one cluster
+//! detection, and what a cluster track remembers of them from frame to frame.
+//!
+//! * A detection's box is fitted to its points ([`crate::cloud::boxes`]: L-shape heading,
+//!   bottom on the ground plane) and classed for this frame ([`crate::cloud::classes`]); when
+//!   that frame's most likely class has a plausible footprint, the box is fitted again with it
+//!   and the visible-face model moves the box's centre away from the sensor. That centre, not
+//!   the centroid of the visible points, is what the filter measures.
+//! * A track keeps a categorical class posterior ([`ClassBelief`]) updated with every matched
+//!   detection's class likelihood (its speed included, from the track), a box size averaged
+//!   over its detections, and a heading in the world frame: the matched box's, turned by π
+//!   towards the direction of travel once the track moves.
+//! * A confirmed cluster is a road user unless its class is `Other` and it moves slower than
+//!   [`STATIC_SPEED`]; parked cars are road users.
+//!
+//! Not for: clustering (see [`super::detect`]) or the filter (see [`super::tracker`]).
+
+use crate::cloud::boxes::{fit_box_of, BoxFitParams, BoxScratch};
+use crate::cloud::classes::{
+    default_prior, ClassBelief, ClassFeatures, ClassModel, ObjectClass, CLASS_COUNT,
+    DEFAULT_FORGETTING,
+};
+use crate::cloud::PointCloud;
+use crate::error::Result;
+use crate::geometry::{wrap_angle, Box3};
+use std::f64::consts::PI;
+
+/// Slower than this (m/s) a track of class `Other` is static clutter, not a road user.
+pub const STATIC_SPEED: f64 = 1.0;
+
+/// Weight of a new detection's box size in a track's running size.
+const SIZE_GAIN: f64 = 0.3;
+
+/// Faster than this (m/s) a track's heading follows its direction of travel.
+const HEADING_SPEED: f64 = 1.0;
+
+/// The box and class evidence of one cluster detection (sensor frame).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClusterShape {
+    /// The box with the visible-face model applied (its centre is the measured position).
+    pub bbox: Box3,
+    /// The points' own bounding box at the fitted heading.
+    pub fitted: Box3,
+    /// What the class likelihood looks at (without a speed: the detection has none).
+    pub features: ClassFeatures,
+    /// The most likely class of this frame alone, under the default prior.
+    pub class: ObjectClass,
+}
+
+/// Fits and classes the cluster made of `indices` of `cloud`; `ground_z` is the ground's
+/// height under it (sensor frame) when known.
+pub fn shape_of(
+    cloud: &PointCloud,
+    indices: &[u32],
+    ground_z: Option<f64>,
+    model: &ClassModel,
+    scratch: &mut BoxScratch,
+) -> Result<ClusterShape> {
+    let params = BoxFitParams::default();
+    let fit = fit_box_of(cloud, indices, ground_z, None, &params, scratch)?;
+    let features = ClassFeatures::from_fit(&fit, None);
+    let class = model.classify(&features, &default_prior())?;
+    let bbox = match class.size_prior() {
+        Some(prior) => fit_box_of(cloud, indices, ground_z, Some(&prior), &params, scratch)?,
+        None => fit,
+    }
+    .estimated;
+    Ok(ClusterShape {
+        bbox,
+        fitted: fit.fitted,
+        features,
+        class,
+    })
+}
+
+/// What a cluster track remembers of its detections' shapes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RoadUserState {
+    belief: ClassBelief,
+    size: [f64; 3],
+    /// Heading of the box's length axis in the world frame (rad).
+    yaw: f64,
+}
+
+impl RoadUserState {
+    /// The state after the first matched detection `shape`, whose box heading in the world
+    /// frame is `world_yaw`.
+    pub fn new(
+        shape: &ClusterShape,
+        world_yaw: f64,
+        speed: f64,
+        model: &ClassModel,
+    ) -> Result<Self> {
+        let mut s = RoadUserState {
+            belief: ClassBelief::new(default_prior())?,
+            size: shape.bbox.size,
+            yaw: world_yaw,
+        };
+        s.observe_class(shape, speed, model)?;
+        Ok(s)
+    }
+
+    fn observe_class(&mut self, shape: &ClusterShape, speed: f64, model: &ClassModel) -> Result<()> {
+        let features = ClassFeatures {
+            speed: Some(speed),
+            ..shape.features
+        };
+        self.belief
+            .update(&model.log_likelihoods(&features)?, DEFAULT_FORGETTING)
+    }
+
+    /// Folds in one more matched detection.
+    pub fn update(
+        &mut self,
+        shape: &ClusterShape,
+        world_yaw: f64,
+        speed: f64,
+        model: &ClassModel,
+    ) -> Result<()> {
+        self.observe_class(shape, speed, model)?;
+        for (s, d) in self.size.iter_mut().zip(shape.bbox.size) {
+            *s += SIZE_GAIN * (d - *s);
+        }
+        self.yaw = world_yaw;
+        Ok(())
+    }
+
+    /// The most likely class and its probability.
+    pub fn class(&self) -> (ObjectClass, f64) {
+        let c = self.belief.most_likely();
+        (c, self.belief.probability(c))
+    }
+
+    /// The class probabilities in [`ObjectClass::ALL`] order.
+    pub fn probabilities(&self) -> [f64; CLASS_COUNT] {
+        self.belief.probabilities()
+    }
+
+    /// Box size (length, width, height, m).
+    pub fn size(&self) -> [f64; 3] {
+        self.size
+    }
+
+    /// The heading (world frame) of a track moving with `velocity` (world frame, m/s): the
+    /// box's axis turned towards the direction of travel once the track is faster than a
+    /// walk, the box's own heading otherwise.
+    pub fn heading(&self, velocity: [f64; 2]) -> f64 {
+        let speed = velocity[0].hypot(velocity[1]);
+        if speed < HEADING_SPEED {
+            return self.yaw;
+        }
+        let travel = velocity[1].atan2(velocity[0]);
+        if wrap_angle(travel - self.yaw).abs() > PI / 2.0 {
+            wrap_angle(self.yaw + PI)
+        } else {
+            self.yaw
+        }
+    }
+
+    /// Whether a confirmed track of this state moving at `speed` is a road user.
+    pub fn is_road_user(&self, speed: f64) -> bool {
+        self.class().0 != ObjectClass::Other || speed >= STATIC_SPEED
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Point3;
+
+    fn car_points() -> PointCloud {
+        // The two faces a sensor at the origin sees of a 4.5 × 1.8 × 1.5 m car whose near
+        // corner is at (10, 2): its rear (x = 10) and its right side (y = 2), ten rings.
+        let mut cloud = PointCloud::new();
+        for ring in 0..10 {
+            let z = -1.6 + 0.15 * ring as f32;
+            for k in 0..30 {
+                cloud.push(10.0, 2.0 + 1.8 * k as f32 / 29.0, z, 0.0);
+                cloud.push(10.0 + 4.5 * k as f32 / 29.0, 2.0, z, 0.0);
+            }
+        }
+        cloud
+    }
+
+    #[test]
+    fn a_car_seen_from_its_corner_is_boxed_and_classed_with_its_centre_behind_the_faces() {
+        let cloud = car_points();
+        let idx: Vec<u32> = (0..cloud.len() as u32).collect();
+        let shape = shape_of(
+            &cloud,
+            &idx,
+            Some(-1.73),
+            &ClassModel::default(),
+            &mut BoxScratch::default(),
+        )
+        .unwrap();
+        assert_eq!(shape.class, ObjectClass::Car);
+        // The true centre (12.25, 2.9) lies behind the two faces seen; the fitted box of the
+        // points is the same rectangle here, since both faces are seen whole.
+        let c = shape.bbox.center;
+        assert!((c.x - 12.25).abs() < 0.1 && (c.y - 2.9).abs() < 0.1, "{c:?}");
+        assert!((shape.bbox.size[0] - 4.5).abs() < 0.1, "{:?}", shape.bbox);
+    }
+
+    #[test]
+    fn heading_follows_the_direction_of_travel_and_static_other_is_not_a_road_user() {
+        let b = Box3::new(Point3::new(0.0, 0.0, 0.0), [0.5, 0.5, 0.5], 0.0);
+        let shape = ClusterShape {
+            bbox: b,
+            fitted: b,
+            features: ClassFeatures {
+                length: 0.5,
+                width: 0.5,
+                height: 0.5,
+                range: 10.0,
+                points: 40,
+                speed: None,
+            },
+            class: ObjectClass::Other,
+        };
+        let model = ClassModel::default();
+        let mut s = RoadUserState::new(&shape, 0.1, 0.0, &model).unwrap();
+        for _ in 0..5 {
+            s.update(&shape, 0.1, 0.0, &model).unwrap();
+        }
+        assert_eq!(s.class().0, ObjectClass::Other);
+        assert!(!s.is_road_user(0.2));
+        assert!(s.is_road_user(STATIC_SPEED + 0.5));
+        // Moving backwards along the box axis: the heading turns by π; slow: it stays.
+        assert!((wrap_angle(s.heading([-3.0, -0.2]) - (0.1 - PI))).abs() < 1e-12);
+        assert_eq!(s.heading([0.1, 0.0]), 0.1);
+        assert_eq!(s.heading([3.0, 0.2]), 0.1);
+    }
+}
