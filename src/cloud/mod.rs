@@ -6,6 +6,8 @@
 //! Not for: finding the frames of a recording (see [`crate::kitti`]) or fitting
 //! planes to the points.
 
+pub mod boxes;
+pub mod classes;
 pub mod cluster;
 pub mod kitti_bin;
 pub mod las_io;

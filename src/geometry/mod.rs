@@ -3,6 +3,7 @@
 //! plane patches.
 //!
 //! * [`angle`]: [`wrap_angle`], the one wrap to (−π, π].
+//! * [`box3`]: [`Box3`], oriented boxes upright about z; [`iou_bev`], [`iou_3d`].
 //! * [`pose2`]: [`Pose2`] and planar rigid motions, [`platform_isometry`] (a planar pose as the
 //!   SE(3) pose a filter step holds).
 //! * [`ray`]: [`ray_circle`], where a ray first meets a circle.
@@ -13,11 +14,13 @@
 //! poses (see [`crate::kitti::poses`]).
 
 pub mod angle;
+pub mod box3;
 pub mod plane;
 pub mod pose2;
 pub mod ray;
 
 pub use angle::wrap_angle;
+pub use box3::{bev_intersection_area, iou_3d, iou_bev, Box3};
 pub use plane::{Plane, PlanePatch};
 pub use pose2::{platform_isometry, Pose2};
 pub use ray::ray_circle;

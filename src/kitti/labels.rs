@@ -21,7 +21,7 @@
 use super::text::{numbered_lines, parse_f64, read_text};
 use crate::atomic::write_atomically;
 use crate::error::{Error, Result};
-use crate::geometry::wrap_angle;
+use crate::geometry::{wrap_angle, Box3};
 use nalgebra::{Isometry3, Point3, Vector3};
 use std::fmt;
 use std::io::Write;
@@ -152,6 +152,11 @@ pub struct VelodyneBox {
 }
 
 impl VelodyneBox {
+    /// The same box as a [`Box3`] (identical fields), for the geometry and IoU code.
+    pub fn to_box3(&self) -> Box3 {
+        Box3::new(self.center, self.size, self.yaw)
+    }
+
     /// Whether `p` (Velodyne frame) lies inside the box grown by `margin` metres on every side
     /// (the box's vertical axis taken as the Velodyne z axis).
     pub fn contains(&self, p: &Point3<f64>, margin: f64) -> bool {
