@@ -18,15 +18,19 @@
 //! 2-D box benchmark, match threshold 0.5); `BevDistance { max }` is max(0, 1 − d/max) with d
 //! the bird's-eye distance of the box positions (camera x and z); a CLEAR / identity match
 //! needs d < max (threshold 10⁻⁶: within max·(1 − 10⁻⁶)), so `max = 2` is "centre distance
-//! within 2 m" and HOTA's α sweeps d from 1.9 m down to 0.1 m. 3-D results whose image boxes
-//! are empty (zero area) are never inside a `DontCare` region.
+//! within 2 m" and HOTA's α sweeps d from 1.9 m down to 0.1 m; `Iou3d` is the 3-D IoU of the
+//! oriented boxes ([`crate::geometry::iou_3d`], the camera's y axis vertical), match threshold
+//! 0.25. 3-D results whose image boxes are empty (zero area) are never inside a `DontCare`
+//! region.
 //!
 //! Not for: the metrics themselves, reading files, or scoring `track`'s JSON output (see
 //! [`super::drive_evaluation`]).
 
 use crate::error::{Error, Result};
+use crate::geometry::{iou_3d, Box3};
 use crate::kitti::{ObjectType, TrackingCalib, TrackingLabel};
 use crate::metrics::tracking::{evaluate, ScoreConfig, TrackingFrame, TrackingScores};
+use nalgebra::Point3;
 use serde::{Deserialize, Serialize};
 
 const EPS: f64 = f64::EPSILON;
@@ -42,6 +46,8 @@ pub enum Similarity {
         /// Distance at which the similarity reaches 0 (m).
         max: f64,
     },
+    /// 3-D IoU of the oriented boxes, the camera's y axis taken as vertical.
+    Iou3d,
 }
 
 impl Similarity {
@@ -51,6 +57,7 @@ impl Similarity {
         match self {
             Similarity::Iou2d => 0.5,
             Similarity::BevDistance { .. } => 1e-6,
+            Similarity::Iou3d => 0.25,
         }
     }
 
@@ -62,6 +69,7 @@ impl Similarity {
                 let d = (gt.location[0] - tr.location[0]).hypot(gt.location[2] - tr.location[2]);
                 (1.0 - d / max).max(0.0)
             }
+            Similarity::Iou3d => iou_3d(&upright_box(gt), &upright_box(tr)),
         };
         if s.is_finite() {
             s.clamp(0.0, 1.0)
@@ -72,12 +80,22 @@ impl Similarity {
 
     fn check(&self) -> Result<()> {
         match *self {
-            Similarity::Iou2d => Ok(()),
+            Similarity::Iou2d | Similarity::Iou3d => Ok(()),
             Similarity::BevDistance { max } => {
                 crate::error::ensure_positive("BEV distance max", max)
             }
         }
     }
+}
+
+/// A label's 3-D box in a z-up frame made from the rectified camera frame by (x, y, z) →
+/// (z, −x, −y): forward, left, up. The label's location is its bottom-face centre.
+pub fn upright_box(l: &TrackingLabel) -> Box3 {
+    let [h, w, len] = l.dimensions;
+    let [x, y, z] = l.location;
+    let (s, c) = l.rotation_y.sin_cos();
+    // The length axis (cos ry, 0, −sin ry) in the camera frame is (−sin ry, −cos ry, 0) here.
+    Box3::new(Point3::new(z, -x, h / 2.0 - y), [len, w, h], (-c).atan2(-s))
 }
 
 /// IoU of two image boxes (left, top, right, bottom), TrackEval's way: 0 when either box or
@@ -184,6 +202,16 @@ impl KittiEvalConfig {
         KittiEvalConfig {
             similarity,
             match_threshold: similarity.default_threshold(),
+            min_height_px: None,
+            ..Self::iou_2d()
+        }
+    }
+
+    /// 3-D IoU of the oriented boxes, a match at IoU ≥ 0.25.
+    pub fn iou_3d() -> Self {
+        KittiEvalConfig {
+            similarity: Similarity::Iou3d,
+            match_threshold: Similarity::Iou3d.default_threshold(),
             min_height_px: None,
             ..Self::iou_2d()
         }
@@ -462,6 +490,34 @@ mod tests {
         assert_eq!(s.identity.idtp, 6);
         let p = &class(&e, EvalClass::Pedestrian).scores;
         assert_eq!(p.clear.tp + p.clear.fp + p.clear.fn_count, 0);
+    }
+
+    #[test]
+    fn iou_3d_by_hand() {
+        // 2 × 2 × 2 m cubes one metre apart along the camera's x: overlap 1 × 2 × 2 = 4 m³,
+        // union 8 + 8 − 4 = 12 m³.
+        let mut a = car(0, 1, 0.0, 10.0);
+        a.dimensions = [2.0, 2.0, 2.0];
+        let mut b = a;
+        b.location[0] += 1.0;
+        assert!((Similarity::Iou3d.between(&a, &b) - 1.0 / 3.0).abs() < 1e-12);
+        // The same shift along the camera's y (vertical): half the height overlaps.
+        let mut c = a;
+        c.location[1] += 1.0;
+        assert!((Similarity::Iou3d.between(&a, &c) - 1.0 / 3.0).abs() < 1e-12);
+        // A 4 × 2 footprint turned by a half turn is the same box; by a quarter turn about
+        // the same centre the footprints share 2 × 2 of 8 + 8 − 4 m².
+        let mut d = a;
+        d.dimensions = [2.0, 2.0, 4.0];
+        let mut e = d;
+        e.rotation_y = std::f64::consts::PI;
+        assert!((Similarity::Iou3d.between(&d, &e) - 1.0).abs() < 1e-12);
+        e.rotation_y = std::f64::consts::FRAC_PI_2;
+        assert!((Similarity::Iou3d.between(&d, &e) - 1.0 / 3.0).abs() < 1e-12);
+        // The box stands on its location: its centre is h/2 above it (camera y down).
+        let u = upright_box(&d);
+        assert!((u.center.z - (1.0 - 1.6)).abs() < 1e-12);
+        assert!((u.center.x - 10.0).abs() < 1e-12 && u.center.y.abs() < 1e-12);
     }
 
     #[test]
