@@ -107,10 +107,10 @@ pub(crate) fn hota_of(seq: &Sequence) -> Hota {
         let (g, t) = (gids.len(), tids.len());
         let mut row_sum = vec![0.0; g];
         let mut col_sum = vec![0.0; t];
-        for i in 0..g {
-            for j in 0..t {
-                row_sum[i] += f.sim(i, j);
-                col_sum[j] += f.sim(i, j);
+        for (i, r) in row_sum.iter_mut().enumerate() {
+            for (j, c) in col_sum.iter_mut().enumerate() {
+                *r += f.sim(i, j);
+                *c += f.sim(i, j);
             }
         }
         for (i, &gi) in gids.iter().enumerate() {
