@@ -22,8 +22,20 @@ use std::path::{Path, PathBuf};
 #[derive(clap::Args)]
 pub struct Args {
     /// Output of `kitti-tools track`.
-    #[arg(long)]
-    tracks: PathBuf,
+    #[arg(long, required_unless_present = "results")]
+    tracks: Option<PathBuf>,
+    /// With `--tracking`: score KITTI tracking results `DIR/NNNN.txt` (label_02 format, an
+    /// optional score) instead of `--tracks`: HOTA, CLEAR MOT and IDF1 per class.
+    #[arg(long, requires = "tracking", conflicts_with_all = ["tracks", "planes"])]
+    results: Option<PathBuf>,
+    /// With `--results`: bev (centre distance in the camera's x–z plane, match within 2 m),
+    /// iou3d (oriented 3-D boxes, IoU ≥ 0.25) or iou2d (image boxes, IoU ≥ 0.5, TrackEval's
+    /// KITTI 2-D rules).
+    #[arg(long, value_enum, default_value = "bev")]
+    mode: crate::tracking_eval_cmd::Mode,
+    /// With `--results`: only objects within this distance of the camera count (m).
+    #[arg(long, requires = "results")]
+    within: Option<f64>,
     /// The drive folder; its `truth.json` (simulated) or `tracklet_labels.xml` (KITTI) is the
     /// truth unless `--truth` or `--tracklets` names one.
     #[arg(long, conflicts_with = "tracking")]
@@ -188,8 +200,26 @@ fn plane_statistics(args: &Args) -> Result<Option<PlanePredictionSummary>> {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    let mut tracks = DriveTracks::read_json(&args.tracks)
-        .with_context(|| format!("reading tracks {}", args.tracks.display()))?;
+    if let (Some(results), Some(root), Some(sequence)) =
+        (&args.results, &args.tracking, args.sequence)
+    {
+        let request = crate::tracking_eval_cmd::Request {
+            root,
+            sequence,
+            results,
+            mode: args.mode,
+            within: args.within,
+            camera_view: args.camera_view,
+            json: args.json,
+        };
+        return crate::tracking_eval_cmd::run(&request).map(|_| ());
+    }
+    let tracks_path = args
+        .tracks
+        .clone()
+        .context("give --tracks (or --results)")?;
+    let mut tracks = DriveTracks::read_json(&tracks_path)
+        .with_context(|| format!("reading tracks {}", tracks_path.display()))?;
     if args.camera_view {
         if let Some((seq, what)) = tracking_sequence(&args)? {
             let calib = seq
@@ -213,11 +243,11 @@ pub fn run(args: Args) -> Result<()> {
         Truth::Objects(f) => (f.clone(), None),
     };
     let clusters = evaluate_clusters(&tracks, &frames, &config)
-        .with_context(|| format!("scoring {}", args.tracks.display()))?;
+        .with_context(|| format!("scoring {}", tracks_path.display()))?;
     let planes = plane_statistics(&args)?;
     if args.json {
         let out = serde_json::json!({
-            "tracks": args.tracks,
+            "tracks": tracks_path,
             "clusters": clusters,
             "walls": walls,
             "plane_prediction": planes,

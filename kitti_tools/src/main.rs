@@ -12,6 +12,7 @@ mod paper_tables;
 mod planes_cmd;
 mod synth_cmd;
 mod track_cmd;
+mod tracking_eval_cmd;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};

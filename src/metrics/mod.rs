@@ -12,6 +12,7 @@
 //! | [`labels`] | Label switches and label persistence of estimates matched to truth |
 //! | [`plane_prediction`] | Area, vertex-distance and normal-angle errors of predicted plane patches |
 //! | [`rmse`] | RMS error of error vectors and the averaged-NIS consistency check |
+//! | [`tracking`](mod@tracking) | HOTA, CLEAR MOT and IDF1 of tracks against truth, computed as TrackEval does |
 //! | [`trajectory`] | Relative pose errors and KITTI's segment errors of an ego trajectory |
 //!
 //! Points are slices of `f64` coordinates of any (common) dimension; all distances between
@@ -31,6 +32,7 @@ pub mod ospa2;
 pub mod plane_prediction;
 mod points;
 pub mod rmse;
+pub mod tracking;
 pub mod trajectory;
 
 pub use cardinality::{cardinality_error, CardinalityError};

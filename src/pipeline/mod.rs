@@ -25,6 +25,8 @@ pub use drive_tracking::{
 
 #[cfg(feature = "kitti")]
 pub mod drive_evaluation;
+#[cfg(feature = "kitti")]
+pub mod kitti_tracking_eval;
 
 #[cfg(feature = "kitti")]
 pub mod box_baseline;
