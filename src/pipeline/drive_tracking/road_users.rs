@@ -204,16 +204,17 @@ mod tests {
 
     #[test]
     fn heading_follows_the_direction_of_travel_and_static_other_is_not_a_road_user() {
-        let b = Box3::new(Point3::new(0.0, 0.0, 0.0), [0.5, 0.5, 0.5], 0.0);
+        // A 4 m pole: no road user is that thin and tall.
+        let b = Box3::new(Point3::new(10.0, 0.0, 0.3), [0.3, 0.3, 4.0], 0.0);
         let shape = ClusterShape {
             bbox: b,
             fitted: b,
             features: ClassFeatures {
-                length: 0.5,
-                width: 0.5,
-                height: 0.5,
+                length: 0.3,
+                width: 0.3,
+                height: 4.0,
                 range: 10.0,
-                points: 40,
+                points: 300,
                 speed: None,
             },
             class: ObjectClass::Other,
