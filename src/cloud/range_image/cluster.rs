@@ -6,8 +6,8 @@
 //!
 //! # Neighbours
 //! Left and right: the nearest occupied cell of the same row within `reach` columns (a few
-//! columns bridge dropouts), azimuth wrapping round. Up and down: the adjacent row, at the
-//! same column or the nearest occupied column within `reach`. Only cells held by a candidate
+//! columns bridge dropouts), azimuth wrapping round. Up and down: the nearest row within
+//! `row_reach` with an occupied cell at the same column or the nearest column within `reach`. Only cells held by a candidate
 //! point take part (the caller's subset, e.g. the points on neither ground nor wall); a
 //! candidate that shares a cell with a nearer candidate joins its cluster when their ranges
 //! differ by at most `max_distance`.
@@ -16,7 +16,10 @@
 //! For points p₁ (the longer range d₁) and p₂: tan β = |p₁ × p₂| / (d₁² − p₁·p₂), so
 //! β > θ ⇔ |p₁ × p₂| > tan θ · (d₁² − p₁·p₂), with no trigonometry per pair. Two points also
 //! need to be within `max_distance` of each other, so that a reach over several columns at
-//! long range cannot join things metres apart.
+//! long range cannot join things metres apart. Neighbours within `near_distance` are joined
+//! whatever β: the angle alone splits every surface seen at grazing incidence (a car's roof
+//! seen from 1.73 m, the side of a car parked down the street), which breaks one object
+//! into several detections.
 //!
 //! # How it differs from the exact Euclidean clustering
 //! [`crate::cloud::euclidean_clusters_of`] joins any two points within a fixed distance.
@@ -42,7 +45,14 @@ pub struct ImageClusterParams {
     pub min_angle: f64,
     /// Columns searched on either side for an occupied neighbour. Default 3.
     pub reach: usize,
-    /// Largest distance between two joined points (m). Default 1.0.
+    /// Rows searched above and below for a neighbour (a row whose cells there hold no
+    /// candidate — a ground or wall point, a dropout — is bridged). Default 2.
+    pub row_reach: usize,
+    /// Neighbours at most this far apart are joined whatever the angle (m): a surface seen
+    /// at grazing incidence (a parked car's side down the street) keeps its neighbours
+    /// within a few decimetres, which the angle alone would split. Default 0.5.
+    pub near_distance: f64,
+    /// Largest distance between two points joined by the angle criterion (m). Default 1.0.
     pub max_distance: f64,
     /// Fewest points of a kept cluster. Default 10.
     pub min_points: usize,
@@ -55,6 +65,8 @@ impl Default for ImageClusterParams {
         ImageClusterParams {
             min_angle: 10f64.to_radians(),
             reach: 3,
+            row_reach: 2,
+            near_distance: 0.5,
             max_distance: 1.0,
             min_points: 10,
             max_points: 100_000,
@@ -68,6 +80,8 @@ impl ImageClusterParams {
             && (0.0..std::f64::consts::FRAC_PI_2).contains(&self.min_angle)
             && self.max_distance.is_finite()
             && self.max_distance > 0.0
+            && self.near_distance.is_finite()
+            && self.near_distance >= 0.0
             && self.min_points <= self.max_points;
         if ok {
             Ok(())
@@ -130,13 +144,16 @@ pub fn range_image_clusters(
 
     let tan = params.min_angle.tan() as f32;
     let max_d2 = (params.max_distance * params.max_distance) as f32;
+    let near_d2 = (params.near_distance * params.near_distance) as f32;
     let joined = |a: usize, b: usize| -> bool {
         let (pa, pb) = ([xs[a], ys[a], zs[a]], [xs[b], ys[b], zs[b]]);
         let d = [pa[0] - pb[0], pa[1] - pb[1], pa[2] - pb[2]];
-        d[0] * d[0] + d[1] * d[1] + d[2] * d[2] <= max_d2 && angle_exceeds(pa, pb, tan)
+        let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        d2 <= near_d2 || (d2 <= max_d2 && angle_exceeds(pa, pb, tan))
     };
 
     let reach = params.reach.min(cols / 2);
+    let row_reach = params.row_reach;
     let mut label = vec![NONE; rows * cols];
     let mut queue: Vec<u32> = Vec::new();
     let mut next = 0u32;
@@ -153,7 +170,7 @@ pub fn range_image_clusters(
             head += 1;
             let (row, col) = (cell / cols, cell % cols);
             let p = holder[cell] as usize;
-            let mut visit = |n: usize, label: &mut [u32], queue: &mut Vec<u32>| {
+            let visit = |n: usize, label: &mut [u32], queue: &mut Vec<u32>| {
                 if label[n] == NONE && joined(p, holder[n] as usize) {
                     label[n] = next;
                     queue.push(n as u32);
@@ -170,17 +187,21 @@ pub fn range_image_clusters(
                     }
                 }
             }
-            // Adjacent rows: the same column, else the nearest occupied within reach.
-            for r in [row.wrapping_sub(1), row + 1] {
-                if r >= rows {
-                    continue;
-                }
-                let base = r * cols;
-                'search: for k in 0..=reach {
-                    for c in [(col + k) % cols, (col + cols - k) % cols] {
-                        if holder[base + c] != NONE {
-                            visit(base + c, &mut label, &mut queue);
-                            break 'search;
+            // Rows above and below: the nearest row within `row_reach` that has an occupied
+            // cell within `reach` columns (the same column first).
+            for up in [true, false] {
+                'rows: for k in 1..=row_reach {
+                    let r = if up { row.wrapping_sub(k) } else { row + k };
+                    if r >= rows {
+                        break;
+                    }
+                    let base = r * cols;
+                    for j in 0..=reach {
+                        for c in [(col + j) % cols, (col + cols - j) % cols] {
+                            if holder[base + c] != NONE {
+                                visit(base + c, &mut label, &mut queue);
+                                break 'rows;
+                            }
                         }
                     }
                 }
@@ -195,6 +216,7 @@ pub fn range_image_clusters(
     let mut sorted: Vec<u32> = indices.to_vec();
     sorted.sort_unstable();
     let max_d = params.max_distance as f32;
+    let near_d = params.near_distance as f32;
     for &i in &sorted {
         let iu = i as usize;
         if seen[iu] {
@@ -206,7 +228,7 @@ pub fn range_image_clusters(
             continue;
         }
         let h = holder[c as usize] as usize;
-        if h != iu && range2(iu).sqrt() - range2(h).sqrt() > max_d {
+        if h != iu && range2(iu).sqrt() - range2(h).sqrt() > max_d.max(near_d) {
             continue;
         }
         members[label[c as usize] as usize].push(i);

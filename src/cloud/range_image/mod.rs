@@ -14,7 +14,8 @@
 //!   The first ring may start late (its laser saw nothing near the cut), so the cut is not the
 //!   first point's azimuth: the lead-in `g` (`ring = ⌊(progress + g) / 2π⌋`) is chosen in
 //!   `[0, g_max]` (`g_max` is what the last turn leaves over) as the value that puts the
-//!   points near the ring boundaries on the ring whose median elevation is closest to theirs.
+//!   points near the ring boundaries on the ring whose median elevation is closest to theirs
+//!   (a coarse then a fine grid of 64 lead-ins each, scored on at most 4,096 of those points).
 //!   A step backwards by more than 1° is taken as a forward gap of more than half a turn (a
 //!   ring that saw nothing over a wide sector, or ended early); a ring with no point at all
 //!   cannot be seen and the image simply has one row less. Rings are then sorted by median
@@ -337,25 +338,41 @@ fn scan_order_rings(
         }
     }
     let reference: Vec<f32> = per_ring.iter_mut().map(|v| median(v)).collect();
+    // Points the lead-in can move, at most 4,096 of them evenly strided: a coarse grid of
+    // lead-ins over [0, g_max], then a fine one around the best coarse value.
     let moved: Vec<usize> = (0..n).filter(|&k| window(progress[k])).collect();
+    let stride = moved.len().div_ceil(4096).max(1);
+    let cost = |g: f64| -> f64 {
+        moved
+            .iter()
+            .step_by(stride)
+            .map(|&k| {
+                let r = reference[ring_with(progress[k], g)];
+                if r.is_nan() {
+                    1.0
+                } else {
+                    (tan_el[k] - r).abs() as f64
+                }
+            })
+            .sum()
+    };
     let mut best = (f64::INFINITY, 0.0);
     if !moved.is_empty() {
-        let steps = ((g_max / 1e-3).ceil() as usize).clamp(1, 256);
-        for s in 0..=steps {
-            let g = g_max * s as f64 / steps as f64;
-            let cost: f64 = moved
-                .iter()
-                .map(|&k| {
-                    let r = reference[ring_with(progress[k], g)];
-                    if r.is_nan() {
-                        1.0
-                    } else {
-                        (tan_el[k] - r).abs() as f64
-                    }
-                })
-                .sum();
-            if cost < best.0 {
-                best = (cost, g);
+        const GRID: usize = 64;
+        let coarse = g_max / GRID as f64;
+        for s in 0..=GRID {
+            let g = coarse * s as f64;
+            let c = cost(g);
+            if c < best.0 {
+                best = (c, g);
+            }
+        }
+        let centre = best.1;
+        for s in 0..=GRID {
+            let g = (centre - coarse + 2.0 * coarse * s as f64 / GRID as f64).clamp(0.0, g_max);
+            let c = cost(g);
+            if c < best.0 {
+                best = (c, g);
             }
         }
     }

@@ -150,9 +150,11 @@ pub fn detect_objects(
             let params = ImageClusterParams {
                 min_angle: c.min_angle_deg.to_radians(),
                 reach: c.reach,
-                max_distance: c.tolerance,
+                near_distance: c.tolerance,
+                max_distance: 2.0 * c.tolerance,
                 min_points: c.min_points,
                 max_points: c.max_points,
+                ..ImageClusterParams::default()
             };
             range_image_clusters(&image, cloud, &candidates, &params)?
         }

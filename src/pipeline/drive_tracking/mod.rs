@@ -185,8 +185,9 @@ pub enum ClusterMethod {
 pub struct ClusterDetectionConfig {
     /// Clustering method. Default `range_image`.
     pub method: ClusterMethod,
-    /// Neighbour distance of the Euclidean clustering, and the largest distance between two
-    /// joined neighbours of the range-image clustering (m). Default 0.5.
+    /// Neighbour distance of the Euclidean clustering; the range-image clustering joins image
+    /// neighbours within it whatever their angle, and up to twice it when the angle criterion
+    /// holds (m). Default 0.5.
     pub tolerance: f64,
     /// Smallest angle between beam and neighbour line that joins two range-image neighbours
     /// (degrees; Bogoslavskyi & Stachniss). Default 10.
