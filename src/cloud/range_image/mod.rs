@@ -15,7 +15,8 @@
 //!   first point's azimuth: the lead-in `g` (`ring = ⌊(progress + g) / 2π⌋`) is chosen in
 //!   `[0, g_max]` (`g_max` is what the last turn leaves over) as the value that puts the
 //!   points near the ring boundaries on the ring whose median elevation is closest to theirs
-//!   (a coarse then a fine grid of 64 lead-ins each, scored on at most 4,096 of those points).
+//!   (the sum of absolute tan-elevation misfits is minimised exactly by one sweep over the
+//!   lead-ins at which those points change ring).
 //!   A step backwards by more than 1° is taken as a forward gap of more than half a turn (a
 //!   ring that saw nothing over a wide sector, or ended early); a ring with no point at all
 //!   cannot be seen and the image simply has one row less. Rings are then sorted by median
@@ -189,7 +190,8 @@ impl RangeImage {
         let mut range = vec![f32::INFINITY; rings * cols];
         let scale = cols as f64 / TAU;
         for (k, &i) in used.iter().enumerate() {
-            let a = (dir * az[k]).rem_euclid(TAU);
+            let a = dir * az[k];
+            let a = if a < 0.0 { a + TAU } else { a };
             let col = ((a * scale) as usize).min(cols - 1);
             let row = row_of_ring[ring_of[k] as usize] as usize;
             let cell = row * cols + col;
@@ -328,56 +330,48 @@ fn scan_order_rings(
         return None;
     }
     let g_max = rings as f64 * TAU - last;
-    let ring_with = |u: f64, g: f64| (((u + g) / TAU).floor().max(0.0) as usize).min(rings - 1);
+    // Whole turns before a point and the lead-in that moves it on to the next ring (progress
+    // is ≥ 0 up to jitter, so truncation is the floor).
+    let turn = |u: f64| ((u.max(0.0) / TAU) as usize).min(rings - 1);
+    let threshold = |u: f64| (turn(u) + 1) as f64 * TAU - u.max(0.0);
     // Reference elevation per ring from the points that no lead-in in [0, g_max] moves.
-    let window = |u: f64| u.rem_euclid(TAU) >= TAU - g_max;
     let mut per_ring: Vec<Vec<f32>> = vec![Vec::new(); rings];
     for k in (0..n).step_by(2) {
-        if !window(progress[k]) {
-            per_ring[ring_with(progress[k], 0.0)].push(tan_el[k]);
+        if threshold(progress[k]) > g_max {
+            per_ring[turn(progress[k])].push(tan_el[k]);
         }
     }
     let reference: Vec<f32> = per_ring.iter_mut().map(|v| median(v)).collect();
-    // Points the lead-in can move, at most 4,096 of them evenly strided: a coarse grid of
-    // lead-ins over [0, g_max], then a fine one around the best coarse value.
-    let moved: Vec<usize> = (0..n).filter(|&k| window(progress[k])).collect();
-    let stride = moved.len().div_ceil(4096).max(1);
-    let cost = |g: f64| -> f64 {
-        moved
-            .iter()
-            .step_by(stride)
-            .map(|&k| {
-                let r = reference[ring_with(progress[k], g)];
-                if r.is_nan() {
-                    1.0
-                } else {
-                    (tan_el[k] - r).abs() as f64
-                }
-            })
-            .sum()
-    };
-    let mut best = (f64::INFINITY, 0.0);
-    if !moved.is_empty() {
-        const GRID: usize = 64;
-        let coarse = g_max / GRID as f64;
-        for s in 0..=GRID {
-            let g = coarse * s as f64;
-            let c = cost(g);
-            if c < best.0 {
-                best = (c, g);
-            }
+    let misfit = |k: usize, ring: usize| -> f64 {
+        match reference.get(ring) {
+            Some(r) if !r.is_nan() => (tan_el[k] - r).abs() as f64,
+            _ => 1.0,
         }
-        let centre = best.1;
-        for s in 0..=GRID {
-            let g = (centre - coarse + 2.0 * coarse * s as f64 / GRID as f64).clamp(0.0, g_max);
-            let c = cost(g);
-            if c < best.0 {
-                best = (c, g);
-            }
+    };
+    // Each movable point, by the lead-in that moves it, with the change of misfit when it
+    // moves; the best lead-in is 0 or just past one of these thresholds (a sweep over their
+    // sorted order with a running sum).
+    let mut moves: Vec<(f64, f64)> = (0..n)
+        .filter(|&k| threshold(progress[k]) <= g_max)
+        .map(|k| {
+            let r = turn(progress[k]);
+            (threshold(progress[k]), misfit(k, r + 1) - misfit(k, r))
+        })
+        .collect();
+    moves.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+    let (mut best, mut g, mut sum) = (0.0f64, 0.0f64, 0.0f64);
+    for &(t, delta) in &moves {
+        sum += delta;
+        if sum < best {
+            best = sum;
+            g = t + 1e-9;
         }
     }
-    let g = best.1;
-    let ring_of = progress.iter().map(|&u| ring_with(u, g) as u32).collect();
+    let ring_with = |u: f64| {
+        let u = u.max(0.0) + g;
+        (((u / TAU) as usize).min(rings - 1)) as u32
+    };
+    let ring_of = progress.iter().map(|&u| ring_with(u)).collect();
     Some((dir, ring_of, rings))
 }
 
