@@ -108,7 +108,7 @@ pub fn ground_mask(
                 continue;
             }
             let p = p as usize;
-            let (rho, z) = (xs[p].hypot(ys[p]), zs[p]);
+            let (rho, z) = ((xs[p] * xs[p] + ys[p] * ys[p]).sqrt(), zs[p]);
             let ground = match last {
                 None => (z - road).abs() <= start,
                 Some((r0, z0)) => rho > r0 && (z - z0).abs() <= slope * (rho - r0) + step,

@@ -165,7 +165,7 @@ impl RangeImage {
             .iter()
             .map(|&i| {
                 let i = i as usize;
-                zs[i] / xs[i].hypot(ys[i])
+                zs[i] / (xs[i] * xs[i] + ys[i] * ys[i]).sqrt()
             })
             .collect();
 
