@@ -9,19 +9,23 @@
 //! * `frame/read`: read and decode the `.bin`;
 //! * `frame/planes`: ground and wall segmentation (`extract_planes`, default configuration);
 //! * `frame/clusters`: Euclidean clustering of the points left after plane removal;
+//! * `frame/clusters_range_image`: the same points clustered on the scan's range image
+//!   (building the image included);
 //! * `frame/read_planes_clusters`: the three in a row, as a frame is processed;
 //! * `frame/filter_update`: one step of the drive tracker (walls and clusters as labelled
 //!   objects of one LMB filter, 1000 particles per track) on this frame's detections, after a
 //!   warm-up on the same detections that confirms them (a static sensor);
-//! * `frame/whole`: read, detect (planes and clusters as the drive tracker selects them) and
-//!   the filter update in a row.
+//! * `frame/whole`: read, detect (planes and clusters as the drive tracker selects them: every
+//!   object-sized cluster of the range image within range) and the filter update in a row;
+//! * `frame/whole_euclidean`: the same with the exact Euclidean clustering selected.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use nalgebra::Isometry3;
 use smc_lmb::cloud::planes::{extract_planes, PlaneConfig};
+use smc_lmb::cloud::range_image::{range_image_clusters, ImageClusterParams, RangeImage};
 use smc_lmb::cloud::{euclidean_clusters_of, read_kitti_bin, ClusterParams, PointCloud};
 use smc_lmb::pipeline::drive_tracking::{
-    detect_objects, DriveTracker, FrameDetections, TrackingConfig,
+    detect_objects, ClusterMethod, DriveTracker, FrameDetections, TrackingConfig,
 };
 use smc_lmb::rng::seeded;
 use std::path::{Path, PathBuf};
@@ -68,6 +72,19 @@ fn frame(c: &mut Criterion) {
     g.bench_function("clusters", |b| {
         b.iter(|| euclidean_clusters_of(&cloud, &seg.remaining, &clusters).unwrap())
     });
+    g.bench_function("clusters_range_image", |b| {
+        b.iter(|| {
+            let image = RangeImage::new(&cloud, &Default::default()).unwrap();
+            let params = ImageClusterParams {
+                near_distance: 0.5,
+                max_distance: 1.0,
+                min_points: clusters.min_points,
+                max_points: clusters.max_points,
+                ..Default::default()
+            };
+            range_image_clusters(&image, &cloud, &seg.remaining, &params).unwrap()
+        })
+    });
     g.bench_function("read_planes_clusters", |b| {
         b.iter(|| {
             let cloud = read_kitti_bin(&path).unwrap();
@@ -85,10 +102,29 @@ fn filter_update(
     path: &Path,
     cloud: &PointCloud,
 ) {
-    let config = TrackingConfig::default();
+    let mut config = TrackingConfig::default();
+    for method in [ClusterMethod::Euclidean, ClusterMethod::RangeImage] {
+        config.clusters.method = method;
+        tracker_group(g, path, cloud, &config);
+    }
+}
+
+/// `filter_update` and `whole` with one cluster configuration (`whole_euclidean` for the
+/// exact clustering).
+fn tracker_group(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    path: &Path,
+    cloud: &PointCloud,
+    config: &TrackingConfig,
+) {
+    let config = config.clone();
+    let suffix = match config.clusters.method {
+        ClusterMethod::RangeImage => "",
+        ClusterMethod::Euclidean => "_euclidean",
+    };
     let det = detect_objects(cloud, &config, &mut seeded(1)).expect("detections");
     println!(
-        "tracked objects: {} walls, {} clusters",
+        "tracked objects{suffix}: {} walls, {} clusters",
         det.walls.len(),
         det.clusters.len()
     );
@@ -105,8 +141,10 @@ fn filter_update(
     for _ in 0..5 {
         step(&mut tracker, &det);
     }
-    g.bench_function("filter_update", |b| b.iter(|| step(&mut tracker, &det)));
-    g.bench_function("whole", |b| {
+    g.bench_function(format!("filter_update{suffix}"), |b| {
+        b.iter(|| step(&mut tracker, &det))
+    });
+    g.bench_function(format!("whole{suffix}"), |b| {
         b.iter(|| {
             let cloud = read_kitti_bin(path).unwrap();
             let det = detect_objects(&cloud, &config, &mut seeded(1)).unwrap();

@@ -6,13 +6,13 @@ use crate::config_file::read_config;
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use smc_lmb::cloud::{write_las_labelled, write_ply_labelled};
+use smc_lmb::kitti::tracking::TrackingCalib;
 use smc_lmb::kitti::{OdometrySequence, RawDrive, TrackingSequence};
+use smc_lmb::pipeline::drive_tracking::kitti_out::{lmb_results, BaselineBoxes};
 use smc_lmb::pipeline::drive_tracking::{
     drive_plot, point_labels, track_drive, track_odometry_sequence, track_tracking_sequence,
     DriveTracks, EgoModel, FrameView, PoseSource, TrackingConfig,
 };
-use smc_lmb::kitti::tracking::TrackingCalib;
-use smc_lmb::pipeline::drive_tracking::kitti_out::{lmb_results, BaselineBoxes};
 use smc_lmb::pipeline::kitti_results::{results_path, write_tracking_results, ResultObject};
 use smc_lmb::trackers::ab3dmot::Ab3dmotConfig;
 use std::ops::Range;

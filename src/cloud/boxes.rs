@@ -279,16 +279,22 @@ fn one_point_per_cell(xy: &mut Vec<f64>, n2: usize, cell: f64) {
     let mut keys: Vec<(i64, i64, usize)> = xy[..n2]
         .chunks_exact(2)
         .enumerate()
-        .map(|(i, p)| ((p[0] / cell).floor() as i64, (p[1] / cell).floor() as i64, i))
+        .map(|(i, p)| {
+            (
+                (p[0] / cell).floor() as i64,
+                (p[1] / cell).floor() as i64,
+                i,
+            )
+        })
         .collect();
     keys.sort_unstable();
     keys.dedup_by(|a, b| a.0 == b.0 && a.1 == b.1);
     let mut first: Vec<usize> = keys.into_iter().map(|k| k.2).collect();
     first.sort_unstable();
     let m = first.len() as f64;
-    let (mx, my) = first.iter().fold((0.0, 0.0), |(x, y), &i| {
-        (x + xy[2 * i], y + xy[2 * i + 1])
-    });
+    let (mx, my) = first
+        .iter()
+        .fold((0.0, 0.0), |(x, y), &i| (x + xy[2 * i], y + xy[2 * i + 1]));
     let (mx, my) = (mx / m, my / m);
     xy.reserve(2 * first.len());
     for i in first {

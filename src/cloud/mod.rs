@@ -1,7 +1,8 @@
 //! Point clouds: the [`PointCloud`] type (structure of arrays, f32) and the KITTI Velodyne
 //! `.bin` reader and writer, LAS and PLY import/export (optionally coloured by label),
-//! Euclidean clustering of points into object candidates, and lidar odometry (the scanner's
-//! motion from its own scans, [`odometry`]).
+//! Euclidean clustering of points into object candidates, the range image of a spinning
+//! scan with its ground and angle-criterion clusters ([`range_image`]), and lidar odometry
+//! (the scanner's motion from its own scans, [`odometry`]).
 //!
 //! Not for: finding the frames of a recording (see [`crate::kitti`]) or fitting
 //! planes to the points.
@@ -16,6 +17,7 @@ pub mod palette;
 pub mod planes;
 pub mod ply_io;
 pub mod points;
+pub mod range_image;
 
 pub use cluster::{euclidean_clusters, euclidean_clusters_of, Cluster, ClusterParams};
 pub use kitti_bin::{read_kitti_bin, read_kitti_bin_with, write_kitti_bin, BinScan, NonFinite};

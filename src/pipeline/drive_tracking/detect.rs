@@ -1,28 +1,36 @@
 //! One LiDAR frame → the detections the tracker sees: building-wall planes (from
-//! [`extract_planes`]) and Euclidean clusters of the points on neither the ground nor a wall,
-//! turned into mixed measurements ([`crate::pipeline::drive_tracking::mixed`]).
+//! [`extract_planes`]) and clusters of the points on neither the ground nor a wall, turned
+//! into mixed measurements ([`crate::pipeline::drive_tracking::mixed`]).
 //!
 //! The ground is not tracked: it is always under the vehicle, so tracking it adds nothing a
 //! per-frame fit does not give; its plane is used to drop the points near the road surface
-//! before clustering. Clusters are kept when they lie within `max_range` of the sensor and
-//! their axis-aligned box is object-sized (`max_footprint`, `max_height`); of those, at most
-//! `max_clusters`, the nearest first.
+//! before clustering. The clustering is chosen by [`ClusterMethod`]: by default the angle
+//! criterion on the scan's range image ([`range_image_clusters`], linear in the points, with
+//! `tolerance` as the largest gap between joined neighbours), or the exact Euclidean
+//! clustering. Every cluster within `max_range` of the sensor whose axis-aligned box is
+//! object-sized (`max_footprint`, `max_height`) is a detection, nearest first: there is no cap
+//! on their number, the size and range limits bound the filter's work. Each detection then gets
+//! its oriented box and class evidence ([`super::road_users::shape_of`]); its measured
+//! position is the box's centre.
 //!
 //! Not for: the filter (see [`super::tracker`]).
 
-use super::TrackingConfig;
-use crate::cloud::cluster::{euclidean_clusters_of, ClusterParams};
-use crate::cloud::planes::extract_planes;
+use super::{ClusterMethod, TrackingConfig};
 use crate::cloud::boxes::BoxScratch;
 use crate::cloud::classes::ClassModel;
+use crate::cloud::cluster::{euclidean_clusters_of, ClusterParams};
+use crate::cloud::planes::extract_planes;
+use crate::cloud::range_image::{
+    range_image_clusters, ImageClusterParams, RangeImage, RangeImageConfig,
+};
 use crate::cloud::PointCloud;
-use crate::pipeline::drive_tracking::road_users::{shape_of, ClusterShape};
 use crate::error::Result;
 use crate::filter::Measurements;
 use crate::geometry::PlanePatch;
 use crate::pipeline::drive_tracking::mixed::{
     cluster_measurement, plane_measurement, MEASUREMENT_DIM,
 };
+use crate::pipeline::drive_tracking::road_users::{shape_of, ClusterShape};
 use crate::rng::FilterRng;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -145,12 +153,31 @@ pub fn detect_objects(
             r2 <= max_r2 && above(i) > c.ground_clearance
         })
         .collect();
-    let params = ClusterParams {
-        tolerance: c.tolerance as f32,
-        min_points: c.min_points,
-        max_points: c.max_points,
+    let found = match c.method {
+        ClusterMethod::Euclidean => {
+            let params = ClusterParams {
+                tolerance: c.tolerance as f32,
+                min_points: c.min_points,
+                max_points: c.max_points,
+            };
+            euclidean_clusters_of(cloud, &candidates, &params)?
+        }
+        ClusterMethod::RangeImage if candidates.is_empty() => Vec::new(),
+        ClusterMethod::RangeImage => {
+            let image = RangeImage::new(cloud, &RangeImageConfig::default())?;
+            let params = ImageClusterParams {
+                min_angle: c.min_angle_deg.to_radians(),
+                reach: c.reach,
+                near_distance: c.tolerance,
+                max_distance: 2.0 * c.tolerance,
+                min_points: c.min_points,
+                max_points: c.max_points,
+                ..ImageClusterParams::default()
+            };
+            range_image_clusters(&image, cloud, &candidates, &params)?
+        }
     };
-    let mut clusters: Vec<ClusterDetection> = euclidean_clusters_of(cloud, &candidates, &params)?
+    let mut clusters: Vec<ClusterDetection> = found
         .into_iter()
         .filter(|k| {
             let size: [f64; 3] = std::array::from_fn(|a| (k.max[a] - k.min[a]) as f64);
@@ -166,7 +193,6 @@ pub fn detect_objects(
         .collect();
     let range = |d: &ClusterDetection| d.centroid[0].hypot(d.centroid[1]);
     clusters.sort_by(|a, b| range(a).total_cmp(&range(b)));
-    clusters.truncate(c.max_clusters);
     let ground_z = |x: f64, y: f64| -> Option<f64> {
         let g = ground.as_ref()?;
         (g.normal.z.abs() > 0.5).then(|| -(g.normal.x * x + g.normal.y * y + g.offset) / g.normal.z)

@@ -133,6 +133,9 @@ mod tests {
             times: Default::default(),
         };
         let p = frame_pose(&f) * nalgebra::Point3::new(1.0, 0.0, 0.0);
-        assert!((p.x - 1.0).abs() < 1e-12 && (p.y - 3.0).abs() < 1e-12, "{p:?}");
+        assert!(
+            (p.x - 1.0).abs() < 1e-12 && (p.y - 3.0).abs() < 1e-12,
+            "{p:?}"
+        );
     }
 }

@@ -20,10 +20,10 @@
 
 pub mod detect;
 pub mod export;
+pub mod kitti_out;
 pub mod mixed;
 pub mod output;
 pub mod repeatability;
-pub mod kitti_out;
 pub mod road_users;
 pub mod tracker;
 
@@ -187,12 +187,34 @@ impl Default for BirthTuning {
     }
 }
 
-/// Which point clusters become detections.
+/// How the points on neither ground nor wall are grouped into clusters.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ClusterMethod {
+    /// Angle-criterion clustering on the scan's range image
+    /// ([`crate::cloud::range_image::range_image_clusters`]), linear in the points.
+    #[default]
+    RangeImage,
+    /// Exact Euclidean clustering with `tolerance` ([`crate::cloud::euclidean_clusters_of`]).
+    Euclidean,
+}
+
+/// Which point clusters become detections: every object-sized cluster within `max_range`.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ClusterDetectionConfig {
-    /// Neighbour distance of the Euclidean clustering (m). Default 0.5.
+    /// Clustering method. Default `range_image`.
+    pub method: ClusterMethod,
+    /// Neighbour distance of the Euclidean clustering; the range-image clustering joins image
+    /// neighbours within it whatever their angle, and up to twice it when the angle criterion
+    /// holds (m). Default 0.5.
     pub tolerance: f64,
+    /// Smallest angle between beam and neighbour line that joins two range-image neighbours
+    /// (degrees; Bogoslavskyi & Stachniss). Default 10.
+    pub min_angle_deg: f64,
+    /// Columns searched on either side for a range-image neighbour (bridges dropouts).
+    /// Default 3.
+    pub reach: usize,
     /// Fewest points of a cluster. Default 15.
     pub min_points: usize,
     /// Most points of a cluster. Default 20 000.
@@ -207,14 +229,15 @@ pub struct ClusterDetectionConfig {
     pub max_footprint: f64,
     /// Largest box height (m). Default 4.
     pub max_height: f64,
-    /// At most this many clusters per frame, the nearest first. Default 40.
-    pub max_clusters: usize,
 }
 
 impl Default for ClusterDetectionConfig {
     fn default() -> Self {
         ClusterDetectionConfig {
+            method: ClusterMethod::RangeImage,
             tolerance: 0.5,
+            min_angle_deg: 10.0,
+            reach: 3,
             min_points: 15,
             max_points: 20_000,
             ground_clearance: 0.3,
@@ -222,7 +245,6 @@ impl Default for ClusterDetectionConfig {
             max_range: 40.0,
             max_footprint: 8.0,
             max_height: 4.0,
-            max_clusters: 40,
         }
     }
 }

@@ -100,7 +100,12 @@ impl RoadUserState {
         Ok(s)
     }
 
-    fn observe_class(&mut self, shape: &ClusterShape, speed: f64, model: &ClassModel) -> Result<()> {
+    fn observe_class(
+        &mut self,
+        shape: &ClusterShape,
+        speed: f64,
+        model: &ClassModel,
+    ) -> Result<()> {
         let features = ClassFeatures {
             speed: Some(speed),
             ..shape.features
@@ -198,7 +203,10 @@ mod tests {
         // The true centre (12.25, 2.9) lies behind the two faces seen; the fitted box of the
         // points is the same rectangle here, since both faces are seen whole.
         let c = shape.bbox.center;
-        assert!((c.x - 12.25).abs() < 0.1 && (c.y - 2.9).abs() < 0.1, "{c:?}");
+        assert!(
+            (c.x - 12.25).abs() < 0.1 && (c.y - 2.9).abs() < 0.1,
+            "{c:?}"
+        );
         assert!((shape.bbox.size[0] - 4.5).abs() < 0.1, "{:?}", shape.bbox);
     }
 

@@ -14,11 +14,11 @@
 use super::detect::FrameDetections;
 use super::output::{OrientedBox, StageTimes, TrackedCluster, TrackedFrame, TrackedPlane};
 use super::road_users::RoadUserState;
-use crate::cloud::classes::ClassModel;
-use crate::geometry::wrap_angle;
 use super::{EgoModel, TrackingConfig};
+use crate::cloud::classes::ClassModel;
 use crate::error::Result;
 use crate::filter::{AdaptiveBirth, Estimate, Frame, Label, LmbFilter};
+use crate::geometry::wrap_angle;
 use crate::geometry::Plane;
 use crate::models::plane::{canonical_plane, plane_residual};
 use crate::models::{ExtendedConstantTurn, PlaneMeasurement};
