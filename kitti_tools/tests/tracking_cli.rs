@@ -257,3 +257,65 @@ fn layout_flags_are_checked() {
         "{out}"
     );
 }
+
+#[test]
+fn track_writes_kitti_results_of_the_lmb_and_the_baseline_which_eval_scores() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path().join("training");
+    synth(&root, 12, 0);
+    let r = root.to_str().unwrap();
+    let (lmb, ab3) = (dir.path().join("lmb"), dir.path().join("ab3"));
+    let text = ok(&common::output(&[
+        "track",
+        "--tracking",
+        r,
+        "--sequence",
+        "0",
+        "--particles",
+        "200",
+        "--out",
+        dir.path().join("t.json").to_str().unwrap(),
+        "--kitti-out",
+        lmb.to_str().unwrap(),
+        "--baseline-out",
+        ab3.to_str().unwrap(),
+        "--quiet",
+    ]));
+    assert!(text.contains("result lines") && text.contains("AB3DMOT"), "{text}");
+    for d in [&lmb, &ab3] {
+        let lines = std::fs::read_to_string(d.join("0000.txt")).unwrap();
+        assert!(!lines.is_empty(), "{}", d.display());
+        for l in lines.lines() {
+            let f: Vec<&str> = l.split_whitespace().collect();
+            assert_eq!(f.len(), 18, "{l}");
+            assert!(
+                ["Car", "Van", "Truck", "Pedestrian", "Cyclist"].contains(&f[2]),
+                "{l}"
+            );
+        }
+        let scores = ok(&common::output(&[
+            "eval",
+            "--tracking",
+            r,
+            "--sequence",
+            "0",
+            "--results",
+            d.to_str().unwrap(),
+            "--camera-view",
+            "--within",
+            "40",
+        ]));
+        assert!(scores.contains("HOTA") && scores.contains("Car"), "{scores}");
+    }
+    // Results need the tracking layout's calibration.
+    let out = common::output(&[
+        "track",
+        "--drive",
+        r,
+        "--out",
+        dir.path().join("x.json").to_str().unwrap(),
+        "--kitti-out",
+        lmb.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+}
