@@ -4,10 +4,9 @@
 //!
 //! The ground is not tracked: it is always under the vehicle, so tracking it adds nothing a
 //! per-frame fit does not give; its plane is used to drop the points near the road surface
-//! before clustering. The clustering is chosen by [`ClusterMethod`]: by default the angle
-//! criterion on the scan's range image ([`range_image_clusters`], linear in the points, with
-//! `tolerance` as the largest gap between joined neighbours), or the exact Euclidean
-//! clustering. Every cluster within `max_range` of the sensor whose axis-aligned box is
+//! before clustering. The clustering is chosen by [`ClusterMethod`]: by default the exact
+//! Euclidean clustering, or the angle criterion on the scan's range image
+//! ([`range_image_clusters`], linear in the points, `tolerance` the gap always joined). Every cluster within `max_range` of the sensor whose axis-aligned box is
 //! object-sized (`max_footprint`, `max_height`) is a detection, nearest first: there is no cap
 //! on their number, the size and range limits bound the filter's work. Each detection then gets
 //! its oriented box and class evidence ([`super::road_users::shape_of`]); its measured

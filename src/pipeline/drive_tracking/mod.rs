@@ -192,10 +192,14 @@ impl Default for BirthTuning {
 #[serde(rename_all = "snake_case")]
 pub enum ClusterMethod {
     /// Angle-criterion clustering on the scan's range image
-    /// ([`crate::cloud::range_image::range_image_clusters`]), linear in the points.
-    #[default]
+    /// ([`crate::cloud::range_image::range_image_clusters`]), linear in the points. On real
+    /// HDL-64E frames it splits about a quarter of the exact method's clusters (surfaces seen
+    /// edge-on, sparse vegetation) and, with the image's build counted, is not faster; on the
+    /// simulated street it doubled the label switches. Kept as an option.
     RangeImage,
-    /// Exact Euclidean clustering with `tolerance` ([`crate::cloud::euclidean_clusters_of`]).
+    /// Exact Euclidean clustering with `tolerance` ([`crate::cloud::euclidean_clusters_of`]):
+    /// the default.
+    #[default]
     Euclidean,
 }
 
@@ -234,7 +238,7 @@ pub struct ClusterDetectionConfig {
 impl Default for ClusterDetectionConfig {
     fn default() -> Self {
         ClusterDetectionConfig {
-            method: ClusterMethod::RangeImage,
+            method: ClusterMethod::Euclidean,
             tolerance: 0.5,
             min_angle_deg: 10.0,
             reach: 3,
