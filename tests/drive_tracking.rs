@@ -66,6 +66,8 @@ fn config() -> TrackingConfig {
     // The synthetic street is every surface sampled on a grid (hidden sides included), not
     // one turn of a spinning scanner: it has no range image, so the exact clustering.
     c.clusters.method = ClusterMethod::Euclidean;
+    // Report static clutter too: the pole below is checked.
+    c.all_clusters = true;
     c
 }
 
@@ -174,6 +176,15 @@ fn synthetic_street_walls_keep_labels_and_the_box_is_tracked() {
         .find(|c| (c.position_world[0] - 20.0).hypot(c.position_world[1] - 5.0) < 1.0)
         .expect("pole tracked");
     assert!(pole.velocity[0].hypot(pole.velocity[1]) < 1.0, "{pole:?}");
+    // A static pole is not a road user; the moving box is a car.
+    assert!(!pole.road_user, "{pole:?}");
+    let car = last
+        .clusters
+        .iter()
+        .find(|c| c.velocity[0].hypot(c.velocity[1]) > 5.0)
+        .expect("box tracked");
+    assert_eq!(car.class.as_deref(), Some("Car"), "{car:?}");
+    assert!(car.road_user);
 
     // JSON round trip.
     let json = tmp.path().join("tracks.json");
