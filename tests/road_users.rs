@@ -5,9 +5,7 @@
 use smc_lmb::kitti::{read_tracking_labels, TrackingSequence};
 use smc_lmb::pipeline::drive_tracking::kitti_out::{lmb_results, BaselineBoxes};
 use smc_lmb::pipeline::kitti_results::result_labels;
-use smc_lmb::pipeline::kitti_tracking_eval::{
-    evaluate_kitti_tracking, EvalClass, KittiEvalConfig,
-};
+use smc_lmb::pipeline::kitti_tracking_eval::{evaluate_kitti_tracking, EvalClass, KittiEvalConfig};
 use smc_lmb::pipeline::{track_tracking_sequence, TrackingConfig};
 use smc_lmb::sim::street::{write_tracking_sequence, StreetConfig};
 use smc_lmb::trackers::ab3dmot::Ab3dmotConfig;
@@ -41,15 +39,17 @@ fn street_road_users_are_boxed_classed_and_scored_beside_the_baseline() {
         }
     }
     let lmb = result_labels(&lmb_results(&tracks), &calib, [1242.0, 375.0]).unwrap();
-    let ab3 = baseline.borrow().results(&Ab3dmotConfig::default()).unwrap();
+    let ab3 = baseline
+        .borrow()
+        .results(&Ab3dmotConfig::default())
+        .unwrap();
     let ab3 = result_labels(&ab3, &calib, [1242.0, 375.0]).unwrap();
     let config = KittiEvalConfig {
         max_range: Some(40.0),
         ..KittiEvalConfig::bev(2.0)
     };
-    let score = |results| {
-        evaluate_kitti_tracking(&truth, results, FRAMES, &config, Some(&calib)).unwrap()
-    };
+    let score =
+        |results| evaluate_kitti_tracking(&truth, results, FRAMES, &config, Some(&calib)).unwrap();
     let (a, b) = (score(&lmb), score(&ab3));
     for (ca, cb) in a.classes.iter().zip(&b.classes) {
         let (sa, sb) = (&ca.scores, &cb.scores);

@@ -281,7 +281,10 @@ fn track_writes_kitti_results_of_the_lmb_and_the_baseline_which_eval_scores() {
         ab3.to_str().unwrap(),
         "--quiet",
     ]));
-    assert!(text.contains("result lines") && text.contains("AB3DMOT"), "{text}");
+    assert!(
+        text.contains("result lines") && text.contains("AB3DMOT"),
+        "{text}"
+    );
     for d in [&lmb, &ab3] {
         let lines = std::fs::read_to_string(d.join("0000.txt")).unwrap();
         assert!(!lines.is_empty(), "{}", d.display());
@@ -305,7 +308,10 @@ fn track_writes_kitti_results_of_the_lmb_and_the_baseline_which_eval_scores() {
             "--within",
             "40",
         ]));
-        assert!(scores.contains("HOTA") && scores.contains("Car"), "{scores}");
+        assert!(
+            scores.contains("HOTA") && scores.contains("Car"),
+            "{scores}"
+        );
     }
     // Results need the tracking layout's calibration.
     let out = common::output(&[
