@@ -17,7 +17,7 @@
 //!
 //! Not for: sequences (see [`super::tracking`]), images, or evaluation.
 
-use super::labels::{ObjectType, TrackingLabel};
+use super::labels::{ObjectType, TrackingLabel, LABEL_FIELDS};
 use super::text::{numbered_lines, parse_f64, read_text};
 use super::tracking::TrackingCalib;
 use crate::cloud::classes::ObjectClass;
@@ -26,24 +26,8 @@ use crate::error::{Error, Result};
 use std::path::{Path, PathBuf};
 
 /// Names of the 15 fields of an object label line, in file order (an optional 16th is
-/// `score`).
-pub const OBJECT_LABEL_FIELDS: [&str; 15] = [
-    "type",
-    "truncated",
-    "occluded",
-    "alpha",
-    "bbox_left",
-    "bbox_top",
-    "bbox_right",
-    "bbox_bottom",
-    "height",
-    "width",
-    "length",
-    "x",
-    "y",
-    "z",
-    "rotation_y",
-];
+/// `score`): a tracking label's fields without its frame and track id.
+pub const OBJECT_LABEL_FIELDS: &[&str] = LABEL_FIELDS.split_at(2).1;
 
 fn field_label(i: usize) -> String {
     match OBJECT_LABEL_FIELDS.get(i) {
