@@ -4,9 +4,11 @@
 //! The cluster bound. With p = 1 the OSPA of a frame splits into a localisation part
 //! Σ_pairs min(d, c) / max(n, m) and a cardinality part c·|n − m| / max(n, m) (n truth
 //! objects, m tracks). A cluster's centroid is the mean of the points on the object's faces
-//! that the lidar sees, so even a perfect tracker reports it up to half the object's length
-//! from the box centre: b = 2.25 m for the 4.5 m cars, 0.3 m for pedestrians. A tracker that
-//! follows every visible object within that bias therefore has a localisation part of at most
+//! that the lidar sees, up to half the object's length from the box centre (2.25 m for the
+//! 4.5 m cars); the detector measures the centre of a box whose unseen sides the visible-face
+//! model extends to the class's mean size, so what is left is the spread of real sizes about
+//! that mean: b = 0.235 m, half the spread of car lengths. A tracker that follows every
+//! visible object within b therefore has a localisation part of at most
 //! b · min(n, m) / max(n, m) in every frame — the bound asserted below, averaged over the
 //! frames after the first two (a birth needs two detections to be confirmed). The cardinality
 //! part is bounded through the miss count: after those two frames the tracker must miss fewer
@@ -46,7 +48,10 @@ fn cluster_and_wall_tracks_of_a_simulated_street_meet_their_bounds() {
     let settled = &eval.frames[2..];
     assert!(settled.iter().map(|f| f.truth).sum::<usize>() >= settled.len());
     let n = settled.len() as f64;
-    let half_car = 4.5 / 2.0;
+    // A track's position is its detections' box centre (visible-face model): what is left is
+    // the class size spread the model extends the unseen sides by, at most half the spread of
+    // car lengths (0.47 m, `cloud::classes`), per matched pair.
+    let box_error = 0.47 / 2.0;
     let bound: f64 = settled
         .iter()
         .map(|f| {
@@ -54,7 +59,7 @@ fn cluster_and_wall_tracks_of_a_simulated_street_meet_their_bounds() {
             if hi == 0 {
                 0.0
             } else {
-                half_car * lo as f64 / hi as f64
+                box_error * lo as f64 / hi as f64
             }
         })
         .sum::<f64>()
@@ -72,5 +77,4 @@ fn cluster_and_wall_tracks_of_a_simulated_street_meet_their_bounds() {
         "localisation {localisation} > {bound}"
     );
     assert!(missed < 0.5, "missed {missed} per frame");
-    assert!(eval.mean_ospa < config.cutoff);
 }

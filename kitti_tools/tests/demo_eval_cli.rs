@@ -46,7 +46,12 @@ fn demo_runs_the_whole_pipeline_and_eval_scores_its_tracks() {
     assert!(ok, "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     let ospa = v["clusters"]["mean_ospa"].as_f64().unwrap();
-    assert!((0.0..=3.0).contains(&ospa), "{ospa}");
+    // c = 3 m. The first two of the eight frames come before any birth is confirmed (OSPA = c
+    // each); the other six must average within a quarter of c (a missed or false object in a
+    // frame of ~15 costs c/15, a box-centre error its own size).
+    let c = 3.0;
+    let bound = (2.0 * c + 6.0 * c / 4.0) / 8.0;
+    assert!(ospa >= 0.0 && ospa <= bound, "{ospa} > {bound}");
     assert_eq!(v["clusters"]["frames"].as_array().unwrap().len(), 8);
     assert!(v["walls"]["matched"].as_u64().unwrap() > 0);
     let angle = v["plane_prediction"]["median_normal_angle_deg"]
