@@ -28,8 +28,9 @@ use std::path::Path;
 /// Scale of the stored integer coordinates (metres per unit).
 pub const LAS_SCALE: f64 = 0.001;
 
-/// Reads a LAS (or LAZ, when the `las` crate can decode it) file: x, y, z as `f32` from the
-/// scaled coordinates, intensity normalised from `u16` to [0, 1].
+/// Reads a LAS file: x, y, z as `f32` from the scaled coordinates, intensity normalised from
+/// `u16` to [0, 1]. Compressed LAZ is not decoded (the `las` crate's `laz` feature is not
+/// enabled): such a file is an error naming it.
 ///
 /// Errors: the file cannot be opened ([`Error::Io`]); its header is not LAS, or it holds
 /// fewer point records than its header announces, e.g. a truncated file ([`Error::Parse`]

@@ -2,9 +2,11 @@
 //!
 //! States are stored as a structure of arrays: component `c` of all particles is one
 //! contiguous slice (`component(c)`), so transition and likelihood loops stream through memory
-//! and vectorise. Weights are kept normalised in the linear domain; every reweighting goes
-//! through the log domain ([`ParticleSet::reweight_log`]) so that likelihoods that underflow
-//! never empty a set. Resampling is systematic, followed by optional roughening or a
+//! and vectorise. Weights are kept normalised in the linear domain. Likelihoods reweight
+//! through the log domain ([`ParticleSet::reweight_log`]) so that those that underflow never
+//! empty a set; factors already in [0, 1] such as p_S and p_D reweight linearly
+//! ([`ParticleSet::reweight`]), which leaves the weights unchanged when the weighted sum is 0
+//! or not finite. Resampling is systematic, followed by optional roughening or a
 //! regularised Gaussian kernel ([`Jitter`]). Not for: the association or existence logic.
 
 use crate::rng::FilterRng;
