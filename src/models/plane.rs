@@ -202,7 +202,9 @@ fn move_plane(r: &Matrix3<f64>, t: &Vector3<f64>, b: [f64; 4]) -> [f64; 4] {
 }
 
 /// Moves one plane β = `[n, d]` by the frame change `m` = T_{k+1}⁻¹ T_k (n' = R n,
-/// d' = d − n'·t, renormalised).
+/// d' = d − n'·t, renormalised). A zero normal has no direction to move: it comes out
+/// non-finite, and a particle left so makes the filter step fail with an error naming its
+/// track (see `LmbFilter::step`) rather than be carried on.
 pub fn transform_plane(beta: &[f64; 4], m: &Isometry3<f64>) -> [f64; 4] {
     let r = m.rotation.to_rotation_matrix().into_inner();
     move_plane(&r, &m.translation.vector, *beta)
