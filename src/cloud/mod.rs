@@ -9,6 +9,7 @@
 
 pub mod boxes;
 pub mod classes;
+pub mod other_class;
 pub mod cluster;
 pub mod kitti_bin;
 pub mod las_io;
