@@ -202,13 +202,8 @@ fn main() -> Result<()> {
         let mut ll = model.log_likelihoods(f)?;
         if let Some(d) = learned {
             let unit = model.expected_points([1.0; 3], f.range).ln();
-            ll[ObjectClass::Other.index()] = d.ln_density(
-                f.length,
-                f.width,
-                f.height,
-                (f.points as f64).ln(),
-                unit,
-            );
+            ll[ObjectClass::Other.index()] =
+                d.ln_density(f.length, f.width, f.height, (f.points as f64).ln(), unit);
         }
         let mut b = smc_lmb::cloud::classes::ClassBelief::new(prior)?;
         b.update(&ll, 0.0)?;

@@ -98,7 +98,10 @@ impl OtherDensity {
         if file.components.is_empty() || file.components.len() > MAX_COMPONENTS {
             return Err(Error::invalid(
                 "Other class model",
-                format!("{} components (need 1 to {MAX_COMPONENTS})", file.components.len()),
+                format!(
+                    "{} components (need 1 to {MAX_COMPONENTS})",
+                    file.components.len()
+                ),
             ));
         }
         let total: f64 = file.components.iter().map(|c| c.weight).sum();
@@ -137,9 +140,8 @@ impl OtherDensity {
         static MODEL: OnceLock<std::result::Result<OtherDensity, String>> = OnceLock::new();
         MODEL
             .get_or_init(|| {
-                let file: OtherModelFile =
-                    serde_json::from_str(include_str!("other_class.json"))
-                        .map_err(|e| e.to_string())?;
+                let file: OtherModelFile = serde_json::from_str(include_str!("other_class.json"))
+                    .map_err(|e| e.to_string())?;
                 OtherDensity::from_file(&file).map_err(|e| e.to_string())
             })
             .as_ref()
