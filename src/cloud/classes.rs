@@ -21,6 +21,11 @@
 //! always in view of a roof-mounted scanner; only the bottom is cut by ground removal, and the
 //! height is measured from the ground when it is known).
 //!
+//! `Other` (everything a clusterer returns that is no road user) has by default the density
+//! learned from KITTI clusters that lie in no label box ([`super::other_class`], a Gaussian
+//! mixture over log sides, height and log point density); the former uniform density over
+//! [0, 20] × [0, 6] × [0, 6] m and ln(points) stays selectable ([`OtherModel::Uniform`]).
+//!
 //! The height profile enters through the top's height above the ground; the height of the
 //! point mass ([`BoxFit::mass_height`]) is kept by the fit but not used here, for want of
 //! published per-class statistics to set its likelihood from.
@@ -29,6 +34,7 @@
 //! through the optional speed), or KITTI's label types (see [`crate::kitti::labels`]).
 
 use super::boxes::{BoxFit, SizePrior};
+use super::other_class::OtherDensity;
 use crate::error::{ensure_non_negative, ensure_probability, Error, Result};
 use std::f64::consts::{FRAC_2_PI, PI};
 
@@ -182,6 +188,19 @@ pub struct ClassModel {
     pub other_extent: [f64; 3],
     /// Largest count of points a cluster of `Other` has (uniform in ln count up to it).
     pub other_max_points: f64,
+    /// Which density the `Other` class has.
+    pub other_model: OtherModel,
+}
+
+/// The density of the `Other` class's features.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum OtherModel {
+    /// Uniform over [0, [`ClassModel::other_extent`]] in the sides and height and over
+    /// [0, ln [`ClassModel::other_max_points`]] in ln(points): no knowledge of clutter.
+    Uniform,
+    /// The Gaussian mixture fitted on KITTI clusters outside every label box
+    /// ([`super::other_class`]).
+    Learned,
 }
 
 impl Default for ClassModel {
@@ -194,6 +213,7 @@ impl Default for ClassModel {
             log_count_sigma: 0.6,
             other_extent: [20.0, 6.0, 6.0],
             other_max_points: 1e5,
+            other_model: OtherModel::Learned,
         }
     }
 }
@@ -264,10 +284,20 @@ impl ClassModel {
             }
             out[k] = ll;
         }
-        let [lx, wx, hx] = self.other_extent;
-        let uniform = |x: f64, top: f64| if x <= top { -top.ln() } else { -1e3 };
-        let mut other = uniform(f.length, lx) + uniform(f.width, wx) + uniform(f.height, hx);
-        other += uniform(ln_n, self.other_max_points.ln());
+        let mut other = match self.other_model {
+            OtherModel::Uniform => {
+                let [lx, wx, hx] = self.other_extent;
+                let uniform = |x: f64, top: f64| if x <= top { -top.ln() } else { -1e3 };
+                uniform(f.length, lx)
+                    + uniform(f.width, wx)
+                    + uniform(f.height, hx)
+                    + uniform(ln_n, self.other_max_points.ln())
+            }
+            OtherModel::Learned => {
+                let unit = self.expected_points([1.0; 3], f.range).ln();
+                OtherDensity::embedded()?.ln_density(f.length, f.width, f.height, ln_n, unit)
+            }
+        };
         if let Some(v) = f.speed {
             other += speed_ll(ObjectClass::Other, v);
         }
@@ -455,6 +485,33 @@ mod tests {
             best(&features(9.0, 0.3, 1.2, 10.0, 3000)),
             ObjectClass::Other
         );
+    }
+
+    #[test]
+    fn clutter_and_road_users_at_ten_metres() {
+        // Sizes from common knowledge: a lamp or sign pole, a piece of hedge, an adult, a
+        // VW Golf. Point counts: ≈ 440 points/m² at 10 m (1/(100 · 0.0031 · 0.0073)) times
+        // 0.8 and the mean silhouette (2/π)(l + w)h (pole ≈ 540, hedge ≈ 1,020, adult ≈ 550,
+        // car ≈ 1,900), rounded down for dark or porous targets (foliage returns about half).
+        // A hedge piece as dense as a solid surface (≥ 900 points here) is a partly seen car
+        // for one frame's evidence: its sides and height fit a car's partial view.
+        let pole = features(0.3, 0.3, 4.0, 10.0, 250);
+        let hedge = features(3.0, 0.8, 1.2, 10.0, 600);
+        let person = features(0.8, 0.6, 1.75, 10.0, 450);
+        let car = features(4.2, 1.7, 1.5, 10.0, 1800);
+        assert_eq!(best(&pole), ObjectClass::Other);
+        assert_eq!(best(&hedge), ObjectClass::Other);
+        assert_eq!(best(&person), ObjectClass::Pedestrian);
+        assert_eq!(best(&car), ObjectClass::Car);
+        // Under the uniform Other model the hedge piece is not recognised as clutter.
+        let uniform = ClassModel {
+            other_model: OtherModel::Uniform,
+            ..ClassModel::default()
+        };
+        let ll = uniform.log_likelihoods(&hedge).unwrap();
+        let learned = ClassModel::default().log_likelihoods(&hedge).unwrap();
+        let other = ObjectClass::Other.index();
+        assert!(learned[other] > ll[other]);
     }
 
     #[test]

@@ -13,6 +13,7 @@ pub mod cluster;
 pub mod kitti_bin;
 pub mod las_io;
 pub mod odometry;
+pub mod other_class;
 pub mod palette;
 pub mod planes;
 pub mod ply_io;
