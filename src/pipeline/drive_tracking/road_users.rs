@@ -2,10 +2,11 @@
 //! detection, and what a cluster track remembers of them from frame to frame.
 //!
 //! * A detection's box is fitted to its points ([`crate::cloud::boxes`]: L-shape heading,
-//!   bottom on the ground plane) and classed for this frame ([`crate::cloud::classes`]); when
-//!   that frame's most likely class has a plausible footprint, the box is fitted again with it
-//!   and the visible-face model moves the box's centre away from the sensor. That centre, not
-//!   the centroid of the visible points, is what the filter measures.
+//!   bottom on the ground plane) and classed for this frame ([`crate::cloud::classes`]); it
+//!   is fitted again with the footprint of the frame's most likely road-user class (whatever
+//!   the likelihood of `Other`) and the visible-face model moves the box's centre away from
+//!   the sensor. That centre, not the centroid of the visible points, is what the filter
+//!   measures.
 //! * A track keeps a categorical class posterior ([`ClassBelief`]) updated with every matched
 //!   detection's class likelihood (its speed included, from the track), a box size averaged
 //!   over its detections, and a heading in the world frame: the matched box's, turned by π
@@ -60,7 +61,14 @@ pub fn shape_of(
     let fit = fit_box_of(cloud, indices, ground_z, None, &params, scratch)?;
     let features = ClassFeatures::from_fit(&fit, None);
     let class = model.classify(&features, &default_prior())?;
-    let bbox = match class.size_prior() {
+    // The box takes the footprint of the most likely road user even when the frame's most
+    // likely class is `Other`: a partly seen car that looks like clutter in one frame keeps
+    // its measured centre where the other frames put it (the class decides what is reported,
+    // not where the track is).
+    let mut road_user_prior = default_prior();
+    road_user_prior[ObjectClass::Other.index()] = 0.0;
+    let shape_class = model.classify(&features, &road_user_prior)?;
+    let bbox = match shape_class.size_prior() {
         Some(prior) => fit_box_of(cloud, indices, ground_z, Some(&prior), &params, scratch)?,
         None => fit,
     }
