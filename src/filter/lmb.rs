@@ -253,21 +253,28 @@ struct TrackLikelihoods {
     pd: Vec<f64>,
     /// η_miss = Σ wᵢ (1 − p_D(xᵢ)) (no underflow risk: a plain sum of probabilities).
     eta_miss: f64,
-    /// Gated measurement indices.
-    gated: Vec<usize>,
-    /// For each gated measurement: ln η = ln Σ wᵢ p_D(xᵢ) g(z | xᵢ) (without κ).
-    log_eta: Vec<f64>,
-    /// For each gated measurement: the likelihoods scaled by their largest value,
-    /// exp(ln g(z | xᵢ) − maxₖ ln g(z | xₖ)), so the best particle has 1 whatever the scale.
-    scaled_g: Vec<Vec<f64>>,
-    /// For each gated measurement: Σ wᵢ p_D(xᵢ) · scaled_g[i].
-    scaled_eta: Vec<f64>,
+    /// The gated measurements some particle can explain, in the gate's order. One entry per
+    /// pair, so a pair's index and its sums cannot come apart.
+    pairs: Vec<GatedPair>,
+}
+
+/// One (track, gated measurement) pair with positive likelihood.
+struct GatedPair {
+    /// Index of the measurement in the step's set.
+    measurement: usize,
+    /// ln η = ln Σ wᵢ p_D(xᵢ) g(z | xᵢ) (without κ).
+    log_eta: f64,
+    /// The likelihoods scaled by their largest value, exp(ln g(z | xᵢ) − maxₖ ln g(z | xₖ)),
+    /// so the best particle has 1 whatever the scale.
+    scaled_g: Vec<f64>,
+    /// Σ wᵢ p_D(xᵢ) · scaled_g[i], positive.
+    scaled_eta: f64,
 }
 
 /// A track's row of association marginals, in its own terms.
 struct TrackMarginals {
     miss: f64,
-    /// (index into `TrackLikelihoods::gated`, probability).
+    /// (index into `TrackLikelihoods::pairs`, probability).
     detect: Vec<(usize, f64)>,
 }
 
@@ -575,39 +582,31 @@ impl LmbFilter {
                         ));
                     }
                 }
-                let (mut log_eta, mut scaled_eta) =
-                    (Vec::with_capacity(zs.len()), Vec::with_capacity(zs.len()));
-                for g in &mut scaled_g {
+                let mut pairs = Vec::with_capacity(zs.len());
+                for (mut g, measurement) in scaled_g.into_iter().zip(gated) {
                     // log-sum-exp: shift by the largest log-likelihood before leaving the log
                     // domain, so likelihoods that would underflow keep their ratios.
                     let top = g.iter().copied().fold(f64::NEG_INFINITY, f64::max);
                     if !top.is_finite() {
-                        log_eta.push(f64::NEG_INFINITY);
-                        scaled_eta.push(0.0);
-                        continue;
+                        continue; // no particle can explain it
                     }
                     // Relative likelihoods below e^−707 ≈ 1e-307 count as 0.
                     g.iter_mut().for_each(|v| *v -= top);
-                    exp_in_place(g);
+                    exp_in_place(&mut g);
                     let sum: f64 = g.iter().zip(w).zip(&pd).map(|((g, w), d)| g * w * d).sum();
-                    log_eta.push(top + sum.ln());
-                    scaled_eta.push(sum);
+                    if sum > 0.0 {
+                        pairs.push(GatedPair {
+                            measurement,
+                            log_eta: top + sum.ln(),
+                            scaled_g: g,
+                            scaled_eta: sum,
+                        });
+                    }
                 }
-                // Drop pairs no particle can explain.
-                let keep: Vec<bool> = scaled_eta.iter().map(|s| *s > 0.0).collect();
-                let mut k = keep.iter();
-                gated.retain(|_| *k.next().expect("one flag per pair"));
-                let mut k = keep.iter();
-                scaled_g.retain(|_| *k.next().expect("one flag per pair"));
-                log_eta.retain(|e| *e > f64::NEG_INFINITY);
-                scaled_eta.retain(|s| *s > 0.0);
                 Ok(TrackLikelihoods {
                     pd,
                     eta_miss,
-                    gated,
-                    log_eta,
-                    scaled_g,
-                    scaled_eta,
+                    pairs,
                 })
             })
             .collect();
@@ -626,7 +625,10 @@ impl LmbFilter {
             .iter()
             .map(|zj| self.models.clutter.log_intensity(zj, ctx))
             .collect();
-        let gated: Vec<Vec<usize>> = lik.iter().map(|l| l.gated.clone()).collect();
+        let gated: Vec<Vec<usize>> = lik
+            .iter()
+            .map(|l| l.pairs.iter().map(|p| p.measurement).collect())
+            .collect();
         let groups = partition(&gated, z.len());
         let tracks = &self.tracks;
         let associator = &self.models.associator;
@@ -645,12 +647,13 @@ impl LmbFilter {
                     let r = tracks[ti].existence;
                     let l = &lik[ti];
                     problem.log_miss.push(log_miss_weight(r, l.eta_miss));
-                    for (k, &j) in l.gated.iter().enumerate() {
+                    for pair in &l.pairs {
+                        let j = pair.measurement;
                         let col = g
                             .measurements
                             .binary_search(&j)
                             .expect("gated measurement in its group");
-                        problem.log_detect[row * m + col] = r.ln() + l.log_eta[k] - log_kappa[j];
+                        problem.log_detect[row * m + col] = r.ln() + pair.log_eta - log_kappa[j];
                     }
                 }
                 let marg: Marginals = if m == 0 {
@@ -669,13 +672,13 @@ impl LmbFilter {
                     .enumerate()
                     .map(|(row, &ti)| {
                         let detect = lik[ti]
-                            .gated
+                            .pairs
                             .iter()
                             .enumerate()
-                            .map(|(k, &j)| {
+                            .map(|(k, pair)| {
                                 let col = g
                                     .measurements
-                                    .binary_search(&j)
+                                    .binary_search(&pair.measurement)
                                     .expect("gated measurement in its group");
                                 (k, marg.detect[row * m + col])
                             })
@@ -716,7 +719,7 @@ impl LmbFilter {
         let mut assigned = vec![0.0; n_meas];
         for (l, mg) in lik.iter().zip(marg) {
             for &(k, p) in &mg.detect {
-                assigned[l.gated[k]] += p;
+                assigned[l.pairs[k].measurement] += p;
             }
         }
         assigned.iter_mut().for_each(|a| *a = a.min(1.0));
@@ -776,7 +779,7 @@ impl LmbFilter {
             if let Some(&(k, probability)) = best {
                 self.most_probable.push(MostProbableMeasurement {
                     label: t.label,
-                    measurement: l.gated[k],
+                    measurement: l.pairs[k].measurement,
                     probability,
                 });
             }
@@ -861,13 +864,15 @@ fn update_track(t: &mut Track, l: &TrackLikelihoods, mg: &TrackMarginals) {
     let mut factor: Vec<f64> = l.pd.iter().map(|d| miss * (1.0 - d)).collect();
     if let Some((&(k0, p0), rest)) = detected.split_first() {
         // Σ_j P_j·ĝ_j,i / η̂_j, started from the first term (no zero-filled buffer).
-        let c0 = p0 / l.scaled_eta[k0];
-        let mut detect_sum: Vec<f64> = l.scaled_g[k0].iter().map(|g| c0 * g).collect();
+        let first = &l.pairs[k0];
+        let c0 = p0 / first.scaled_eta;
+        let mut detect_sum: Vec<f64> = first.scaled_g.iter().map(|g| c0 * g).collect();
         for &(k, p) in rest {
-            let c = p / l.scaled_eta[k];
+            let pair = &l.pairs[k];
+            let c = p / pair.scaled_eta;
             detect_sum
                 .iter_mut()
-                .zip(&l.scaled_g[k])
+                .zip(&pair.scaled_g)
                 .for_each(|(s, g)| *s += c * g);
         }
         factor
