@@ -305,36 +305,113 @@ fn one_point_per_cell(xy: &mut Vec<f64>, n2: usize, cell: f64) {
 }
 
 /// The heading in [0, π/2) maximising the closeness criterion over the interleaved x–y
-/// coordinates `xy`, centred on their mean (see the module notes). The first maximum wins on
-/// ties.
+/// coordinates `xy`, centred on their mean (see the module notes).
+///
+/// The candidates are the multiples of `angle_step`. With more than [`COARSE_STEPS`]·4 of
+/// them the search runs coarse to fine: every [`COARSE_STEPS`]-th candidate is scored, then
+/// every candidate within [`COARSE_STEPS`] − 1 steps of the two best coarse ones. Near its
+/// peak the criterion falls off steadily as the heading turns away (the points leave the
+/// edges in proportion to the angle), so the best coarse candidate lies next to the peak;
+/// the second covers a cluster with two rival L's. Of the headings scored the highest wins,
+/// the smallest on ties. The rectangle of each candidate is bounded by the points' convex
+/// hull, whose vertices hold every extreme projection.
 pub fn lshape_heading(xy: &[f64], params: &BoxFitParams) -> f64 {
     let steps = ((FRAC_PI_2 / params.angle_step).ceil() as usize).max(1);
+    let hull = hull_xy(xy);
     let d0 = params.min_distance;
-    let mut best = (f64::NEG_INFINITY, 0.0);
-    for k in 0..steps {
+    let score = |k: usize| -> Option<f64> {
         let theta = k as f64 * params.angle_step;
         if theta >= FRAC_PI_2 {
-            break;
+            return None;
         }
         let (s, c) = theta.sin_cos();
-        let r = Rect::bounding_sc(xy, s, c);
+        let r = Rect::bounding_sc(&hull, s, c);
         // Per axis, the edge whose distance vector has the smaller norm: Σ(a − lo)² ≤
         // Σ(hi − a)² ⟺ 2·Σa ≤ n·(lo + hi), and Σa = 0 for the centred points, so the lower
         // edge wins when lo + hi ≥ 0 (the mean lies in the rectangle's lower half).
         let use_lo1 = r.lo[0] + r.hi[0] >= 0.0;
         let use_lo2 = r.lo[1] + r.hi[1] >= 0.0;
-        let mut score = 0.0;
+        let mut total = 0.0;
         for p in xy.chunks_exact(2) {
             let (a, b) = (c * p[0] + s * p[1], -s * p[0] + c * p[1]);
             let d1 = if use_lo1 { a - r.lo[0] } else { r.hi[0] - a };
             let d2 = if use_lo2 { b - r.lo[1] } else { r.hi[1] - b };
-            score += 1.0 / d1.min(d2).max(d0);
+            total += 1.0 / d1.min(d2).max(d0);
         }
-        if score > best.0 {
-            best = (score, theta);
+        Some(total)
+    };
+    // (score, step), the higher score first, then the smaller step.
+    let better = |a: (f64, usize), b: (f64, usize)| a.0 > b.0 || (a.0 == b.0 && a.1 < b.1);
+    let mut best = (f64::NEG_INFINITY, 0);
+    let consider = |k: usize, best: &mut (f64, usize)| -> Option<f64> {
+        let v = score(k)?;
+        if better((v, k), *best) {
+            *best = (v, k);
+        }
+        Some(v)
+    };
+    if steps <= 4 * COARSE_STEPS {
+        for k in 0..steps {
+            consider(k, &mut best);
+        }
+    } else {
+        let mut top = [(f64::NEG_INFINITY, 0); 2];
+        for k in (0..steps).step_by(COARSE_STEPS) {
+            if let Some(v) = consider(k, &mut best) {
+                if better((v, k), top[0]) {
+                    top = [(v, k), top[0]];
+                } else if better((v, k), top[1]) {
+                    top[1] = (v, k);
+                }
+            }
+        }
+        for &(v, kc) in &top {
+            if v == f64::NEG_INFINITY {
+                continue;
+            }
+            let lo = kc.saturating_sub(COARSE_STEPS - 1);
+            let hi = (kc + COARSE_STEPS - 1).min(steps - 1);
+            for k in (lo..=hi).filter(|k| k % COARSE_STEPS != 0) {
+                consider(k, &mut best);
+            }
         }
     }
-    best.1
+    best.1 as f64 * params.angle_step
+}
+
+/// Candidate headings per coarse step of [`lshape_heading`].
+pub const COARSE_STEPS: usize = 8;
+
+/// The convex hull's vertices of the interleaved x–y coordinates `xy`, interleaved (Andrew's
+/// monotone chain; every point when there are fewer than three).
+fn hull_xy(xy: &[f64]) -> Vec<f64> {
+    let mut pts: Vec<[f64; 2]> = xy.chunks_exact(2).map(|p| [p[0], p[1]]).collect();
+    if pts.len() < 3 {
+        return xy.to_vec();
+    }
+    pts.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
+    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
+        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+    };
+    let mut hull: Vec<[f64; 2]> = Vec::with_capacity(32);
+    for pass in 0..2 {
+        let start = hull.len();
+        let mut push = |p: [f64; 2]| {
+            while hull.len() >= start + 2
+                && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(p);
+        };
+        if pass == 0 {
+            pts.iter().for_each(|&p| push(p));
+        } else {
+            pts.iter().rev().for_each(|&p| push(p));
+        }
+        hull.pop(); // the last point starts the other chain
+    }
+    hull.into_iter().flatten().collect()
 }
 
 /// An axis-aligned rectangle in the frame turned by θ: `lo[k] ≤ coordinate k ≤ hi[k]`.
@@ -604,7 +681,76 @@ mod tests {
         assert!((one.fitted.center.x - 1.0).abs() < 1e-12);
     }
 
+    /// The closeness criterion of Zhang et al. (Algorithm 4) at heading `theta`, computed as
+    /// the paper states it: every point projected, the bounding edges from all projections,
+    /// per axis the edge whose distance vector has the smaller norm.
+    fn closeness_reference(xy: &[[f64; 2]], theta: f64, d0: f64) -> f64 {
+        let (s, c) = theta.sin_cos();
+        let c1: Vec<f64> = xy.iter().map(|p| c * p[0] + s * p[1]).collect();
+        let c2: Vec<f64> = xy.iter().map(|p| -s * p[0] + c * p[1]).collect();
+        let nearer = |v: &[f64]| -> Vec<f64> {
+            let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let to_lo: Vec<f64> = v.iter().map(|a| a - lo).collect();
+            let to_hi: Vec<f64> = v.iter().map(|a| hi - a).collect();
+            let norm = |d: &[f64]| d.iter().map(|x| x * x).sum::<f64>();
+            if norm(&to_lo) <= norm(&to_hi) {
+                to_lo
+            } else {
+                to_hi
+            }
+        };
+        let (d1, d2) = (nearer(&c1), nearer(&c2));
+        d1.iter()
+            .zip(&d2)
+            .map(|(a, b)| 1.0 / a.min(*b).max(d0))
+            .sum()
+    }
+
     proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        /// The coarse-to-fine search finds the heading an exhaustive search over every
+        /// candidate finds, on the visible faces of cars, vans and pedestrians seen from any
+        /// side, near and far.
+        #[test]
+        fn coarse_to_fine_search_matches_the_exhaustive_one(
+            yaw in -3.2..3.2f64,
+            range in 3.0..40.0f64,
+            bearing in -3.2..3.2f64,
+            size in prop_oneof![Just((4.5, 1.8)), Just((5.5, 2.1)), Just((0.8, 0.6))],
+            noise in 0.0..0.04f64,
+            seed in 0u64..1000,
+        ) {
+            let b = Box3::new(
+                Point3::new(range * bearing.cos(), range * bearing.sin(), -1.0),
+                [size.0, size.1, 1.5],
+                yaw,
+            );
+            let [xs, ys, _] = visible_faces(&b, 40.0, noise, seed);
+            prop_assume!(xs.len() >= 3);
+            let n = xs.len() as f64;
+            let (mx, my) = (
+                xs.iter().map(|&x| x as f64).sum::<f64>() / n,
+                ys.iter().map(|&y| y as f64).sum::<f64>() / n,
+            );
+            let pts: Vec<[f64; 2]> =
+                xs.iter().zip(&ys).map(|(&x, &y)| [x as f64 - mx, y as f64 - my]).collect();
+            let xy: Vec<f64> = pts.iter().flatten().copied().collect();
+            let p = BoxFitParams::default();
+            let steps = (FRAC_PI_2 / p.angle_step).ceil() as usize;
+            let (best_k, best) = (0..steps)
+                .map(|k| (k, closeness_reference(&pts, k as f64 * p.angle_step, p.min_distance)))
+                .fold((0, f64::NEG_INFINITY), |a, b| if b.1 > a.1 { b } else { a });
+            let found = lshape_heading(&xy, &p);
+            let score = closeness_reference(&pts, found, p.min_distance);
+            prop_assert!(
+                score >= best * (1.0 - 1e-9),
+                "found {:.2}° scoring {score}, exhaustive {:.2}° scoring {best}",
+                found.to_degrees(),
+                (best_k as f64 * p.angle_step).to_degrees()
+            );
+        }
+
         #[test]
         fn boxes_hold_the_points_and_grow_at_most_to_the_prior(
             pts in proptest::collection::vec((-30.0..30.0f32, -30.0..30.0f32, -2.0..1.0f32), 1..60),
