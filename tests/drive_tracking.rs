@@ -301,10 +301,10 @@ fn assert_clusters_are_components(cloud: &PointCloud, clusters: &[Vec<u32>], tol
         i
     }
     let t2 = tolerance * tolerance;
-    for a in 0..members.len() {
-        let i = members[a].1 as usize;
-        for b in a + 1..members.len() {
-            let j = members[b].1 as usize;
+    for (a, &(_, i)) in members.iter().enumerate() {
+        let i = i as usize;
+        for (b, &(_, j)) in members.iter().enumerate().skip(a + 1) {
+            let j = j as usize;
             let (dx, dy, dz) = (xs[i] - xs[j], ys[i] - ys[j], zs[i] - zs[j]);
             if dx * dx + dy * dy + dz * dz <= t2 {
                 let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
@@ -314,13 +314,13 @@ fn assert_clusters_are_components(cloud: &PointCloud, clusters: &[Vec<u32>], tol
     }
     let mut components: Vec<Vec<u32>> = Vec::new();
     let mut slot: BTreeMap<usize, usize> = BTreeMap::new();
-    for a in 0..members.len() {
+    for (a, &(_, i)) in members.iter().enumerate() {
         let r = root(&mut parent, a);
         let k = *slot.entry(r).or_insert_with(|| {
             components.push(Vec::new());
             components.len() - 1
         });
-        components[k].push(members[a].1);
+        components[k].push(i);
     }
     let normalise = |sets: &mut Vec<Vec<u32>>| {
         sets.iter_mut().for_each(|c| c.sort_unstable());
