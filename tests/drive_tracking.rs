@@ -398,11 +398,28 @@ fn full_real_frames_when_present() {
     let Some(dir) = shared_data("kitti_raw/2011_09_26/2011_09_26_drive_UNKNOWN_sync") else {
         return;
     };
-    let tracks = run(&dir, 1);
+    let drive = RawDrive::open(&dir).unwrap();
+    let tolerance = config().clusters.tolerance as f32;
+    let mut checked = 0;
+    let tracks = track_drive(&drive, None, &config(), 1, |view| {
+        if view.tracked.frame == 0 {
+            let clusters: Vec<Vec<u32>> = view
+                .detections
+                .clusters
+                .iter()
+                .map(|c| c.indices.clone())
+                .collect();
+            assert_clusters_are_components(view.cloud, &clusters, tolerance);
+            checked = clusters.len();
+        }
+        Ok(())
+    })
+    .unwrap();
     assert_eq!(tracks.frames.len(), 4);
     let s = &tracks.summary;
     eprintln!("{s:#?}");
-    assert!(s.mean_planes + s.mean_clusters > 1.0, "{s:?}");
+    assert_eq!(tracks.frames[0].detected_clusters, checked);
+    assert!(checked > 0, "{s:?}");
 }
 
 #[test]
