@@ -18,6 +18,10 @@
 //!
 //! p_D(x) = p_inside · (1 − b / n)  inside the field of view, p_outside elsewhere.
 //!
+//! Bearings count modulo 2π: the window takes the beams of the scan whose directions fall
+//! inside it, whichever turn their bearings are written in, so a person astride the start and
+//! end of a full-turn scan (−π and π, or 0 and 2π) keeps the beams on both sides.
+//!
 //! With `min_returns` = m > 0 the model also accounts for range: a detector that needs m
 //! returns on the object cannot see far objects that catch fewer beams. With bearing noise the
 //! number of beams ending on the disc is close to Poisson with mean μ = (1 − b / n) ·
@@ -186,7 +190,8 @@ const BEARING_SLACK: f64 = 1e-4;
 impl OcclusionDetection {
     /// The beams the windows of the particles can cover, from the bounds of the cloud's
     /// positions: bearings widened by the widest window (that of the nearest possible
-    /// particle), a bearing slack and one beam on either side.
+    /// particle), a bearing slack and one beam on either side, and the copies of that
+    /// interval a whole turn away that meet the scan (bearings count modulo 2π).
     fn reach(&self, view: &BeamView, bounds: Option<&PolarBounds>) -> CloudReach {
         let n = view.ranges.len();
         let inc = view.angle_increment;
@@ -203,19 +208,35 @@ impl OcclusionDetection {
         let half_max = (self.object_radius / b.d_min).min(1.0).asin() * (1.0 + 1e-9);
         let lo = ((b.bearing_min - half_max - BEARING_SLACK - view.angle_min) / inc).floor() - 1.0;
         let hi = ((b.bearing_max + half_max + BEARING_SLACK - view.angle_min) / inc).ceil() + 1.0;
-        if !(lo.is_finite() && hi.is_finite()) {
+        // beams per turn
+        let turn = std::f64::consts::TAU / inc;
+        if !(lo.is_finite() && hi.is_finite() && turn >= 1.0) {
             return CloudReach::UNKNOWN;
         }
         let last_beam = (n - 1) as f64;
-        let (first, last) = (lo.max(0.0), hi.min(last_beam));
-        if first > last {
+        let (mut min, mut max) = (f64::INFINITY, f64::NEG_INFINITY);
+        let (mut copies, mut inside) = (0, false);
+        let mut k = (-hi / turn).ceil();
+        let k_last = ((last_beam - lo) / turn).floor();
+        while k <= k_last {
+            let (from, to) = (lo + k * turn, hi + k * turn);
+            let (first, last) = (from.ceil().max(0.0), to.floor().min(last_beam));
+            if first <= last {
+                let (a, b) = view.extremes.query(first as usize, last as usize);
+                (min, max) = (min.min(a), max.max(b));
+                copies += 1;
+                inside = from >= 0.0 && to <= last_beam;
+            }
+            k += 1.0;
+        }
+        if copies == 0 {
             return CloudReach::NOTHING;
         }
-        let (min, max) = view.extremes.query(first as usize, last as usize);
         CloudReach {
             min,
             max,
-            inside: lo >= 0.0 && hi <= last_beam,
+            // every window within one copy that lies wholly in the scan
+            inside: copies == 1 && inside,
         }
     }
 
