@@ -3,6 +3,9 @@
 //! and how many beams of a bearing window end nearer than a limit, with range extremes of
 //! power-of-two runs of beams so that most windows are answered by two lookups.
 //!
+//! Bearings count modulo 2π: a window that reaches past an end of the scan also takes the
+//! beams a whole turn away, so a scan of a full turn has no seam, wherever it starts (−π, 0).
+//!
 //! Not for: reading scans from files ([`crate::laser2d`]) or deciding what blocks whom.
 
 use crate::error::{ensure_finite, Error, Result};
@@ -145,18 +148,79 @@ impl BeamView {
     }
 
     /// (blocked, total) beams of the window `bearing ± half_width` whose return is shorter than
-    /// `limit`; the window holds at least the beam nearest to `bearing` when that lies in the
-    /// scan. (0, 0) when the window misses the scan.
+    /// `limit`, bearings modulo 2π (a window past an end of the scan takes the beams a whole
+    /// turn away too); the window holds at least the beam nearest to `bearing` when that lies
+    /// within half a spacing of it. (0, 0) when the window misses the scan.
     #[inline]
     pub fn blocked(&self, bearing: f64, half_width: f64, limit: f64) -> (usize, usize) {
         let (first, last) = self.window_ends(bearing, half_width);
-        self.count_blocked(first, last, bearing, limit)
+        // With a beam on either side left out and the scan within one turn, no other copy of
+        // the window, a turn away, meets the scan, and the nearest beam is a beam of the scan.
+        let top = self.ranges.len() as f64 - 1.0;
+        let span = top * self.angle_increment.abs();
+        if first >= 1.0 && last <= top - 1.0 && span <= std::f64::consts::TAU {
+            self.count_blocked(first, last, bearing, limit)
+        } else {
+            self.blocked_around(bearing, half_width, limit, first, last)
+        }
+    }
+
+    /// [`BeamView::blocked`] for a window that reaches an end of the scan, or on a scan of more
+    /// than a turn: the window and its copies a whole number of turns away, each clipped to
+    /// the scan; without a beam in any of them, the beam within half a spacing of the bearing
+    /// or of a copy of it. Non-finite windows and a zero increment take the window as it is.
+    #[inline(never)]
+    fn blocked_around(
+        &self,
+        bearing: f64,
+        half_width: f64,
+        limit: f64,
+        first: f64,
+        last: f64,
+    ) -> (usize, usize) {
+        let inc = self.angle_increment;
+        let a = (bearing - half_width - self.angle_min) / inc;
+        let b = (bearing + half_width - self.angle_min) / inc;
+        let (lo, hi) = if a <= b { (a, b) } else { (b, a) };
+        // beams per turn; at least one, or the copies overlap beam by beam
+        let turn = std::f64::consts::TAU / inc.abs();
+        if self.ranges.is_empty() || !(lo.is_finite() && hi.is_finite() && turn >= 1.0) {
+            return self.count_blocked(first, last, bearing, limit);
+        }
+        let top = (self.ranges.len() - 1) as f64;
+        let (mut blocked, mut total) = (0, 0);
+        // copies lo + k · turn ..= hi + k · turn that can meet 0..=top
+        let mut k = (-hi / turn).ceil();
+        let k_last = ((top - lo) / turn).floor();
+        while k <= k_last {
+            let first = (lo + k * turn).ceil().max(0.0);
+            let last = (hi + k * turn).floor().min(top);
+            if first <= last {
+                let (b, t) = self.count_blocked(first, last, bearing, limit);
+                blocked += b;
+                total += t;
+            }
+            k += 1.0;
+        }
+        if total > 0 {
+            return (blocked, total);
+        }
+        // No beam direction inside any copy: the nearest beam, from the first copy of the
+        // bearing at or above index −½.
+        let c = (bearing - self.angle_min) / inc;
+        let nearest = round_exact(c + ((-0.5 - c) / turn).ceil() * turn);
+        if (0.0..=top).contains(&nearest) {
+            self.count_blocked(nearest, nearest, bearing, limit)
+        } else {
+            (0, 0)
+        }
     }
 
     /// The unclipped first and last beam index of the window `bearing ± half_width`, ⌈lo⌉ and
     /// ⌊hi⌋ as whole floats (first > last when no beam direction falls inside it). Free of
     /// branches and calls, so a loop over many windows runs on vector lanes; the rest of
-    /// [`BeamView::blocked`] is [`BeamView::count_blocked`].
+    /// [`BeamView::blocked`] is [`BeamView::count_blocked`] (or, past an end of the scan,
+    /// [`BeamView::blocked_around`]).
     #[inline(always)]
     pub(super) fn window_ends(&self, bearing: f64, half_width: f64) -> (f64, f64) {
         let inc = if self.angle_increment == 0.0 {
@@ -272,6 +336,34 @@ pub(crate) mod tests {
         assert_eq!(v.blocked(0.2f64.to_radians(), 1e-4, 5.0), (1, 1));
         // behind the scanner: nothing
         assert_eq!(v.blocked(PI, 0.01, 5.0), (0, 0));
+    }
+
+    #[test]
+    fn windows_run_on_past_the_ends_of_a_full_turn() {
+        // 360 beams 1° apart from 0°, a wall at 3 m over beams 355..=359 and 0..=4
+        let ranges: Vec<f64> = (0..360)
+            .map(|i| if !(5..355).contains(&i) { 3.0 } else { 20.0 })
+            .collect();
+        let deg = |a: f64| a.to_radians();
+        let v = BeamView::new(0.0, deg(1.0), &ranges).unwrap();
+        // straight ahead, ±2.5°: beams 358, 359, 0, 1, 2
+        assert_eq!(v.blocked(0.0, deg(2.5), 5.0), (5, 5));
+        // at −6°, ±2.5°: beams 352..=356, of which 355 and 356 blocked
+        assert_eq!(v.blocked(deg(-6.0), deg(2.5), 5.0), (2, 5));
+        // narrower than a beam at −0.8°: the nearest beam is 359
+        assert_eq!(v.blocked(deg(-0.8), 1e-4, 5.0), (1, 1));
+        assert_eq!(v.blocked(deg(-0.8), 1e-4, 2.0), (0, 1));
+        // the same ranges from −180°: astride ±180°, beams 358, 359 (178°, 179°) and 0, 1, 2
+        let v = BeamView::new(-PI, deg(1.0), &ranges).unwrap();
+        assert_eq!(v.blocked(PI, deg(2.5), 5.0), (5, 5));
+        assert_eq!(v.blocked(-PI, deg(2.5), 5.0), (5, 5));
+        // 361 beams from −180° to 180°: the beam at ±180° is there twice
+        let v = BeamView::new(-PI, deg(1.0), &[vec![3.0; 3], vec![20.0; 358]].concat()).unwrap();
+        assert_eq!(v.blocked(PI, deg(2.5), 5.0), (3, 6));
+        // a half-turn scan has nothing behind it, and its first beam is beam 0 (−90°)
+        let v = BeamView::new(-FRAC_PI_2, deg(1.0), &ranges[..181]).unwrap();
+        assert_eq!(v.blocked(PI, deg(2.5), 5.0), (0, 0));
+        assert_eq!(v.blocked(deg(-88.9), deg(2.5), 5.0), (4, 4));
     }
 
     /// The window rule evaluated beam by beam with the library's rounding.
