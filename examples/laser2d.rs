@@ -153,7 +153,7 @@ struct Args {
 fn main() -> Result<()> {
     let args = Args::parse();
     if args.carmen.is_some() || args.bag.is_some() {
-        return recording::run(&args);
+        return recording::run(&args).map(|_| ());
     }
     run_simulated(&args)
 }
@@ -410,7 +410,7 @@ mod recording {
         read_bag, read_carmen, read_pose_arrays, BagOptions, CarmenOptions, Scan, TimeOrder,
     };
     use smc_lmb::pipeline::people_tracking::score::{
-        truth_for_scans, DetectionScore, TrackScore, FIRST_SCORED_SCAN,
+        truth_for_scans, DetectionScore, TrackScore, TrackScoreSummary, FIRST_SCORED_SCAN,
     };
     use smc_lmb::pipeline::people_tracking::{
         config_for_scans, track_scans_with_model, write_people_json, PeopleRun,
@@ -419,7 +419,21 @@ mod recording {
     use std::path::Path;
     use std::time::Instant;
 
-    pub fn run(args: &Args) -> Result<()> {
+    /// What `--truth-topic` or `--empty` scored (as printed).
+    #[derive(Debug)]
+    #[cfg_attr(not(test), allow(dead_code))] // the program prints them; its tests read them
+    pub struct Scores {
+        /// The front end's people.
+        pub front_end: DetectionScore,
+        /// The tracker's visible people.
+        pub tracker: TrackScoreSummary,
+        /// The tracker's visible people classed dynamic.
+        pub dynamic: TrackScoreSummary,
+    }
+
+    /// Tracks the recording, writes and prints what `args` ask for; the scores when the run
+    /// was scored.
+    pub fn run(args: &Args) -> Result<Option<Scores>> {
         let t_read = Instant::now();
         let scans = window(args, load(args)?)?;
         let read_s = t_read.elapsed().as_secs_f64();
@@ -456,9 +470,9 @@ mod recording {
         report(&scans, &run, read_s, secs);
         if args.truth_topic.is_some() || args.empty {
             let truth = truth(args, &scans)?;
-            score(&run, &truth, min_visibility)?;
+            return Ok(Some(score(&run, &truth, min_visibility)?));
         }
-        Ok(())
+        Ok(None)
     }
 
     /// The people of every scan: from the annotations of `--truth-topic`, or nobody.
@@ -490,7 +504,7 @@ mod recording {
     }
 
     /// Prints the scores of the front end's people and of the tracker's visible people.
-    fn score(run: &PeopleRun, truth: &[Vec<[f64; 2]>], min_visibility: f64) -> Result<()> {
+    fn score(run: &PeopleRun, truth: &[Vec<[f64; 2]>], min_visibility: f64) -> Result<Scores> {
         let mut detector = DetectionScore::default();
         let mut tracks = TrackScore::default();
         let mut walking = TrackScore::default();
@@ -527,15 +541,22 @@ mod recording {
             )
         };
         line("front end", &detector);
-        for (what, acc) in [("tracker", &tracks), ("tracker, dynamic only", &walking)] {
-            let t = acc.summary();
+        let scores = Scores {
+            front_end: detector,
+            tracker: tracks.summary(),
+            dynamic: walking.summary(),
+        };
+        for (what, t) in [
+            ("tracker", &scores.tracker),
+            ("tracker, dynamic only", &scores.dynamic),
+        ] {
             line(what, &t.detection);
             println!(
                 "{what}: MOTA {:.3}, IDF1 {:.3}, ID switches {}",
                 t.mota, t.idf1, t.id_switches
             );
         }
-        Ok(())
+        Ok(scores)
     }
 
     fn load(args: &Args) -> Result<Vec<Scan>> {
@@ -656,5 +677,110 @@ mod recording {
             scans.len()
         );
         Ok(scans[a..b].to_vec())
+    }
+}
+
+/// The recording path as the command line runs it, on the ROS bag excerpt vendored for the
+/// tests (`tests/data/laser2d/positive_1_excerpt.bag`: 39 scans of one person walking away
+/// from the scanner, with leg annotations): `cargo test --example laser2d`.
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use smc_lmb::pipeline::people_tracking::score::DetectionScore;
+    use smc_lmb::pipeline::people_tracking::PeopleRun;
+
+    const EXCERPT: &str = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/laser2d/positive_1_excerpt.bag"
+    );
+    /// Scans in the excerpt, and those scored (from the 10th).
+    const SCANS: usize = 39;
+    const SCORED: usize = 30;
+
+    /// `laser2d --bag EXCERPT --topic /training_scan --out J --plot P EXTRA`: the scores, the
+    /// people JSON read back and the plot.
+    fn laser2d(extra: &[&str]) -> Result<(Option<recording::Scores>, PeopleRun, String)> {
+        let dir = tempfile::tempdir()?;
+        let (out, plot) = (
+            dir.path().join("people.json"),
+            dir.path().join("tracks.svg"),
+        );
+        let mut argv = vec!["laser2d", "--bag", EXCERPT, "--topic", "/training_scan"];
+        argv.extend([
+            "--out",
+            out.to_str().unwrap(),
+            "--plot",
+            plot.to_str().unwrap(),
+        ]);
+        argv.extend(extra);
+        let scores = recording::run(&Args::try_parse_from(argv)?)?;
+        let run = serde_json::from_slice(&std::fs::read(&out)?)?;
+        Ok((scores, run, std::fs::read_to_string(&plot)?))
+    }
+
+    fn assert_sane(d: &DetectionScore) {
+        for v in [d.precision(), d.recall(), d.f1(), d.false_per_scan()] {
+            assert!(v.is_finite() && v >= 0.0, "{d:?}");
+        }
+        assert!(d.precision() <= 1.0 && d.recall() <= 1.0 && d.f1() <= 1.0);
+    }
+
+    #[test]
+    fn bag_excerpt_is_tracked_and_scored_against_its_annotations() {
+        let (scores, run, svg) = laser2d(&["--truth-topic", "/leg_cluster_positions"]).unwrap();
+        let s = scores.expect("--truth-topic scores the run");
+        // One annotated person in every scored scan.
+        for d in [&s.front_end, &s.tracker.detection, &s.dynamic.detection] {
+            assert_eq!((d.scans, d.people), (SCORED, SCORED), "{d:?}");
+            assert_sane(d);
+        }
+        for t in [&s.tracker, &s.dynamic] {
+            assert!(t.mota.is_finite() && t.mota <= 1.0, "{t:?}");
+            assert!((0.0..=1.0).contains(&t.idf1), "{t:?}");
+        }
+        assert_eq!(run.scans.len(), SCANS);
+        assert!(run.scans.iter().enumerate().all(|(k, s)| s.scan == k));
+        assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+    }
+
+    #[test]
+    fn bag_excerpt_with_the_legs_front_end_finds_its_walker() {
+        // The excerpt is part of the shipped leg model's training data: an end-to-end check
+        // of the legs path, not of how well the model generalises.
+        let extra = [
+            "--truth-topic",
+            "/leg_cluster_positions",
+            "--front-end",
+            "legs",
+        ];
+        let (scores, run, _) = laser2d(&extra).unwrap();
+        let s = scores.unwrap();
+        assert!(
+            s.front_end.recall() >= 0.9 && s.front_end.precision() >= 0.9,
+            "{s:?}"
+        );
+        assert!(s.tracker.detection.f1() >= 0.9, "{s:?}");
+        assert_eq!(s.tracker.id_switches, 0);
+        assert_eq!(run.tracks_with(20).count(), 1, "{:?}", run.tracks);
+    }
+
+    #[test]
+    fn bag_excerpt_window_runs_unscored_and_bad_requests_are_refused() {
+        let (scores, run, _) = laser2d(&["--scans", "5..25"]).unwrap();
+        assert!(scores.is_none());
+        assert_eq!(run.scans.len(), 20);
+        let e = laser2d(&[
+            "--scans",
+            "5..25",
+            "--truth-topic",
+            "/leg_cluster_positions",
+        ])
+        .unwrap_err();
+        assert!(format!("{e:#}").contains("drop --scans"), "{e:#}");
+        let e = laser2d(&["--truth-topic", "/training_scan"]).unwrap_err();
+        assert!(
+            format!("{e:#}").contains("geometry_msgs/PoseArray"),
+            "{e:#}"
+        );
     }
 }
