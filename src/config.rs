@@ -192,7 +192,7 @@ pub enum BirthConfig {
     Static {
         /// The terms (existence, mean, std in the state layout of the transition).
         terms: Vec<BirthTerm>,
-        /// Particles per birth track.
+        /// Particles per birth track, 1 to [`crate::filter::MAX_PARTICLES`].
         particles: usize,
     },
     /// [`AdaptiveBirth`] from unexplained measurements.
@@ -201,7 +201,7 @@ pub enum BirthConfig {
         expected_births: f64,
         /// Cap r_B,max on a birth's existence.
         max_existence: f64,
-        /// Particles per birth track.
+        /// Particles per birth track, 1 to [`crate::filter::MAX_PARTICLES`].
         particles: usize,
         /// Position spread around the measured point (m).
         position_std: f64,

@@ -11,7 +11,7 @@
 //! name in the header (`z0`, `z1`, … for the measurement). A line whose `z` fields are all
 //! empty declares an empty frame. Frames must appear in non-decreasing order of `frame`;
 //! missing frame numbers in between are empty frames, their times interpolated between the
-//! neighbouring listed frames' (at most [`MAX_FRAME_GAP`] of them in a row).
+//! neighbouring listed frames' (at most [`MAX_FRAME_GAP`] of them in the whole file).
 //!
 //! Estimates are written as JSON (`{"frames": [{"frame", "time", "estimates": [{"label":
 //! {"birth_step", "index"}, "existence", "state", "age"}]}]}`) or CSV
@@ -24,8 +24,9 @@ use crate::filter::Estimate;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-/// The most empty frames a CSV file may leave between two listed frame numbers (or before
-/// its first one): a larger gap is refused as a typo rather than allocated.
+/// The most empty frames a CSV file may leave unlisted, counted over the whole file (between
+/// listed frame numbers and before the first one): more are refused as a typo rather than
+/// allocated, so that a few short lines cannot fill memory with empty frames.
 pub const MAX_FRAME_GAP: usize = 1_000_000;
 
 /// Appends empty frames up to and including `frame` (when it is not there yet). A frame
@@ -241,6 +242,7 @@ fn parse_csv(
     };
     let id_col = col("id");
     let mut frames: Vec<DetectionFrame> = Vec::new();
+    let mut unlisted = 0usize;
     for (i, line) in lines {
         let line_no = i + 1;
         let cells: Vec<&str> = line.split(',').map(str::trim).collect();
@@ -293,14 +295,15 @@ fn parse_csv(
             ));
         }
         let gap = frame.saturating_sub(frames.len());
-        if gap > MAX_FRAME_GAP {
+        unlisted = unlisted.saturating_add(gap);
+        if unlisted > MAX_FRAME_GAP {
             return Err(Error::parse(
                 path,
                 line_no,
                 "frame",
                 format!(
-                    "frame {frame} would leave {gap} empty frames before it; at most \
-                     {MAX_FRAME_GAP} are accepted"
+                    "frame {frame} would leave {gap} empty frames before it, {unlisted} in the \
+                     file so far; at most {MAX_FRAME_GAP} are accepted"
                 ),
             ));
         }
@@ -432,6 +435,16 @@ mod tests {
         let e = read_frames(&p).unwrap_err().to_string();
         assert!(
             e.contains("over.csv:2") && e.contains("not a frame number"),
+            "{e}"
+        );
+        // Gaps each within the limit add up: three lines may not fill 88 MB each.
+        let p = tmp(
+            "gaps.csv",
+            "frame,time,z0,z1\n600000,0.0,1,2\n1200000,1.0,1,2\n1800000,2.0,1,2\n",
+        );
+        let e = read_frames(&p).unwrap_err().to_string();
+        assert!(
+            e.contains("gaps.csv:3") && e.contains("1199999 in the file"),
             "{e}"
         );
     }

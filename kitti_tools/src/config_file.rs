@@ -66,3 +66,148 @@ mod tests {
         assert!(err.contains("c.toml:2:"), "{err}");
     }
 }
+
+/// Hostile configuration files: arbitrary bytes, the example configuration with a few bytes
+/// changed or cut short, deep nesting and huge numbers. Each read (and the check or build that
+/// follows it in the commands) must return, an error naming the file, never a panic.
+#[cfg(test)]
+mod hostile {
+    use super::*;
+    use proptest::prelude::*;
+    use proptest::sample::Index;
+    use smc_lmb::config::RunConfig;
+    use smc_lmb::pipeline::drive_tracking::TrackingConfig;
+    use smc_lmb::sim::street::StreetConfig;
+    use std::path::PathBuf;
+
+    fn example() -> Vec<u8> {
+        let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/data/config.toml");
+        std::fs::read(p).unwrap()
+    }
+
+    fn example_json() -> Vec<u8> {
+        let text = String::from_utf8(example()).unwrap();
+        let config: RunConfig = toml::from_str(&text).unwrap();
+        serde_json::to_vec_pretty(&config).unwrap()
+    }
+
+    /// Reads `bytes` as `name` for every configuration type the commands read, checks or
+    /// builds what was read as the commands do, and returns whether the run configuration was
+    /// read and built a filter. Every reading error must name the file.
+    fn read_all(dir: &Path, name: &str, bytes: &[u8]) -> bool {
+        let path: PathBuf = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let named = |e: &dyn std::fmt::Display| {
+            let msg = e.to_string();
+            assert!(msg.contains(&path.display().to_string()), "{msg}");
+        };
+        let run = read_config::<RunConfig>(&path);
+        let accepted = match &run {
+            // The detections command builds the filter right away.
+            Ok(config) => config.build().is_ok(),
+            Err(e) => {
+                named(e);
+                false
+            }
+        };
+        match read_config::<StreetConfig>(&path) {
+            Ok(config) => drop(config.validate()),
+            Err(e) => named(&e),
+        }
+        if let Err(e) = read_config::<TrackingConfig>(&path) {
+            named(&e);
+        }
+        accepted
+    }
+
+    fn mutate(valid: &[u8], edits: &[(Index, u8, u8)]) -> Vec<u8> {
+        let mut v = valid.to_vec();
+        for (at, byte, kind) in edits {
+            if v.is_empty() {
+                v.push(*byte);
+                continue;
+            }
+            let i = at.index(v.len());
+            match kind % 3 {
+                0 => v[i] = *byte,
+                1 => v.insert(i, *byte),
+                _ => {
+                    v.remove(i);
+                }
+            }
+        }
+        v
+    }
+
+    fn hostile(valid: Vec<u8>) -> impl Strategy<Value = Vec<u8>> {
+        let edits = proptest::collection::vec((any::<Index>(), any::<u8>(), any::<u8>()), 1..8);
+        prop_oneof![
+            proptest::collection::vec(any::<u8>(), 0..1024),
+            edits.prop_map(move |e| mutate(&valid, &e)),
+        ]
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(128))]
+
+        #[test]
+        fn toml_hostile_bytes(bytes in hostile(example())) {
+            let dir = tempfile::tempdir().unwrap();
+            read_all(dir.path(), "c.toml", &bytes);
+        }
+
+        #[test]
+        fn json_hostile_bytes(bytes in hostile(example_json())) {
+            let dir = tempfile::tempdir().unwrap();
+            read_all(dir.path(), "c.json", &bytes);
+        }
+    }
+
+    #[test]
+    fn every_truncation_returns_and_the_whole_file_is_accepted() {
+        let dir = tempfile::tempdir().unwrap();
+        for (name, valid) in [("c.toml", example()), ("c.json", example_json())] {
+            for n in 0..valid.len() {
+                read_all(dir.path(), name, &valid[..n]);
+            }
+            assert!(read_all(dir.path(), name, &valid), "{name}");
+        }
+    }
+
+    #[test]
+    fn deep_nesting_and_huge_numbers_are_errors() {
+        let dir = tempfile::tempdir().unwrap();
+        let deep = 100_000;
+        for text in [
+            format!("seed = {}{}", "[".repeat(deep), "]".repeat(deep)),
+            format!("seed = {}1{}", "{a=".repeat(deep), "}".repeat(deep)),
+            format!("{}seed = 1", "[a.".repeat(deep)),
+            format!("[{}]", "a.".repeat(deep) + "b"),
+        ] {
+            assert!(!read_all(dir.path(), "deep.toml", text.as_bytes()));
+        }
+        let json = format!("{{\"seed\": {}{}}}", "[".repeat(deep), "]".repeat(deep));
+        assert!(!read_all(dir.path(), "deep.json", json.as_bytes()));
+        let text = String::from_utf8(example()).unwrap();
+        for (from, to) in [
+            (
+                "particles = 500\n\n[transition]",
+                "particles = 1000000000000\n\n[transition]",
+            ),
+            (
+                "particles = 500\nposition_std",
+                "particles = 1000000000000\nposition_std",
+            ),
+            (
+                "particles = 500\n\n[transition]",
+                "particles = 18446744073709551616\n\n[transition]",
+            ),
+            ("dims = 2", "dims = 1000000000000"),
+            ("seed = 7", "seed = 1e400"),
+        ] {
+            assert!(text.contains(from), "{from}");
+            let bad = text.replacen(from, to, 1);
+            assert!(!read_all(dir.path(), "huge.toml", bad.as_bytes()), "{to}");
+        }
+    }
+}

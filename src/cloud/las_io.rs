@@ -33,11 +33,13 @@ pub const LAS_SCALE: f64 = 0.001;
 /// enabled): such a file is an error naming it.
 ///
 /// Errors: the file cannot be opened ([`Error::Io`]); its header is not LAS, or it holds
-/// fewer point records than its header announces, e.g. a truncated file ([`Error::Parse`]
-/// naming the file).
+/// fewer point records than its header announces, e.g. a truncated file, or a record length
+/// field reaches past the end of the file ([`Error::Parse`] naming the file). Such sizes are
+/// checked before anything is allocated for them.
 pub fn read_las(path: impl AsRef<Path>) -> Result<PointCloud> {
     let path = path.as_ref();
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    check_sizes(path, &bytes)?;
     let mut reader = Reader::new(Cursor::new(bytes))
         .map_err(|e| Error::parse(path, 0, "header", e.to_string()))?;
     let expected = reader.header().number_of_points();
@@ -60,6 +62,73 @@ pub fn read_las(path: impl AsRef<Path>) -> Result<PointCloud> {
         cloud.push(x as f32, y as f32, z as f32, f32::from(i) / 65535.0);
     }
     Ok(cloud)
+}
+
+/// Bytes of an extended VLR's header; its `u64` record length starts at byte 20.
+const EVLR_HEADER_LEN: u64 = 60;
+
+/// Checks the sizes in the header of `bytes` against the file: the `las` crate reserves
+/// memory for the announced points and for the first extended VLR before it reads them, so a
+/// header announcing 10^12 points (or a count × record length that overflows) must be refused
+/// here.
+fn check_sizes(path: &Path, bytes: &[u8]) -> Result<()> {
+    let raw = las::raw::Header::read_from(bytes)
+        .map_err(|e| Error::parse(path, 0, "header", e.to_string()))?;
+    let len = bytes.len() as u64;
+    // The count the crate uses: the legacy 32-bit field unless it is zero (LAS 1.4 R15).
+    let legacy = u64::from(raw.number_of_point_records);
+    let count = match raw.large_file {
+        Some(large) if legacy == 0 => large.number_of_point_records,
+        _ => legacy,
+    };
+    let record_len = u64::from(raw.point_data_record_length);
+    let end = count
+        .checked_mul(record_len)
+        .and_then(|n| n.checked_add(u64::from(raw.offset_to_point_data)));
+    // Compressed (LAZ) points are smaller than their records; the crate refuses them later.
+    let compressed = raw.point_data_record_format & 0xC0 != 0;
+    if end.is_none_or(|end| end > len && !compressed) {
+        return Err(Error::parse(
+            path,
+            0,
+            "points",
+            format!(
+                "header announces {count} points of {record_len} bytes from byte {}, beyond \
+                 the file's {len} bytes",
+                raw.offset_to_point_data
+            ),
+        ));
+    }
+    if let Some(evlr) = raw.evlr {
+        if evlr.start_of_first_evlr > 0 && evlr.number_of_evlrs > 0 {
+            let start = evlr.start_of_first_evlr;
+            let header_end = start.checked_add(EVLR_HEADER_LEN).filter(|&e| e <= len);
+            let Some(header_end) = header_end else {
+                return Err(Error::parse(
+                    path,
+                    0,
+                    "extended VLR",
+                    format!("starts at byte {start}, beyond the file's {len} bytes"),
+                ));
+            };
+            let at = (start + 20) as usize;
+            let mut field = [0u8; 8];
+            field.copy_from_slice(&bytes[at..at + 8]);
+            let record = u64::from_le_bytes(field);
+            if record > len - header_end {
+                return Err(Error::parse(
+                    path,
+                    0,
+                    "extended VLR",
+                    format!(
+                        "record of {record} bytes at byte {header_end}, beyond the file's \
+                         {len} bytes"
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Writes `cloud` as LAS 1.2, point format 0 (no colour), atomically.
@@ -219,6 +288,22 @@ mod tests {
         std::fs::write(&path, b"not a las file at all").unwrap();
         let err = read_las(&path).unwrap_err().to_string();
         assert!(err.contains("t.las"), "{err}");
+    }
+
+    #[test]
+    fn a_point_count_beyond_the_file_is_refused_before_allocating() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("n.las");
+        write_las(&path, &sample()).unwrap();
+        let mut bytes = std::fs::read(&path).unwrap();
+        // The legacy point count, a u32 at byte 107: 4e9 records of 20 bytes.
+        bytes[107..111].copy_from_slice(&u32::MAX.to_le_bytes());
+        std::fs::write(&path, &bytes).unwrap();
+        let err = read_las(&path).unwrap_err().to_string();
+        assert!(
+            err.contains("n.las") && err.contains("announces 4294967295 points"),
+            "{err}"
+        );
     }
 
     #[test]

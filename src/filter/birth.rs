@@ -9,7 +9,7 @@
 
 use super::{Measurements, ParticleSet};
 use crate::error::{ensure_finite, Error, Result};
-use crate::filter::StepContext;
+use crate::filter::{StepContext, MAX_PARTICLES};
 use crate::rng::FilterRng;
 
 /// A proposed new track, before it gets its label.
@@ -69,6 +69,21 @@ pub struct BirthTerm {
     pub std: Vec<f64>,
 }
 
+/// Checks a birth track's particle count: 1 to [`MAX_PARTICLES`], like the filter's own (a
+/// larger count would fail its allocation at the first birth, in the middle of a run).
+fn check_particles(particles: usize) -> Result<()> {
+    if particles == 0 {
+        return Err(Error::invalid("birth particle count", "must be positive"));
+    }
+    if particles > MAX_PARTICLES {
+        return Err(Error::invalid(
+            "birth particle count",
+            format!("{particles} is above the limit of {MAX_PARTICLES}"),
+        ));
+    }
+    Ok(())
+}
+
 /// A fixed list of Gaussian birth terms, proposed at every step.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StaticBirth {
@@ -99,9 +114,7 @@ impl StaticBirth {
                 return Err(Error::invalid(what, "negative standard deviation"));
             }
         }
-        if particles == 0 {
-            return Err(Error::invalid("birth particle count", "must be positive"));
-        }
+        check_particles(particles)?;
         Ok(StaticBirth { terms, particles })
     }
 
@@ -203,9 +216,7 @@ impl AdaptiveBirth {
                 format!("{max_existence} outside (0, 1]"),
             ));
         }
-        if particles == 0 {
-            return Err(Error::invalid("birth particle count", "must be positive"));
-        }
+        check_particles(particles)?;
         Ok(AdaptiveBirth {
             sampler: Box::new(sampler),
             expected_births,
@@ -333,5 +344,24 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("birth term 0"));
+    }
+
+    #[test]
+    fn particle_counts_above_the_filters_limit_are_refused() {
+        let term = BirthTerm {
+            existence: 0.1,
+            mean: vec![0.0],
+            std: vec![1.0],
+        };
+        assert!(StaticBirth::new(vec![term.clone()], MAX_PARTICLES).is_ok());
+        let msg = StaticBirth::new(vec![term], MAX_PARTICLES + 1)
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("above the limit"), "{msg}");
+        let sampler = PositionBirthSampler {
+            position_std: 0.5,
+            velocity_std: 1.0,
+        };
+        assert!(AdaptiveBirth::new(sampler, 1.0, 0.5, 1_000_000_000_000).is_err());
     }
 }

@@ -38,7 +38,8 @@ use crate::error::{Error, Result};
 use crate::geometry::Pose2;
 use ::rosbag::{ChunkRecord, IndexRecord, MessageRecord, RosBag};
 use std::collections::HashMap;
-use std::io::Read;
+use std::fs::File;
+use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
 
 const LASER_SCAN: &str = "sensor_msgs/LaserScan";
@@ -375,7 +376,115 @@ fn open_bag(path: &Path) -> Result<RosBag> {
              is truncated or damaged"
         )));
     }
+    check_chunk_sizes(path, &mut file, start, index_pos)?;
     RosBag::new(path).map_err(|e| Error::io(path, e))
+}
+
+/// The fields (`name=value`, each after its `u32` length) of a record header, up to the first
+/// one that runs past the header.
+fn header_fields(header: &[u8]) -> impl Iterator<Item = &[u8]> {
+    let mut rest = header;
+    std::iter::from_fn(move || {
+        if rest.len() < 4 {
+            return None;
+        }
+        let n = u32::from_le_bytes([rest[0], rest[1], rest[2], rest[3]]) as usize;
+        if n > rest.len() - 4 {
+            return None;
+        }
+        let (field, tail) = rest[4..].split_at(n);
+        rest = tail;
+        Some(field)
+    })
+}
+
+/// Compressed chunks declaring at most this many uncompressed bytes are left to the `rosbag`
+/// crate as they are (ROS closes a chunk at about 768 KiB).
+const CHUNK_SIZE_TRUSTED: u64 = 64 << 20;
+
+/// How far lz4 can expand its input at most (a match length grows by 255 per extra byte).
+const LZ4_MAX_RATIO: u64 = 256;
+
+/// Walks the records of the chunk section (`start..end`) and refuses a compressed chunk that
+/// declares more than [`CHUNK_SIZE_TRUSTED`] uncompressed bytes unless its data can hold them:
+/// the `rosbag` crate reserves the declared size before decompressing, so a chunk of a few
+/// bytes declaring 4 GiB would reserve 4 GiB. bzip2 data is decoded (without keeping the
+/// output) and must give exactly the declared size; lz4 data must be large enough to expand to
+/// it. The walk stops at the first record that does not fit the section, where the crate
+/// stops with its own error.
+fn check_chunk_sizes(path: &Path, file: &mut File, start: u64, end: u64) -> Result<()> {
+    let io = |e| Error::io(path, e);
+    let mut pos = start;
+    let mut chunk = 0;
+    while end - pos >= 8 {
+        file.seek(SeekFrom::Start(pos)).map_err(io)?;
+        let mut len = [0u8; 4];
+        file.read_exact(&mut len).map_err(io)?;
+        let header_len = u64::from(u32::from_le_bytes(len));
+        if header_len > end - pos - 8 {
+            break;
+        }
+        let mut header = vec![0u8; header_len as usize];
+        file.read_exact(&mut header).map_err(io)?;
+        file.read_exact(&mut len).map_err(io)?;
+        let data_len = u64::from(u32::from_le_bytes(len));
+        if data_len > end - pos - 8 - header_len {
+            break;
+        }
+        pos += 8 + header_len + data_len;
+        let (mut op, mut compression, mut size) = (None, None, None);
+        for field in header_fields(&header) {
+            let Some(eq) = field.iter().position(|&b| b == b'=') else {
+                continue;
+            };
+            match (&field[..eq], &field[eq + 1..]) {
+                (b"op", &[v]) => op = Some(v),
+                (b"compression", v) => compression = Some(v),
+                (b"size", &[a, b, c, d]) => {
+                    size = Some(u64::from(u32::from_le_bytes([a, b, c, d])))
+                }
+                _ => {}
+            }
+        }
+        if op != Some(0x05) {
+            continue;
+        }
+        chunk += 1;
+        let (Some(compression), Some(size)) = (compression, size) else {
+            continue;
+        };
+        if size <= CHUNK_SIZE_TRUSTED {
+            continue;
+        }
+        let bad = |holds: String| {
+            Error::parse(
+                path,
+                0,
+                format!("chunk {chunk}"),
+                format!(
+                    "declares {size} bytes uncompressed, but its {data_len} bytes of {} data \
+                     {holds}",
+                    String::from_utf8_lossy(compression)
+                ),
+            )
+        };
+        match compression {
+            b"bz2" => {
+                let data = file.by_ref().take(data_len);
+                let mut decoder = bzip2::read::BzDecoder::new(data).take(size + 1);
+                match std::io::copy(&mut decoder, &mut std::io::sink()) {
+                    Ok(n) if n == size => {}
+                    Ok(n) => return Err(bad(format!("hold {n}"))),
+                    Err(e) => return Err(bad(format!("do not decompress ({e})"))),
+                }
+            }
+            b"lz4" if size > data_len.saturating_mul(LZ4_MAX_RATIO) => {
+                return Err(bad("cannot hold that many".into()));
+            }
+            _ => {}
+        }
+    }
+    Ok(())
 }
 
 /// Every connection of the index section as (id, topic, type).
