@@ -237,6 +237,7 @@ impl RunConfig {
             TransitionConfig::ConstantVelocity { dims, .. } => (2 * dims, dims),
             TransitionConfig::CoordinatedTurn { .. } => (5, 2),
         };
+        self.association.validate()?;
         let builder = LmbFilter::builder()
             .survival(ConstantSurvival::new(self.survival)?)
             .config(self.filter.clone())

@@ -68,6 +68,49 @@ impl Default for AssociationMethod {
     }
 }
 
+/// Largest Murty k (hypotheses kept) a configuration may ask for: each ranked hypothesis
+/// costs an assignment problem, so 10⁵ already means minutes per step on a large group.
+pub const MAX_MURTY_K: usize = 100_000;
+/// Largest number of Gibbs sweeps a configuration may ask for (10⁷).
+pub const MAX_GIBBS_SAMPLES: usize = 10_000_000;
+/// Largest LBP iteration cap a configuration may ask for (10⁶).
+pub const MAX_LBP_ITERATIONS: usize = 1_000_000;
+
+impl AssociationMethod {
+    /// Checks the method's settings: Murty k in 1..=[`MAX_MURTY_K`], Gibbs sweeps in
+    /// 1..=[`MAX_GIBBS_SAMPLES`], LBP iterations in 1..=[`MAX_LBP_ITERATIONS`] with a finite,
+    /// non-negative tolerance. Errors name the field.
+    pub fn validate(&self) -> crate::Result<()> {
+        let bounded = |field: &str, v: usize, max: usize| -> crate::Result<()> {
+            if v == 0 || v > max {
+                return Err(crate::Error::invalid(
+                    format!("association {field}"),
+                    format!("{v} outside 1..={max}"),
+                ));
+            }
+            Ok(())
+        };
+        match *self {
+            AssociationMethod::Murty { k } => bounded("k", k, MAX_MURTY_K),
+            AssociationMethod::Gibbs { samples } => bounded("samples", samples, MAX_GIBBS_SAMPLES),
+            AssociationMethod::Lbp {
+                max_iterations,
+                tolerance,
+            } => {
+                bounded("max_iterations", max_iterations, MAX_LBP_ITERATIONS)?;
+                if !(tolerance >= 0.0 && tolerance.is_finite()) {
+                    return Err(crate::Error::invalid(
+                        "association tolerance",
+                        format!("{tolerance} (must be finite and non-negative)"),
+                    ));
+                }
+                Ok(())
+            }
+            AssociationMethod::Exhaustive => Ok(()),
+        }
+    }
+}
+
 impl Associator for AssociationMethod {
     fn marginals(&self, problem: &AssociationProblem, rng: &mut FilterRng) -> Marginals {
         match *self {
@@ -110,7 +153,7 @@ impl FromStr for AssociationMethod {
                 }),
             }
         };
-        match name {
+        let method = match name {
             "murty" => Ok(AssociationMethod::Murty {
                 k: number(arg, MurtyAssociator::default().k)?,
             }),
@@ -129,13 +172,40 @@ impl FromStr for AssociationMethod {
                 "association method",
                 format!("`{s}` (expected murty, gibbs, lbp or exhaustive, optionally `:N`)"),
             )),
-        }
+        }?;
+        method.validate()?;
+        Ok(method)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn settings_beyond_their_bounds_are_refused() {
+        for bad in [
+            "murty:0",
+            "murty:100001",
+            "gibbs:0",
+            "gibbs:10000001",
+            "lbp:0",
+        ] {
+            let err = bad.parse::<AssociationMethod>().unwrap_err().to_string();
+            assert!(err.contains("outside 1..="), "{bad}: {err}");
+        }
+        assert!("murty:100000".parse::<AssociationMethod>().is_ok());
+        let lbp = AssociationMethod::Lbp {
+            max_iterations: 10,
+            tolerance: f64::NAN,
+        };
+        assert!(lbp
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("tolerance"));
+        assert!(AssociationMethod::Exhaustive.validate().is_ok());
+    }
 
     #[test]
     fn parse_names_and_defaults() {

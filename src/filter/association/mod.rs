@@ -47,6 +47,6 @@ pub(crate) mod testutil;
 pub use exhaustive::ExhaustiveAssociator;
 pub use gibbs::{distinct_hypotheses, GibbsAssociator};
 pub use lbp::LbpAssociator;
-pub use method::AssociationMethod;
+pub use method::{AssociationMethod, MAX_GIBBS_SAMPLES, MAX_LBP_ITERATIONS, MAX_MURTY_K};
 pub use murty::{ranked_hypotheses, MurtyAssociator};
 pub use problem::{AssociationProblem, Associator, Hypothesis, Marginals};
