@@ -379,6 +379,25 @@ mod tests {
     use proptest::prelude::*;
 
     #[test]
+    fn reweight_with_no_usable_total_leaves_the_weights() {
+        let mut rng = seeded(2);
+        let mut p = ParticleSet::gaussian(&[0.0], &[1.0], 4, &mut rng);
+        p.reweight(&[1.0, 2.0, 3.0, 4.0]);
+        let before = p.weights().to_vec();
+        assert_eq!(p.reweight(&[0.0; 4]), 0.0);
+        assert_eq!(p.weights(), &before[..]);
+        assert!(p.reweight(&[1.0, f64::NAN, 1.0, 1.0]).is_nan());
+        assert_eq!(p.weights(), &before[..]);
+        assert_eq!(p.reweight(&[1.0, f64::INFINITY, 1.0, 1.0]), f64::INFINITY);
+        assert_eq!(p.weights(), &before[..]);
+        // A usable total renormalises: weights ∝ w·f.
+        let total = p.reweight(&[0.0, 0.0, 1.0, 1.0]);
+        assert!((total - (before[2] + before[3])).abs() < 1e-15);
+        assert!((p.weights()[2] - before[2] / total).abs() < 1e-15);
+        assert_eq!(p.weights()[0], 0.0);
+    }
+
+    #[test]
     fn reweight_survives_total_underflow() {
         let mut rng = seeded(1);
         let mut p = ParticleSet::gaussian(&[0.0, 0.0], &[1.0, 1.0], 100, &mut rng);

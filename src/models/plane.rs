@@ -471,6 +471,18 @@ mod tests {
         [n.x, n.y, n.z, d]
     }
 
+    #[test]
+    fn zero_normal_comes_out_non_finite() {
+        let m = Isometry3::from_parts(
+            Translation3::new(1.0, 2.0, 0.0),
+            UnitQuaternion::from_euler_angles(0.0, 0.0, 0.3),
+        );
+        let moved = transform_plane(&[0.0, 0.0, 0.0, 5.0], &m);
+        assert!(moved.iter().all(|v| !v.is_finite()), "{moved:?}");
+        let fine = transform_plane(&[1.0, 0.0, 0.0, 5.0], &m);
+        assert!(fine.iter().all(|v| v.is_finite()), "{fine:?}");
+    }
+
     proptest! {
         #[test]
         fn moved_point_lies_on_moved_plane(
