@@ -100,8 +100,14 @@ impl ObjectType {
         }
     }
 
-    /// The type named `name` exactly as in label files; `None` for anything else.
+    /// The type named `name` exactly as in label files; `None` for anything else. The
+    /// tracking benchmark's label files write a sitting person as `Person` (the object
+    /// benchmark as `Person_sitting`; TrackEval reads `Person`), so both names give
+    /// [`ObjectType::PersonSitting`], which is written back as `Person_sitting`.
     pub fn from_name(name: &str) -> Option<ObjectType> {
+        if name == "Person" {
+            return Some(ObjectType::PersonSitting);
+        }
         ObjectType::ALL.into_iter().find(|t| t.name() == name)
     }
 }
@@ -385,6 +391,15 @@ mod tests {
             assert_eq!(ObjectType::from_name(t.name()), Some(t));
         }
         assert_eq!(ObjectType::PersonSitting.to_string(), "Person_sitting");
+    }
+
+    #[test]
+    fn tracking_labels_name_sitting_people_person() {
+        let line = PEDESTRIAN.replacen("Pedestrian", "Person", 1);
+        assert_ne!(line, PEDESTRIAN);
+        let l = TrackingLabel::parse_line(&line, Path::new("a.txt"), 1).unwrap();
+        assert_eq!(l.object_type, ObjectType::PersonSitting);
+        assert_eq!(ObjectType::from_name("person"), None);
     }
 
     #[test]
