@@ -37,6 +37,19 @@ const MATCH_ANGLE: f64 = 0.15;
 const MATCH_OFFSET: f64 = 1.0;
 /// Largest sensor-frame distance between a cluster track and its matched detection (m).
 const MATCH_DISTANCE: f64 = 1.5;
+/// Gap (m) between a wall track's remembered rectangle and a matched segment along their
+/// plane that costs as much as `MATCH_OFFSET` of offset, and beyond which the segment is
+/// another stretch of the same plane (a collinear facade) and does not replace the rectangle.
+const MATCH_GAP: f64 = 2.0;
+
+/// The gap between two rectangles in (nearly) one plane, along their longer sides: the
+/// distance between their centres less half the sum of their lengths, 0 when they overlap.
+fn rectangle_gap(a: &[Point3<f64>; 4], b: &[Point3<f64>; 4]) -> f64 {
+    let centre =
+        |r: &[Point3<f64>; 4]| Point3::from(r.iter().map(|p| p.coords).sum::<Vector3<f64>>() / 4.0);
+    let length = |r: &[Point3<f64>; 4]| (r[1] - r[0]).norm().max((r[3] - r[0]).norm());
+    ((centre(a) - centre(b)).norm() - 0.5 * (length(a) + length(b))).max(0.0)
+}
 
 /// The tracker of one drive: the filter, its random state and what the report remembers.
 pub struct DriveTracker {
@@ -212,10 +225,18 @@ impl DriveTracker {
         // Greedy matching, cheapest pair first.
         let mut plane_pairs: Vec<(f64, usize, usize)> = Vec::new();
         for (i, (_, beta)) in planes.iter().enumerate() {
+            // The remembered rectangle in the sensor frame: of several segments of one plane,
+            // the one on the same stretch of facade is preferred.
+            let remembered = self
+                .wall_corners
+                .get(&planes[i].0.label)
+                .map(|world| world.map(|v| inv * v));
             for (j, w) in det.walls.iter().enumerate() {
                 let (angle, dd) = plane_residual(beta, &w.patch.plane.as_vector());
                 if angle <= MATCH_ANGLE && dd.abs() <= MATCH_OFFSET {
-                    plane_pairs.push((angle / MATCH_ANGLE + dd.abs() / MATCH_OFFSET, i, j));
+                    let gap = remembered.map_or(0.0, |r| rectangle_gap(&r, &w.patch.vertices));
+                    let cost = angle / MATCH_ANGLE + dd.abs() / MATCH_OFFSET + gap / MATCH_GAP;
+                    plane_pairs.push((cost, i, j));
                 }
             }
         }
@@ -237,7 +258,13 @@ impl DriveTracker {
             let plane = Plane::new(Vector3::new(beta[0], beta[1], beta[2]), beta[3]).ok();
             if let (Some(j), Some(_)) = (m, &plane) {
                 let corners = det.walls[j].patch.vertices.map(|v| pose * v);
-                self.wall_corners.insert(e.label, corners);
+                let same_stretch = self
+                    .wall_corners
+                    .get(&e.label)
+                    .is_none_or(|old| rectangle_gap(old, &corners) <= MATCH_GAP);
+                if same_stretch {
+                    self.wall_corners.insert(e.label, corners);
+                }
             }
             let sensor = match (&plane, self.wall_corners.get(&e.label)) {
                 (Some(pl), Some(world)) => Some(world.map(|v| pl.project(&(inv * v)))),
@@ -362,5 +389,22 @@ mod tests {
     fn greedy_takes_cheapest_pairs_first() {
         let m = greedy(vec![(1.0, 0, 0), (0.5, 1, 0), (2.0, 0, 1)], 3, 2);
         assert_eq!(m, vec![Some(1), Some(0), None]);
+    }
+
+    #[test]
+    fn gap_between_stretches_of_one_facade() {
+        // Upright 10 m × 4 m rectangles in the plane y = 5, starting at x0.
+        let rect = |x0: f64, len: f64| {
+            [
+                Point3::new(x0, 5.0, 0.0),
+                Point3::new(x0 + len, 5.0, 0.0),
+                Point3::new(x0 + len, 5.0, 4.0),
+                Point3::new(x0, 5.0, 4.0),
+            ]
+        };
+        assert_eq!(rectangle_gap(&rect(0.0, 10.0), &rect(4.0, 10.0)), 0.0);
+        assert_eq!(rectangle_gap(&rect(0.0, 10.0), &rect(2.0, 4.0)), 0.0);
+        assert!((rectangle_gap(&rect(0.0, 10.0), &rect(25.0, 10.0)) - 15.0).abs() < 1e-12);
+        assert!((rectangle_gap(&rect(0.0, 10.0), &rect(-13.0, 10.0)) - 3.0).abs() < 1e-12);
     }
 }
