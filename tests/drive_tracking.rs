@@ -71,11 +71,6 @@ fn config() -> TrackingConfig {
     c
 }
 
-fn run(dir: &Path, seed: u64) -> DriveTracks {
-    let drive = RawDrive::open(dir).unwrap();
-    track_drive(&drive, None, &config(), seed, |_| Ok(())).unwrap()
-}
-
 #[test]
 fn synthetic_street_walls_keep_labels_and_the_box_is_tracked() {
     let tmp = tempfile::tempdir().unwrap();
