@@ -738,6 +738,12 @@ fuzz_reader!(
     read_bag_all
 );
 fuzz_reader!(
+    real_bag_excerpt_hostile_bytes,
+    "positive_1_excerpt.bag",
+    vendored(REAL_BAG),
+    read_bag_all
+);
+fuzz_reader!(
     bag_bz2_hostile_bytes,
     "s.bag",
     bag::valid(2, true),
@@ -902,6 +908,19 @@ fn bag_truncations() {
         let valid = bag::valid(3, bzip2);
         for (n, r) in truncations("bag", "s.bag", &valid, 3, read_bag_all) {
             assert_eq!(r.is_ok(), n == valid.len(), "cut at {n}: {r:?}");
+        }
+    }
+}
+
+/// The vendored excerpt of a real recording (three topics, three uncompressed chunks).
+const REAL_BAG: &str = "tests/data/laser2d/positive_1_excerpt.bag";
+
+#[test]
+fn real_bag_excerpt_truncations() {
+    let valid = vendored(REAL_BAG);
+    for (n, r) in truncations("real bag", "r.bag", &valid, 39, read_bag_all) {
+        if let Ok(scans) = r {
+            assert!(scans <= 39, "cut at {n}: {scans} scans");
         }
     }
 }
