@@ -25,6 +25,9 @@ pub use cluster::{euclidean_clusters, euclidean_clusters_of, Cluster, ClusterPar
 pub use kitti_bin::{read_kitti_bin, read_kitti_bin_with, write_kitti_bin, BinScan, NonFinite};
 pub use las_io::{read_las, write_las, write_las_labelled};
 pub use palette::label_colour;
-pub use pcd_io::{read_pcd, read_pcd_with, write_pcd, write_pcd_labelled, PcdEncoding, PcdScan};
+pub use pcd_io::{
+    decode_pcd, encode_pcd, read_pcd, read_pcd_with, write_pcd, write_pcd_labelled, PcdEncoding,
+    PcdScan,
+};
 pub use ply_io::{read_ply, write_ply, write_ply_labelled};
 pub use points::{Bounds, Point, PointCloud};

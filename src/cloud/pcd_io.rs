@@ -138,7 +138,6 @@ pub fn write_pcd_labelled(
     labels: &[u32],
     encoding: PcdEncoding,
 ) -> Result<()> {
-    super::palette::check_label_count(labels, cloud.len())?;
     write(path.as_ref(), cloud, Some(labels), encoding)
 }
 
@@ -915,6 +914,23 @@ fn write(
     labels: Option<&[u32]>,
     encoding: PcdEncoding,
 ) -> Result<()> {
+    let bytes = encode_pcd(cloud, labels, encoding)?;
+    write_atomically(path, |w| w.write_all(&bytes))
+}
+
+/// Encodes a cloud as the bytes of a PCD 0.7 file (what [`write_pcd`] and
+/// [`write_pcd_labelled`] write), with a `label` field when `labels` is given.
+///
+/// Errors: a label count different from the point count, or (binary_compressed) a cloud of
+/// more than 4 GiB of data ([`Error::InvalidInput`]).
+pub fn encode_pcd(
+    cloud: &PointCloud,
+    labels: Option<&[u32]>,
+    encoding: PcdEncoding,
+) -> Result<Vec<u8>> {
+    if let Some(labels) = labels {
+        super::palette::check_label_count(labels, cloud.len())?;
+    }
     let n = cloud.len();
     let (fields, sizes, types, counts) = if labels.is_some() {
         (
@@ -991,15 +1007,15 @@ fn write(
             b
         }
     };
-    write_atomically(path, |w| {
-        w.write_all(header.as_bytes())?;
-        w.write_all(&body)
-    })
+    let mut bytes = header.into_bytes();
+    bytes.extend_from_slice(&body);
+    Ok(bytes)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
 
     fn sample() -> PointCloud {
         let mut c = PointCloud::new();
@@ -1339,6 +1355,41 @@ mod tests {
             assert_eq!(scan.cloud.len(), 5);
             assert_eq!(scan.cloud.xs()[4], 8.0);
             assert_eq!(scan.labels, Some(vec![0, 1, 2, 3, 6]));
+        }
+    }
+
+    fn finite() -> impl Strategy<Value = f32> {
+        prop_oneof![
+            proptest::num::f32::NORMAL | proptest::num::f32::SUBNORMAL | proptest::num::f32::ZERO,
+            -100.0..100.0f32,
+        ]
+    }
+
+    proptest! {
+        #[test]
+        fn random_clouds_round_trip_exactly(
+            points in proptest::collection::vec((finite(), finite(), finite(), finite(), any::<u32>()), 0..80),
+            encoding in prop_oneof![
+                Just(PcdEncoding::Ascii),
+                Just(PcdEncoding::Binary),
+                Just(PcdEncoding::BinaryCompressed),
+            ],
+            labelled in any::<bool>(),
+        ) {
+            let mut cloud = PointCloud::new();
+            for p in &points {
+                cloud.push(p.0, p.1, p.2, p.3);
+            }
+            let labels: Vec<u32> = points.iter().map(|p| p.4).collect();
+            let bytes = encode_pcd(&cloud, labelled.then_some(&labels[..]), encoding).unwrap();
+            let scan = decode(&bytes).unwrap();
+            // Bit for bit, so that -0.0 and subnormals count too.
+            let bits = |c: &PointCloud| {
+                c.iter().map(|p| [p.x, p.y, p.z, p.intensity].map(f32::to_bits)).collect::<Vec<_>>()
+            };
+            prop_assert_eq!(bits(&scan.cloud), bits(&cloud));
+            prop_assert_eq!(scan.labels, labelled.then_some(labels));
+            prop_assert_eq!(scan.skipped, 0);
         }
     }
 
