@@ -10,9 +10,9 @@
 //! `F` (4 or 8 bytes), `U` and `I` (1, 2, 4 or 8 bytes).
 //!
 //! Fields `x`, `y`, `z` are required; `intensity` or `reflectance` (any case) becomes the
-//! cloud's intensity (float values as they are, `U` of 1 byte divided by 255 and of 2 bytes by
-//! 65535, as [`super::ply_io`] does; 0 when absent); an integer `label` is returned by
-//! [`read_pcd_with`]. Every other field (`rgb`, `normal_x`, padding `_`, fields with
+//! cloud's intensity (`U` of 1 byte divided by 255 and of 2 bytes by 65535, as
+//! [`super::ply_io`] does, every other type taken as it is; 0 when absent); a `label` field
+//! (whole numbers from 0 to 2^32 − 1, of any type) is returned by [`read_pcd_with`]. Every other field (`rgb`, `normal_x`, padding `_`, fields with
 //! `COUNT` > 1, ...) is skipped by its `SIZE × COUNT` bytes. `VIEWPOINT` is checked but not
 //! applied (as PCL does on load).
 //!
@@ -22,6 +22,8 @@
 //! them in [`PcdScan::skipped`].
 //!
 //! Every size in the header is checked against the file before anything is allocated for it.
+//! Bytes after the last point are ignored. [`decode_pcd`] and [`encode_pcd`] do the same on
+//! bytes in memory.
 //!
 //! Writing produces version 0.7 with `x y z intensity` as `F 4` (plus `label` as `U 4` for
 //! [`write_pcd_labelled`]), `WIDTH` = point count, `HEIGHT 1`, in the chosen [`PcdEncoding`]
@@ -205,6 +207,10 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
             .map_or(bytes.len(), |k| at + k);
         let raw = &bytes[at..end];
         at = (end + 1).min(bytes.len());
+        // Comments may hold any bytes.
+        if raw.trim_ascii_start().starts_with(b"#") {
+            continue;
+        }
         let line = std::str::from_utf8(raw)
             .map_err(|_| Error::parse(path, line_no, "header", "line is not text"))?
             .trim();
@@ -1134,6 +1140,10 @@ mod tests {
                     1 2 3\n";
         let scan = decode(text.as_bytes()).unwrap();
         assert_eq!(scan.cloud.intensities(), &[0.0]);
+        // A comment in Latin-1 and a CRLF header.
+        let mut bytes = b"# caf\xe9\r\n".to_vec();
+        bytes.extend_from_slice(text.replace('\n', "\r\n").as_bytes());
+        assert_eq!(decode(&bytes).unwrap().cloud.xs(), &[1.0]);
     }
 
     /// A binary_compressed file of `n` points with fields `x y z` (F 4) and the given stream.
