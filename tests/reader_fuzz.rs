@@ -10,14 +10,17 @@
 //! bytes failed" instead of letting one hostile header take the machine's memory.
 //!
 //! Readers: KITTI `.bin`, OXTS packet, calibration files (rigid, cam-to-cam, tracking),
-//! timestamps, odometry poses, tracklets XML, tracking labels (`label_02`), LAS, PLY, CARMEN
+//! timestamps, odometry poses, tracklets XML, tracking labels (`label_02`), LAS, PLY, PCD, CARMEN
 //! logs (plain and gzip), ROS bags (scans, topics, pose arrays), laser2d CSV, detections JSON
 //! and CSV. The TOML/JSON configuration reader lives in the command-line crate and is tested
 //! there (`kitti_tools/src/config_file.rs`).
 
 use proptest::prelude::*;
 use proptest::sample::Index;
-use smc_lmb::cloud::{read_kitti_bin, read_las, read_ply, write_las, write_ply, PointCloud};
+use smc_lmb::cloud::{
+    encode_pcd, read_kitti_bin, read_las, read_pcd_with, read_ply, write_las, write_ply,
+    NonFinite as CloudNonFinite, PcdEncoding, PointCloud,
+};
 use smc_lmb::detections::{read_frames, read_frames_with, NonFinite};
 use smc_lmb::kitti::odometry::read_odometry_poses;
 use smc_lmb::kitti::{
@@ -331,6 +334,11 @@ fn ply_file() -> Vec<u8> {
     std::fs::read(p).unwrap()
 }
 
+fn pcd_file(encoding: PcdEncoding) -> Vec<u8> {
+    let labels: Vec<u32> = (0..12).collect();
+    encode_pcd(&small_cloud(), Some(&labels), encoding).unwrap()
+}
+
 fn ply_ascii() -> Vec<u8> {
     b"ply\nformat ascii 1.0\ncomment two points and a face\nelement vertex 3\n\
 property float x\nproperty float y\nproperty float z\nproperty uchar intensity\n\
@@ -596,6 +604,11 @@ fn read_ply_points(p: &Path) -> smc_lmb::Result<usize> {
     read_ply(p).map(|c| c.len())
 }
 
+/// NaN points are left out (counted) so that more of the reader is reached.
+fn read_pcd_points(p: &Path) -> smc_lmb::Result<usize> {
+    read_pcd_with(p, CloudNonFinite::Skip).map(|s| s.cloud.len())
+}
+
 /// Strict about lines; time going backwards is kept (the vendored log has such records).
 fn read_carmen_strict(p: &Path) -> smc_lmb::Result<usize> {
     let options = CarmenOptions {
@@ -712,6 +725,24 @@ fuzz_reader!(
     "c.ply",
     ply_ascii(),
     read_ply_points
+);
+fuzz_reader!(
+    pcd_ascii_hostile_bytes,
+    "c.pcd",
+    pcd_file(PcdEncoding::Ascii),
+    read_pcd_points
+);
+fuzz_reader!(
+    pcd_binary_hostile_bytes,
+    "c.pcd",
+    pcd_file(PcdEncoding::Binary),
+    read_pcd_points
+);
+fuzz_reader!(
+    pcd_compressed_hostile_bytes,
+    "c.pcd",
+    pcd_file(PcdEncoding::BinaryCompressed),
+    read_pcd_points
 );
 fuzz_reader!(
     carmen_hostile_bytes,
@@ -860,6 +891,25 @@ fn ply_truncations() {
 }
 
 #[test]
+fn pcd_truncations() {
+    for encoding in [PcdEncoding::Binary, PcdEncoding::BinaryCompressed] {
+        let pcd = pcd_file(encoding);
+        for (n, r) in truncations("pcd", "c.pcd", &pcd, 12, read_pcd_points) {
+            assert_eq!(r.is_ok(), n == pcd.len(), "{encoding:?} cut at {n}: {r:?}");
+        }
+    }
+    // Ascii cut inside its last line may still read (a shorter last label); before it, never.
+    let pcd = pcd_file(PcdEncoding::Ascii);
+    let last_line = pcd[..pcd.len() - 1]
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .unwrap();
+    for (n, r) in truncations("ascii pcd", "c.pcd", &pcd, 12, read_pcd_points) {
+        assert!(r.is_err() || n > last_line + 1, "cut at {n}: {r:?}");
+    }
+}
+
+#[test]
 fn carmen_truncations() {
     let log = carmen_log();
     let vendored = data("tests/data/laser2d/intel_head.clf");
@@ -984,6 +1034,38 @@ fn las_point_count_beyond_the_file_is_refused_without_allocating_it() {
         read_las_points,
     );
     assert!(!msg.is_empty());
+}
+
+#[test]
+fn pcd_counts_beyond_the_file_are_refused_without_allocating_them() {
+    let binary = String::from_utf8_lossy(&pcd_file(PcdEncoding::Binary)).into_owned();
+    for n in ["214748364", "4000000000", "18446744073709551615"] {
+        let text = binary
+            .replace("WIDTH 12", &format!("WIDTH {n}"))
+            .replace("POINTS 12", &format!("POINTS {n}"));
+        let msg = expect_err("pcd huge count", "c.pcd", text.as_bytes(), read_pcd_points);
+        assert!(msg.contains("POINTS"), "{msg}");
+    }
+    // binary_compressed: a POINTS count matching an uncompressed size of almost 4 GiB, or a
+    // compressed size beyond the file.
+    let compressed = pcd_file(PcdEncoding::BinaryCompressed);
+    let data = find(&compressed, b"DATA binary_compressed\n").unwrap() + 23;
+    let header = String::from_utf8_lossy(&compressed[..data])
+        .replace("WIDTH 12", "WIDTH 214748364")
+        .replace("POINTS 12", "POINTS 214748364");
+    let mut bytes = header.into_bytes();
+    bytes.extend_from_slice(&compressed[data..]);
+    let at = bytes.len() - (compressed.len() - data) + 4;
+    let big = patched(&bytes, at, &(214_748_364u32 * 20).to_le_bytes());
+    let msg = expect_err("pcd huge unpacked", "c.pcd", &big, read_pcd_points);
+    assert!(msg.contains("cannot hold"), "{msg}");
+    let msg = expect_err(
+        "pcd huge packed",
+        "c.pcd",
+        &patched(&compressed, data, &u32::MAX.to_le_bytes()),
+        read_pcd_points,
+    );
+    assert!(msg.contains("truncated"), "{msg}");
 }
 
 /// A LAS 1.4 file of the small cloud (written with the `las` crate itself).

@@ -1,25 +1,48 @@
 //! `kitti-tools convert`: a point cloud from one file format to another (`.bin`, `.las`,
-//! `.ply`, chosen by extension).
+//! `.ply`, `.pcd`, chosen by extension).
 
 use anyhow::{bail, Result};
 use smc_lmb::cloud::{
-    read_kitti_bin_with, read_las, read_ply, write_kitti_bin, write_las, write_ply, NonFinite,
-    PointCloud,
+    read_kitti_bin_with, read_las, read_pcd_with, read_ply, write_kitti_bin, write_las, write_pcd,
+    write_ply, NonFinite, PcdEncoding, PointCloud,
 };
 use std::path::{Path, PathBuf};
 
 /// Flags of `convert`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The cloud to read (.bin KITTI Velodyne scan, .las or .ply).
+    /// The cloud to read (.bin KITTI Velodyne scan, .las, .ply or .pcd).
     #[arg(long)]
     input: PathBuf,
-    /// Where to write the cloud (.bin, .las or .ply); written atomically.
+    /// Where to write the cloud (.bin, .las, .ply or .pcd); written atomically.
     #[arg(long)]
     output: PathBuf,
+    /// The DATA encoding of a .pcd output.
+    #[arg(long, value_enum, default_value_t = PcdData::Binary)]
+    pcd_data: PcdData,
     /// Leave out points holding NaN or infinities instead of refusing the input.
     #[arg(long)]
     skip_invalid: bool,
+}
+
+/// The DATA encodings of a .pcd output.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum PcdData {
+    Ascii,
+    Binary,
+    /// LZF-compressed, column by column.
+    #[value(name = "binary_compressed", alias = "binary-compressed")]
+    BinaryCompressed,
+}
+
+impl From<PcdData> for PcdEncoding {
+    fn from(d: PcdData) -> Self {
+        match d {
+            PcdData::Ascii => PcdEncoding::Ascii,
+            PcdData::Binary => PcdEncoding::Binary,
+            PcdData::BinaryCompressed => PcdEncoding::BinaryCompressed,
+        }
+    }
 }
 
 /// The formats `convert` knows.
@@ -28,6 +51,7 @@ enum Format {
     Bin,
     Las,
     Ply,
+    Pcd,
 }
 
 fn format_of(path: &Path) -> Result<Format> {
@@ -40,8 +64,9 @@ fn format_of(path: &Path) -> Result<Format> {
         "bin" => Format::Bin,
         "las" => Format::Las,
         "ply" => Format::Ply,
+        "pcd" => Format::Pcd,
         other => bail!(
-            "{}: unknown point-cloud extension `{other}` (expected .bin, .las or .ply)",
+            "{}: unknown point-cloud extension `{other}` (expected .bin, .las, .ply or .pcd)",
             path.display()
         ),
     })
@@ -50,14 +75,18 @@ fn format_of(path: &Path) -> Result<Format> {
 /// Reads `path`, dropping (with `skip_invalid`) or refusing non-finite points; returns the
 /// cloud and how many points were dropped.
 fn read(path: &Path, skip_invalid: bool) -> Result<(PointCloud, usize)> {
+    let policy = if skip_invalid {
+        NonFinite::Skip
+    } else {
+        NonFinite::Error
+    };
     let mut cloud = match format_of(path)? {
         Format::Bin => {
-            let policy = if skip_invalid {
-                NonFinite::Skip
-            } else {
-                NonFinite::Error
-            };
             let scan = read_kitti_bin_with(path, policy)?;
+            return Ok((scan.cloud, scan.skipped));
+        }
+        Format::Pcd => {
+            let scan = read_pcd_with(path, policy)?;
             return Ok((scan.cloud, scan.skipped));
         }
         Format::Las => read_las(path)?,
@@ -88,6 +117,7 @@ pub fn run(args: Args) -> Result<()> {
         Format::Bin => write_kitti_bin(&args.output, &cloud)?,
         Format::Las => write_las(&args.output, &cloud)?,
         Format::Ply => write_ply(&args.output, &cloud)?,
+        Format::Pcd => write_pcd(&args.output, &cloud, args.pcd_data.into())?,
     }
     print!("{} points", cloud.len());
     if skipped > 0 {

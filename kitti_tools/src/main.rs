@@ -36,7 +36,7 @@ enum Command {
     /// Run the filter on your own per-frame detections (JSON or CSV) with a model config
     /// (TOML or JSON); write per-frame estimates and, given truth, print OSPA/GOSPA.
     Detections(detections_cmd::Args),
-    /// Convert a point cloud between KITTI .bin, .las and .ply (by extension).
+    /// Convert a point cloud between KITTI .bin, .las, .ply and .pcd (by extension).
     Convert(convert_cmd::Args),
     /// Describe a KITTI raw drive or tracking sequence: frame counts, time span, calibration,
     /// poses, labels, issues.

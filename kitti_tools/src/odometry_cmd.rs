@@ -1,5 +1,5 @@
 //! `kitti-tools odometry`: lidar odometry (KISS-ICP's recipe) over the scans of a raw drive,
-//! an odometry sequence or a folder of `.bin` files; writes KITTI pose lines and, given a
+//! an odometry sequence or a folder of `.bin` or `.pcd` files; writes KITTI pose lines and, given a
 //! reference trajectory, prints its relative pose errors.
 
 use anyhow::{bail, Context, Result};
@@ -27,7 +27,8 @@ pub struct Args {
     /// Odometry sequence number.
     #[arg(long)]
     sequence: Option<u32>,
-    /// A folder of `.bin` scans, taken in file-name order.
+    /// A folder of `.bin` scans or of `.pcd` clouds (their NaN points left out), taken in
+    /// file-name order.
     #[arg(long)]
     scans: Option<PathBuf>,
     /// Only the first N scans.
@@ -72,7 +73,7 @@ pub fn run(args: Args) -> Result<()> {
         input.scans.truncate(n);
     }
     if input.scans.is_empty() {
-        bail!("no .bin scans to register");
+        bail!("no scans to register");
     }
     let estimate = match &args.evaluate {
         Some(file) => read_odometry_poses(file)
@@ -127,7 +128,7 @@ fn input(args: &Args) -> Result<Input> {
             Ok(Input { scans, reference })
         }
         (None, None, Some(dir)) => Ok(Input {
-            scans: bin_files(dir)?,
+            scans: scan_files(dir)?,
             reference: None,
         }),
         (None, None, None) => {
@@ -136,20 +137,37 @@ fn input(args: &Args) -> Result<Input> {
     }
 }
 
-/// The `.bin` files of `dir` in file-name order; an error naming the folder when there is none.
-fn bin_files(dir: &Path) -> Result<Vec<PathBuf>> {
-    let mut files = Vec::new();
+/// The `.bin` or the `.pcd` files of `dir` in file-name order; an error naming the folder when
+/// there is none, or when it holds both kinds.
+fn scan_files(dir: &Path) -> Result<Vec<PathBuf>> {
+    let (mut bin, mut pcd) = (Vec::new(), Vec::new());
     for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
         let path = entry
             .with_context(|| format!("reading {}", dir.display()))?
             .path();
-        if path.extension().is_some_and(|e| e == "bin") && path.is_file() {
-            files.push(path);
+        if !path.is_file() {
+            continue;
+        }
+        if path.extension().is_some_and(|e| e == "bin") {
+            bin.push(path);
+        } else if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("pcd"))
+        {
+            pcd.push(path);
         }
     }
-    if files.is_empty() {
-        bail!("{}: no .bin scans in this folder", dir.display());
-    }
+    let mut files = match (bin.is_empty(), pcd.is_empty()) {
+        (true, true) => bail!("{}: no .bin or .pcd scans in this folder", dir.display()),
+        (false, false) => bail!(
+            "{}: holds both .bin ({}) and .pcd ({}) scans; keep one kind",
+            dir.display(),
+            bin.len(),
+            pcd.len()
+        ),
+        (false, true) => bin,
+        (true, false) => pcd,
+    };
     files.sort();
     Ok(files)
 }

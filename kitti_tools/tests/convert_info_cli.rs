@@ -1,7 +1,8 @@
 //! `kitti-tools convert` and `kitti-tools info` through the built binary, on the vendored KITTI
-//! data: format round trips, refused inputs and the drive summary.
+//! data: format round trips (`.bin`, `.las`, `.ply`, `.pcd`), refused inputs and the drive
+//! summary.
 
-use smc_lmb::cloud::{read_kitti_bin, read_ply, write_ply_labelled, PointCloud};
+use smc_lmb::cloud::{read_kitti_bin, read_pcd, read_ply, write_ply_labelled, PointCloud};
 use std::path::{Path, PathBuf};
 mod common;
 use common::{ok, output as run};
@@ -69,6 +70,75 @@ fn bin_ply_bin_round_trip_is_exact() {
 }
 
 #[test]
+fn bin_pcd_las_keeps_the_points_in_every_pcd_encoding() {
+    let dir = tempfile::tempdir().unwrap();
+    let original = read_kitti_bin(frame()).unwrap();
+    for data in ["ascii", "binary", "binary_compressed"] {
+        let pcd = dir.path().join(format!("f_{data}.pcd"));
+        let las = dir.path().join(format!("f_{data}.las"));
+        let back = dir.path().join(format!("back_{data}.bin"));
+        let stdout = ok(&run(&[
+            "convert",
+            "--input",
+            frame().to_str().unwrap(),
+            "--output",
+            pcd.to_str().unwrap(),
+            "--pcd-data",
+            data,
+        ]));
+        assert!(stdout.contains("14714"), "{stdout}");
+        let head = std::fs::read(&pcd).unwrap();
+        let marker = format!("DATA {data}\n");
+        assert!(
+            head.windows(marker.len()).any(|w| w == marker.as_bytes()),
+            "{data}"
+        );
+        // Every encoding keeps the f32 values exactly.
+        assert_eq!(read_pcd(&pcd).unwrap(), original, "{data}");
+        let stdout = ok(&convert(&pcd, &las));
+        assert!(stdout.contains("14714"), "{stdout}");
+        ok(&convert(&las, &back));
+        let round = read_kitti_bin(&back).unwrap();
+        assert_eq!(round.len(), original.len());
+        assert!(max_abs_diff(&original, &round) <= 1e-3, "{data}");
+        let reflectance = original
+            .intensities()
+            .iter()
+            .zip(round.intensities())
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f32::max);
+        assert!(reflectance <= 1e-4, "{data}: {reflectance}");
+    }
+}
+
+#[test]
+fn organised_pcd_with_nan_points_is_refused_unless_skipped() {
+    let dir = tempfile::tempdir().unwrap();
+    let pcd = dir.path().join("organised.pcd");
+    std::fs::write(
+        &pcd,
+        "VERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F U\nCOUNT 1 1 1 1\n\
+         WIDTH 2\nHEIGHT 2\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 4\nDATA ascii\n\
+         1 2 3 255\nnan nan nan 0\n4 5 6 0\nnan nan nan 0\n",
+    )
+    .unwrap();
+    let bin = dir.path().join("out.bin");
+    assert_fails_naming(&convert(&pcd, &bin), "organised.pcd", &bin);
+    let stdout = ok(&run(&[
+        "convert",
+        "--input",
+        pcd.to_str().unwrap(),
+        "--output",
+        bin.to_str().unwrap(),
+        "--skip-invalid",
+    ]));
+    assert!(stdout.contains("2 points (2 non-finite"), "{stdout}");
+    let cloud = read_kitti_bin(&bin).unwrap();
+    assert_eq!(cloud.xs(), &[1.0, 4.0]);
+    assert_eq!(cloud.intensities(), &[0.0, 0.0]);
+}
+
+#[test]
 fn labelled_ply_has_two_colours_for_two_labels() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("l.ply");
@@ -127,7 +197,13 @@ fn bad_inputs_are_errors_naming_the_file_and_write_nothing() {
     std::fs::write(&bin, [0u8; 17]).unwrap();
     assert_fails_naming(&convert(&bin, &out_ply), "short.bin", &out_ply);
 
-    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 3);
+    let pcd = dir.path().join("cut.pcd");
+    ok(&convert(&frame(), &pcd));
+    let bytes = std::fs::read(&pcd).unwrap();
+    std::fs::write(&pcd, &bytes[..bytes.len() / 2]).unwrap();
+    assert_fails_naming(&convert(&pcd, &out_bin), "cut.pcd", &out_bin);
+
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 4);
 }
 
 #[test]

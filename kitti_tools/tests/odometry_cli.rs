@@ -1,5 +1,5 @@
 //! `kitti-tools odometry` through the built binary: a folder of scans (the vendored real frame,
-//! twice), the odometry layout with its reference poses, and refused inputs.
+//! twice, as `.bin` or `.pcd`), the odometry layout with its reference poses, and refused inputs.
 
 mod common;
 use common::{ok, run};
@@ -105,7 +105,55 @@ fn an_empty_folder_is_refused_naming_it() {
     ]);
     assert!(!good);
     assert!(
-        stderr.contains("no .bin scans") && stderr.contains(dir.path().to_str().unwrap()),
+        stderr.contains("no .bin or .pcd scans") && stderr.contains(dir.path().to_str().unwrap()),
+        "{stderr}"
+    );
+}
+
+/// Runs the odometry on `scans` and returns the poses written.
+fn poses_of(scans: &Path, out: &Path) -> Vec<nalgebra::Isometry3<f64>> {
+    ok(&common::output(&[
+        "odometry",
+        "--scans",
+        scans.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]));
+    smc_lmb::kitti::odometry::read_odometry_poses(out).unwrap()
+}
+
+#[test]
+fn a_folder_of_pcd_clouds_gives_the_poses_of_the_same_bin_scans() {
+    use smc_lmb::cloud::{read_kitti_bin, write_pcd, PcdEncoding};
+    let dir = tempfile::tempdir().unwrap();
+    let bin_poses = poses_of(&standing_scans(dir.path()), &dir.path().join("bin.txt"));
+    let pcd = dir.path().join("pcd");
+    std::fs::create_dir_all(&pcd).unwrap();
+    let mut cloud = read_kitti_bin(frame()).unwrap();
+    write_pcd(pcd.join("a.pcd"), &cloud, PcdEncoding::BinaryCompressed).unwrap();
+    // The invalid point of an organised cloud is left out.
+    cloud.push(f32::NAN, f32::NAN, f32::NAN, 0.0);
+    write_pcd(pcd.join("b.PCD"), &cloud, PcdEncoding::Ascii).unwrap();
+    let pcd_poses = poses_of(&pcd, &dir.path().join("pcd.txt"));
+    assert_eq!(pcd_poses.len(), 2);
+    for (a, b) in bin_poses.iter().zip(&pcd_poses) {
+        assert!(
+            (a.to_homogeneous() - b.to_homogeneous()).norm() < 1e-9,
+            "{a:?} {b:?}"
+        );
+    }
+    // A folder holding both kinds is refused.
+    std::fs::copy(frame(), pcd.join("c.bin")).unwrap();
+    let (good, _, stderr) = run(&[
+        "odometry",
+        "--scans",
+        pcd.to_str().unwrap(),
+        "--out",
+        dir.path().join("mixed.txt").to_str().unwrap(),
+    ]);
+    assert!(
+        !good && stderr.contains("both .bin (1) and .pcd (2)"),
         "{stderr}"
     );
 }

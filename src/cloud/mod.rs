@@ -1,5 +1,5 @@
 //! Point clouds: the [`PointCloud`] type (structure of arrays, f32) and the KITTI Velodyne
-//! `.bin` reader and writer, LAS and PLY import/export (optionally coloured by label),
+//! `.bin` reader and writer, LAS, PLY and PCD import/export (optionally coloured by label),
 //! Euclidean clustering of points into object candidates, the range image of a spinning
 //! scan with its ground and angle-criterion clusters ([`range_image`]), and lidar odometry
 //! (the scanner's motion from its own scans, [`odometry`]).
@@ -15,6 +15,7 @@ pub mod las_io;
 pub mod odometry;
 pub mod other_class;
 pub mod palette;
+pub mod pcd_io;
 pub mod planes;
 pub mod ply_io;
 pub mod points;
@@ -24,5 +25,9 @@ pub use cluster::{euclidean_clusters, euclidean_clusters_of, Cluster, ClusterPar
 pub use kitti_bin::{read_kitti_bin, read_kitti_bin_with, write_kitti_bin, BinScan, NonFinite};
 pub use las_io::{read_las, write_las, write_las_labelled};
 pub use palette::label_colour;
+pub use pcd_io::{
+    decode_pcd, encode_pcd, read_pcd, read_pcd_with, write_pcd, write_pcd_labelled, PcdEncoding,
+    PcdScan,
+};
 pub use ply_io::{read_ply, write_ply, write_ply_labelled};
 pub use points::{Bounds, Point, PointCloud};

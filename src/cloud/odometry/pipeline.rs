@@ -7,7 +7,7 @@ use super::registration::{align_points_to_map, IcpParams};
 use super::se3::renormalized;
 use super::threshold::AdaptiveThreshold;
 use super::voxel_map::VoxelHashMap;
-use crate::cloud::{read_kitti_bin, PointCloud};
+use crate::cloud::{read_kitti_bin, read_pcd_with, NonFinite, PointCloud};
 use crate::error::{Error, Result};
 use nalgebra::Isometry3;
 use std::path::{Path, PathBuf};
@@ -130,8 +130,10 @@ impl LidarOdometry {
     }
 }
 
-/// Runs the odometry over the `.bin` scans `paths` in order and returns one pose per scan;
-/// `on_scan(k)` is called after scan k.
+/// Runs the odometry over the scans `paths` in order and returns one pose per scan;
+/// `on_scan(k)` is called after scan k. Files ending in `.pcd` (any case) are read as PCD,
+/// leaving out points with NaN or infinite values (the invalid points of an organised cloud);
+/// every other file as a KITTI `.bin` scan.
 ///
 /// Errors: no scans at all, a scan that cannot be read, or a scan with no point in range —
 /// each naming the file.
@@ -145,7 +147,7 @@ pub fn odometry_of_files(
     }
     let mut odometry = LidarOdometry::new(config.clone())?;
     for (k, path) in paths.iter().enumerate() {
-        let cloud = read_kitti_bin(path)?;
+        let cloud = read_scan(path)?;
         let registered = odometry.register(&cloud).map_err(|e| named(path, e))?;
         on_scan(k, &registered);
     }
@@ -168,6 +170,18 @@ pub fn odometry_of_frames(
         odometry.register(&load(k)?)?;
     }
     Ok(odometry.poses.clone())
+}
+
+/// Reads one scan by its extension: `.pcd` without its non-finite points, else `.bin`.
+fn read_scan(path: &Path) -> Result<PointCloud> {
+    let pcd = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("pcd"));
+    if pcd {
+        Ok(read_pcd_with(path, NonFinite::Skip)?.cloud)
+    } else {
+        read_kitti_bin(path)
+    }
 }
 
 fn named(path: &Path, e: Error) -> Error {
