@@ -347,6 +347,36 @@ impl<'a> Solver<'a> {
     }
 }
 
+/// Lower bound on how much more child `r` of `node` costs than `node` (Miller, Stone & Cox
+/// 1997): with the node's duals, row r must move to another column, at least its smallest
+/// reduced cost elsewhere, and column c = `node.cols[r]` must be taken by another free row
+/// or left to the dummy rows, at least the smallest reduced cost into it. Raising both
+/// duals by those amounts keeps them feasible, as (r, c) is forbidden.
+fn bound(cost: &[f64], cols: usize, node: &Node, r: usize, avail: &[bool]) -> f64 {
+    let c = node.cols[r];
+    let row = &cost[r * cols..(r + 1) * cols];
+    let ur = node.u[r];
+    let mut row_min = f64::INFINITY;
+    for (k, &x) in row.iter().enumerate() {
+        if k == c || !avail[k] || x == f64::INFINITY {
+            continue;
+        }
+        if r == node.first && node.excluded.contains(&k) {
+            continue;
+        }
+        row_min = row_min.min(x - ur - node.v[k]);
+    }
+    let vc = node.v[c];
+    let mut col_min = node.v_free - vc;
+    for i in r + 1..node.cols.len() {
+        let x = cost[i * cols + c];
+        if x < f64::INFINITY {
+            col_min = col_min.min(x - node.u[i] - vc);
+        }
+    }
+    row_min + col_min
+}
+
 /// The `k` best hypotheses of a table with their shifted log weights, best first.
 ///
 /// Murty's partition with the optimisations of Miller, Stone & Cox (1997): each child is
@@ -425,6 +455,10 @@ pub(crate) fn ranked(table: &LogTable, k: usize) -> Vec<(Vec<usize>, f64)> {
                 Some(worst) if queue.len() >= room => worst.cost - node.cost + tol,
                 _ => f64::INFINITY,
             };
+            if limit < f64::INFINITY && bound(&cost, cols, &node, r, &s.avail) > limit {
+                s.avail[col_r] = false;
+                continue;
+            }
             s.col_of.copy_from_slice(&node.cols);
             s.u.copy_from_slice(&node.u);
             s.v.copy_from_slice(&node.v);
