@@ -177,9 +177,12 @@ struct Solver<'a> {
     banned_row: usize,
     /// Columns forbidden to `banned_row`.
     banned: Vec<bool>,
+    /// Tentative distance of each column; NaN once settled or if unavailable, so that no
+    /// comparison picks it again.
     dist: Vec<f64>,
+    /// Final distance of each settled column, +∞ for the others.
+    settled: Vec<f64>,
     pred: Vec<usize>,
-    done: Vec<bool>,
 }
 
 impl<'a> Solver<'a> {
@@ -197,8 +200,8 @@ impl<'a> Solver<'a> {
             banned_row: NONE,
             banned: vec![false; cols],
             dist: vec![f64::INFINITY; cols],
+            settled: vec![f64::INFINITY; cols],
             pred: vec![NONE; cols],
-            done: vec![false; cols],
         }
     }
 
@@ -237,8 +240,10 @@ impl<'a> Solver<'a> {
     /// of the path, by which the total cost grew.
     fn augment(&mut self, r: usize, target: usize, limit: f64) -> Option<f64> {
         let cols = self.cols;
-        self.dist.fill(f64::INFINITY);
-        self.done.fill(false);
+        for (d, &a) in self.dist.iter_mut().zip(&self.avail) {
+            *d = if a { f64::INFINITY } else { f64::NAN };
+        }
+        self.settled.fill(f64::INFINITY);
         let mut dummy_dist = f64::INFINITY;
         let mut dummy_from = NONE;
         let mut dummy_done = false;
@@ -246,9 +251,9 @@ impl<'a> Solver<'a> {
         let (end, total) = loop {
             let mut best = f64::INFINITY;
             let mut j = NONE;
-            for k in 0..cols {
-                if !self.done[k] && self.dist[k] < best {
-                    best = self.dist[k];
+            for (k, &d) in self.dist.iter().enumerate() {
+                if d < best {
+                    best = d;
                     j = k;
                 }
             }
@@ -258,13 +263,12 @@ impl<'a> Solver<'a> {
                 }
                 // The dummy rows may take any column: unassigned ones are all at v_free.
                 dummy_done = true;
-                for k in 0..cols {
-                    if self.avail[k] && !self.done[k] {
-                        let d = dummy_dist + (self.v_free - self.v[k]);
-                        if d < self.dist[k] {
-                            self.dist[k] = d;
-                            self.pred[k] = DUMMY;
-                        }
+                let dists = self.dist.iter_mut().zip(self.pred.iter_mut());
+                for ((dk, pk), &vk) in dists.zip(&self.v) {
+                    let d = dummy_dist + (self.v_free - vk);
+                    if d < *dk {
+                        *dk = d;
+                        *pk = DUMMY;
                     }
                 }
                 continue;
@@ -272,7 +276,8 @@ impl<'a> Solver<'a> {
             if j == NONE || best > limit {
                 return None;
             }
-            self.done[j] = true;
+            self.settled[j] = best;
+            self.dist[j] = f64::NAN;
             if j == target {
                 break (j, best);
             }
@@ -290,7 +295,7 @@ impl<'a> Solver<'a> {
         // Dual update: every column settled closer than the end, and its row, move by the
         // difference, which keeps reduced costs ≥ 0 and makes the path tight.
         for k in 0..cols {
-            let d = self.dist[k];
+            let d = self.settled[k];
             if d < total {
                 self.v[k] -= total - d;
                 let i = self.owner[k];
@@ -325,23 +330,19 @@ impl<'a> Solver<'a> {
         Some(total)
     }
 
-    /// Offers the paths through row `i`, reached at distance `base`.
+    /// Offers the paths through row `i`, reached at distance `base`. Forbidden pairs cost
+    /// +∞ and settled or unavailable columns hold NaN, so neither is ever updated.
     #[inline]
     fn relax(&mut self, i: usize, base: f64) {
         let row = &self.cost[i * self.cols..(i + 1) * self.cols];
         let ui = self.u[i];
-        for (k, &c) in row.iter().enumerate() {
-            if c == f64::INFINITY
-                || !self.avail[k]
-                || self.done[k]
-                || (i == self.banned_row && self.banned[k])
-            {
-                continue;
-            }
-            let d = base + (c - ui - self.v[k]);
-            if d < self.dist[k] {
-                self.dist[k] = d;
-                self.pred[k] = i;
+        let banned = (i == self.banned_row).then_some(&self.banned[..]);
+        let dists = self.dist.iter_mut().zip(self.pred.iter_mut());
+        for (k, ((dk, pk), (&c, &vk))) in dists.zip(row.iter().zip(&self.v)).enumerate() {
+            let d = base + (c - ui - vk);
+            if d < *dk && banned.is_none_or(|b| !b[k]) {
+                *dk = d;
+                *pk = i;
             }
         }
     }
