@@ -13,10 +13,17 @@
 //! Murty (1968, "An algorithm for ranking all the assignments in order of increasing cost")
 //! partitions the solutions other than the best one into disjoint subproblems: for the i-th
 //! free row of the best solution, the rows before it are fixed to their columns in that
-//! solution and row i is forbidden its column. Each subproblem is solved with the Hungarian
-//! method of [`crate::assignment`]; the best remaining subproblem yields the next
-//! hypothesis and is partitioned in turn. Not for: approximate marginals of large groups
-//! (see the Gibbs and belief-propagation associators).
+//! solution and row i is forbidden its column. The best remaining subproblem yields the next
+//! hypothesis and is partitioned in turn.
+//!
+//! With the optimisations of Miller, Stone & Cox (1997, "Optimizing Murty's ranked assignment
+//! method"): each subproblem keeps its optimal dual variables, so a child is solved by a
+//! single shortest augmenting path from its parent's solution; a child whose dual lower bound
+//! cannot beat the k-th best node queued is skipped, and only that many nodes are kept. The
+//! ranking (weights, order and ties broken by creation order) is that of solving every
+//! subproblem from scratch, except that among hypotheses of exactly equal weight the
+//! augmenting path may find a different one first. Not for: approximate marginals of large
+//! groups (see the Gibbs and belief-propagation associators).
 
 use super::problem::Accumulator;
 use super::problem::{AssociationProblem, Associator, Hypothesis, Marginals};
