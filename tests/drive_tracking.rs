@@ -209,6 +209,28 @@ fn synthetic_street_walls_keep_labels_and_the_box_is_tracked() {
     assert!(las.len() > 10_000);
     let plot = drive_plot(&tracks);
     assert!(plot.lines.len() >= 4, "ego path, two walls, a trajectory");
+    let last = tracks.frames.last().unwrap().frame;
+    assert!(
+        plot.title[0].ends_with(&format!("frames 0-{last}")),
+        "{:?}",
+        plot.title
+    );
+    let names: Vec<&str> = plot.legend.iter().map(|e| e.label.as_str()).collect();
+    for name in ["walls", "ego path", "ego start", "last position"] {
+        assert!(names.contains(&name), "{names:?}");
+    }
+    // The last class each cluster track was reported with is named in the legend.
+    let mut last_class = std::collections::BTreeMap::new();
+    for f in &tracks.frames {
+        for c in &f.clusters {
+            if let Some(class) = &c.class {
+                last_class.insert(c.id, class.clone());
+            }
+        }
+    }
+    for class in last_class.values() {
+        assert!(names.contains(&class.as_str()), "{class} not in {names:?}");
+    }
     let svg = tmp.path().join("drive.svg");
     plot.write(&svg, 600).unwrap();
     assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));

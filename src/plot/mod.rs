@@ -1,8 +1,8 @@
 //! Bird's-eye plots: poly-lines, segments and dots on a metric x–y plane at equal scale,
-//! written as SVG or PNG (chosen by the file extension) with `plotters`. A light 10 m grid
-//! stands in for axes; there is no text, so no font is needed. [`text`] is a 5×7 pixel font for
-//! the plots that need titles, legends and ticks (the people plot of
-//! [`crate::pipeline::people_tracking`]).
+//! written as SVG or PNG (chosen by the file extension) with `plotters`, with a grid of round
+//! metre steps and tick labels, axis names, a scale bar, an optional title and legend. Text is
+//! drawn with [`text`], a 5×7 pixel font, so no font engine is needed (it serves the people
+//! plot of [`crate::pipeline::people_tracking`] too).
 //!
 //! Not for: deciding what to draw (the pipelines build a [`BirdsEyePlot`]) or interactive
 //! viewing.
@@ -88,14 +88,58 @@ pub struct Dot {
     pub radius: u32,
 }
 
+/// How a legend entry shows its colour.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum LegendMark {
+    /// A short line of this width in pixels.
+    Line(u32),
+    /// A dot of this radius in pixels.
+    Dot(u32),
+}
+
+/// One legend entry.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LegendEntry {
+    /// What it names.
+    pub label: String,
+    /// RGB colour.
+    pub colour: [u8; 3],
+    /// Its mark.
+    pub mark: LegendMark,
+}
+
 /// What a bird's-eye plot shows.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct BirdsEyePlot {
+    /// Title lines above the plot (none: no title band).
+    pub title: Vec<String>,
+    /// Legend entries, drawn in the top-right corner of the plot area (none: no legend).
+    pub legend: Vec<LegendEntry>,
     /// Lines (paths, trajectories, wall segments), drawn in order.
     pub lines: Vec<Polyline>,
     /// Dots, drawn over the lines.
     pub dots: Vec<Dot>,
 }
+
+/// A round grid step (1, 2 or 5 × 10ⁿ) giving at most about `lines` lines over `span`.
+pub(crate) fn grid_step(span: f64, lines: f64) -> f64 {
+    let raw = (span / lines).max(1e-9);
+    let p = 10f64.powf(raw.log10().floor());
+    [1.0, 2.0, 5.0, 10.0]
+        .into_iter()
+        .map(|m| m * p)
+        .find(|&s| s >= raw)
+        .unwrap_or(10.0 * p)
+}
+
+/// Margins of the plot area in pixels: left (y tick labels), bottom (x tick labels and the
+/// axis name), right, and the top without a title.
+const LEFT: u32 = 56;
+const BOTTOM: u32 = 40;
+const RIGHT: u32 = 16;
+const TOP: u32 = 16;
+/// Pixel height of one title line (scale 2 glyphs and spacing).
+const TITLE_LINE: u32 = 24;
 
 impl BirdsEyePlot {
     /// The smallest square (x range, y range) holding every point, with a 5 m margin; `None`
@@ -138,35 +182,90 @@ impl Draw for BirdsEyePlot {
     where
         DB::ErrorType: 'static,
     {
+        use text::{draw_text, text_width, HEIGHT};
         let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+        let ink = RGBColor(40, 40, 40);
         root.fill(&WHITE).map_err(err)?;
+        let (w, h) = root.dim_in_pixel();
+        let top = TOP + TITLE_LINE * self.title.len() as u32;
+        for (k, line) in self.title.iter().enumerate() {
+            let scale = if k == 0 { 2 } else { 1 };
+            let y = 8 + (TITLE_LINE * k as u32) as i32;
+            draw_text(&root, line, (LEFT as i32, y), scale, ink).map_err(err)?;
+        }
+        // The plot area: the largest square that fits inside the margins, at equal scale.
+        let side = w
+            .saturating_sub(LEFT + RIGHT)
+            .min(h.saturating_sub(top + BOTTOM))
+            .max(16);
+        let area = root.margin(
+            top,
+            h.saturating_sub(top + side),
+            LEFT,
+            w.saturating_sub(LEFT + side),
+        );
         let (xr, yr) = self.bounds().unwrap_or(([-10.0, 10.0], [-10.0, 10.0]));
-        let mut chart = ChartBuilder::on(&root)
-            .margin(10)
+        let mut chart = ChartBuilder::on(&area)
             .build_cartesian_2d(xr[0]..xr[1], yr[0]..yr[1])
             .map_err(err)?;
         let grid = RGBColor(225, 225, 225);
-        let step = 10.0;
-        let mut g = (xr[0] / step).ceil() * step;
-        while g <= xr[1] {
+        let step = grid_step(xr[1] - xr[0], 10.0);
+        let ticks = |a: f64, b: f64| {
+            let mut v = Vec::new();
+            let mut g = (a / step).ceil() * step;
+            while g <= b {
+                v.push(g);
+                g += step;
+            }
+            v
+        };
+        let label = |v: f64| format!("{:.0}", v + 0.0);
+        for g in ticks(xr[0], xr[1]) {
             chart
                 .draw_series(std::iter::once(PathElement::new(
                     vec![(g, yr[0]), (g, yr[1])],
                     grid.stroke_width(1),
                 )))
                 .map_err(err)?;
-            g += step;
+            let (px, _) = chart.backend_coord(&(g, yr[0]));
+            let t = label(g);
+            let x = px - text_width(&t, 1) / 2;
+            draw_text(&root, &t, (x, (top + side) as i32 + 6), 1, ink).map_err(err)?;
         }
-        let mut g = (yr[0] / step).ceil() * step;
-        while g <= yr[1] {
+        for g in ticks(yr[0], yr[1]) {
             chart
                 .draw_series(std::iter::once(PathElement::new(
                     vec![(xr[0], g), (xr[1], g)],
                     grid.stroke_width(1),
                 )))
                 .map_err(err)?;
-            g += step;
+            let (_, py) = chart.backend_coord(&(xr[0], g));
+            let t = label(g);
+            let x = LEFT as i32 - 6 - text_width(&t, 1);
+            draw_text(&root, &t, (x, py - HEIGHT / 2), 1, ink).map_err(err)?;
         }
+        let names_y = (top + side) as i32 + 20;
+        let xname = "X (M)";
+        let xc = (LEFT + side / 2) as i32 - text_width(xname, 1) / 2;
+        draw_text(&root, xname, (xc, names_y), 1, ink).map_err(err)?;
+        draw_text(&root, "Y (M)", (4, top as i32 - 12), 1, ink).map_err(err)?;
+        // Scale bar: one grid step, bottom left under the axis.
+        let (p0, _) = chart.backend_coord(&(xr[0], yr[0]));
+        let (p1, _) = chart.backend_coord(&(xr[0] + step, yr[0]));
+        let bar_y = names_y + 3;
+        root.draw(&PathElement::new(
+            vec![(p0, bar_y), (p1, bar_y)],
+            ink.stroke_width(3),
+        ))
+        .map_err(err)?;
+        draw_text(
+            &root,
+            &format!("{} M", label(step)),
+            (p1 + 6, bar_y - 3),
+            1,
+            ink,
+        )
+        .map_err(err)?;
         for l in &self.lines {
             let [r, gr, b] = l.colour;
             let pts: Vec<(f64, f64)> = l.points.iter().map(|p| (p[0], p[1])).collect();
@@ -187,6 +286,41 @@ impl Draw for BirdsEyePlot {
                 )))
                 .map_err(err)?;
         }
+        if !self.legend.is_empty() {
+            let rows = self.legend.len() as i32;
+            let wide = self
+                .legend
+                .iter()
+                .map(|e| text_width(&e.label, 1))
+                .max()
+                .unwrap_or(0);
+            let (bw, bh) = (wide + 44, rows * 14 + 8);
+            let x0 = (LEFT + side) as i32 - bw - 6;
+            let y0 = top as i32 + 6;
+            root.draw(&Rectangle::new(
+                [(x0, y0), (x0 + bw, y0 + bh)],
+                WHITE.mix(0.9).filled(),
+            ))
+            .map_err(err)?;
+            root.draw(&Rectangle::new([(x0, y0), (x0 + bw, y0 + bh)], ink))
+                .map_err(err)?;
+            for (k, e) in self.legend.iter().enumerate() {
+                let y = y0 + 4 + 14 * k as i32 + HEIGHT / 2;
+                let [r, g, b] = e.colour;
+                let c = RGBColor(r, g, b);
+                match e.mark {
+                    LegendMark::Line(width) => root.draw(&PathElement::new(
+                        vec![(x0 + 6, y), (x0 + 30, y)],
+                        c.stroke_width(width.max(1)),
+                    )),
+                    LegendMark::Dot(radius) => {
+                        root.draw(&Circle::new((x0 + 18, y), radius.max(1), c.filled()))
+                    }
+                }
+                .map_err(err)?;
+                draw_text(&root, &e.label, (x0 + 38, y - HEIGHT / 2), 1, ink).map_err(err)?;
+            }
+        }
         root.present().map_err(err)?;
         Ok(())
     }
@@ -197,6 +331,65 @@ mod tests {
     use super::*;
 
     #[test]
+    fn grid_steps_are_round() {
+        assert_eq!(grid_step(100.0, 10.0), 10.0);
+        assert_eq!(grid_step(30.0, 10.0), 5.0);
+        assert_eq!(grid_step(12.0, 10.0), 2.0);
+        assert_eq!(grid_step(7.0, 10.0), 1.0);
+        assert!((grid_step(3.0, 10.0) - 0.5).abs() < 1e-12);
+    }
+
+    /// Dark pixels of a plot drawn into a `w`×`h` buffer, as (x, y).
+    fn dark_pixels(plot: &BirdsEyePlot, w: u32, h: u32) -> Vec<(u32, u32)> {
+        let mut buf = vec![255u8; (w * h * 3) as usize];
+        {
+            let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+            plot.draw_on(root).unwrap();
+        }
+        (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .filter(|&(x, y)| buf[((y * w + x) * 3) as usize] < 100)
+            .collect()
+    }
+
+    #[test]
+    fn title_ticks_scale_and_legend_are_drawn() {
+        let line = Polyline {
+            points: vec![[0.0, 0.0], [90.0, 0.0]],
+            colour: [230, 230, 0],
+            width: 1,
+        };
+        let bare = BirdsEyePlot {
+            lines: vec![line.clone()],
+            ..Default::default()
+        };
+        let dressed = BirdsEyePlot {
+            title: vec!["DRIVE 5".into(), "SECOND LINE".into()],
+            legend: vec![LegendEntry {
+                label: "WALLS".into(),
+                colour: [0, 0, 0],
+                mark: LegendMark::Line(4),
+            }],
+            lines: vec![line],
+            ..Default::default()
+        };
+        // Bare, the plot area fills the height between the margins: (400 − 72) = (384 − 56).
+        let (w, h) = (400, 384);
+        let bare_px = dark_pixels(&bare, w, h);
+        let dressed_px = dark_pixels(&dressed, w, h);
+        // Tick labels and axis names: dark text below and left of the plot area even bare.
+        assert!(bare_px.iter().any(|&(_, y)| y > h - BOTTOM));
+        assert!(bare_px.iter().any(|&(x, _)| x < LEFT));
+        // The title sits in its band above the plot area, at the left margin.
+        let title_band = |&&(x, y): &&(u32, u32)| y < 2 * TITLE_LINE && x >= LEFT;
+        assert!(dressed_px.iter().any(|p| title_band(&p)));
+        assert!(!bare_px.iter().any(|p| title_band(&p)));
+        // The legend box is in the top-right corner of the plot area.
+        let corner = |&&(x, y): &&(u32, u32)| x > w / 2 && y > 2 * TITLE_LINE && y < h / 3;
+        assert!(dressed_px.iter().filter(|p| corner(p)).count() > 50);
+    }
+
+    #[test]
     fn bounds_are_square_with_margin() {
         let plot = BirdsEyePlot {
             lines: vec![Polyline {
@@ -204,7 +397,7 @@ mod tests {
                 colour: [0, 0, 0],
                 width: 1,
             }],
-            dots: vec![],
+            ..Default::default()
         };
         let (x, y) = plot.bounds().unwrap();
         assert_eq!(x, [-5.0, 25.0]);
@@ -226,6 +419,7 @@ mod tests {
                 colour: [0, 0, 200],
                 radius: 3,
             }],
+            ..Default::default()
         };
         let svg = dir.path().join("a.svg");
         plot.write(&svg, 200).unwrap();

@@ -40,25 +40,44 @@ pub fn point_labels(len: usize, detections: &FrameDetections, tracked: &TrackedF
 }
 
 #[cfg(feature = "plot")]
-/// The bird's-eye plot of a drive in world x–y: the ego path (black), each cluster track's
-/// trajectory in its label colour with a dot at its last position, and each wall track's
-/// last rectangle as a thick segment (its horizontal extent) in its label colour.
+/// The colour of a cluster class in the drive plot (`None` for a name it does not know).
+fn class_colour(class: &str) -> Option<[u8; 3]> {
+    Some(match class {
+        "Car" => [31, 119, 180],
+        "Van" => [23, 160, 190],
+        "Truck" => [148, 103, 189],
+        "Pedestrian" => [214, 39, 40],
+        "Cyclist" => [255, 127, 14],
+        "Other" => [150, 150, 150],
+        _ => return None,
+    })
+}
+
+#[cfg(feature = "plot")]
+/// The bird's-eye plot of a drive in world x–y, titled with the drive, its frame range and
+/// the ego source: the ego path (black, a dot where it starts), each wall track's last
+/// rectangle as a thick green segment (its horizontal extent), and each cluster track's
+/// trajectory with a dot at its last position, coloured by its last class when it has one
+/// (else by label); a legend names them.
 pub fn drive_plot(tracks: &DriveTracks) -> BirdsEyePlot {
-    use std::collections::BTreeMap;
+    use crate::plot::{LegendEntry, LegendMark};
+    use std::collections::{BTreeMap, BTreeSet};
+    const WALL: [u8; 3] = [44, 160, 44];
     let mut plot = BirdsEyePlot::default();
     let ego: Vec<[f64; 2]> = tracks
         .frames
         .iter()
         .map(|f| [f.ego_position[0], f.ego_position[1]])
         .collect();
-    let mut trajectories: BTreeMap<u32, Vec<[f64; 2]>> = BTreeMap::new();
+    let mut trajectories: BTreeMap<u32, (Vec<[f64; 2]>, Option<String>)> = BTreeMap::new();
     let mut walls: BTreeMap<u32, [[f64; 3]; 4]> = BTreeMap::new();
     for f in &tracks.frames {
         for c in &f.clusters {
-            trajectories
-                .entry(c.id)
-                .or_default()
-                .push([c.position_world[0], c.position_world[1]]);
+            let t = trajectories.entry(c.id).or_default();
+            t.0.push([c.position_world[0], c.position_world[1]]);
+            if c.class.is_some() {
+                t.1.clone_from(&c.class);
+            }
         }
         for p in &f.planes {
             if let Some(v) = p.vertices_world {
@@ -66,7 +85,8 @@ pub fn drive_plot(tracks: &DriveTracks) -> BirdsEyePlot {
             }
         }
     }
-    for (id, v) in walls {
+    let wall_count = walls.len();
+    for v in walls.into_values() {
         // The two corners farthest apart in x–y span the wall's footprint.
         let mut best = (0.0, 0, 0);
         for a in 0..4 {
@@ -79,20 +99,33 @@ pub fn drive_plot(tracks: &DriveTracks) -> BirdsEyePlot {
         }
         plot.lines.push(Polyline {
             points: vec![[v[best.1][0], v[best.1][1]], [v[best.2][0], v[best.2][1]]],
-            colour: label_colour(id),
+            colour: WALL,
             width: 4,
         });
     }
-    for (id, pts) in trajectories {
+    let cluster_count = trajectories.len();
+    let mut classes: BTreeSet<String> = BTreeSet::new();
+    let mut unclassed = false;
+    for (id, (pts, class)) in trajectories {
+        let colour = match class.as_deref().and_then(class_colour) {
+            Some(c) => {
+                classes.insert(class.unwrap_or_default());
+                c
+            }
+            None => {
+                unclassed = true;
+                label_colour(id)
+            }
+        };
         let last = *pts.last().expect("a trajectory has a point");
         plot.lines.push(Polyline {
             points: pts,
-            colour: label_colour(id),
+            colour,
             width: 2,
         });
         plot.dots.push(Dot {
             at: last,
-            colour: label_colour(id),
+            colour,
             radius: 3,
         });
     }
@@ -108,5 +141,40 @@ pub fn drive_plot(tracks: &DriveTracks) -> BirdsEyePlot {
         colour: [0, 0, 0],
         width: 2,
     });
+
+    let (first, last) = (
+        tracks.frames.first().map_or(0, |f| f.frame),
+        tracks.frames.last().map_or(0, |f| f.frame),
+    );
+    plot.title = vec![
+        format!("{}, frames {first}-{last}", tracks.drive),
+        format!(
+            "{wall_count} wall tracks, {cluster_count} cluster tracks; ego motion: {}",
+            tracks.ego
+        ),
+    ];
+    let entry = |label: &str, colour: [u8; 3], mark: LegendMark| LegendEntry {
+        label: label.to_string(),
+        colour,
+        mark,
+    };
+    plot.legend.push(entry("walls", WALL, LegendMark::Line(4)));
+    for class in &classes {
+        let colour = class_colour(class).expect("classes kept have a colour");
+        plot.legend.push(entry(class, colour, LegendMark::Line(2)));
+    }
+    if unclassed {
+        plot.legend.push(entry(
+            "clusters (by label)",
+            [120, 120, 200],
+            LegendMark::Line(2),
+        ));
+    }
+    plot.legend
+        .push(entry("last position", [90, 90, 90], LegendMark::Dot(3)));
+    plot.legend
+        .push(entry("ego path", [0, 0, 0], LegendMark::Line(2)));
+    plot.legend
+        .push(entry("ego start", [0, 0, 0], LegendMark::Dot(4)));
     plot
 }

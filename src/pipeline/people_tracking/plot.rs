@@ -13,6 +13,7 @@ use super::PeopleRun;
 use crate::error::{Error, Result};
 use crate::filter::Label;
 use crate::laser2d::Scan;
+use crate::plot::grid_step;
 use crate::plot::text::{draw_text, text_width, HEIGHT};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -230,17 +231,6 @@ fn label_colour(label: Label) -> RGBColor {
         .wrapping_add(label.index as usize * 7);
     let c = Palette99::pick(k).to_rgba();
     RGBColor(c.0, c.1, c.2)
-}
-
-/// A grid step of 1, 2 or 5 times a power of ten giving about `lines` lines over `span`.
-fn grid_step(span: f64, lines: f64) -> f64 {
-    let raw = (span / lines).max(1e-9);
-    let p = 10f64.powf(raw.log10().floor());
-    [1.0, 2.0, 5.0, 10.0]
-        .into_iter()
-        .map(|m| m * p)
-        .find(|&s| s >= raw)
-        .unwrap_or(10.0 * p)
 }
 
 impl Scene<'_> {
@@ -582,14 +572,5 @@ mod tests {
         };
         let counts = write_people_plot(&png, &scans, &run, &strict).unwrap();
         assert_eq!((counts.moving, counts.stationary), (0, 1));
-    }
-
-    #[test]
-    fn grid_steps_are_round() {
-        assert_eq!(grid_step(100.0, 10.0), 10.0);
-        assert_eq!(grid_step(30.0, 10.0), 5.0);
-        assert_eq!(grid_step(12.0, 10.0), 2.0);
-        assert_eq!(grid_step(7.0, 10.0), 1.0);
-        assert!((grid_step(3.0, 10.0) - 0.5).abs() < 1e-12);
     }
 }
