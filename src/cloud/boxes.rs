@@ -26,8 +26,9 @@
 
 use super::points::PointCloud;
 use crate::error::{Error, Result};
+use crate::geometry::plane::convex_hull;
 use crate::geometry::Box3;
-use nalgebra::Point3;
+use nalgebra::{Point2, Point3};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Settings of the box fit.
@@ -382,36 +383,20 @@ pub fn lshape_heading(xy: &[f64], params: &BoxFitParams) -> f64 {
 /// Candidate headings per coarse step of [`lshape_heading`].
 pub const COARSE_STEPS: usize = 8;
 
-/// The convex hull's vertices of the interleaved x–y coordinates `xy`, interleaved (Andrew's
-/// monotone chain; every point when there are fewer than three).
+/// The convex hull's vertices of the interleaved x–y coordinates `xy`, interleaved (every
+/// point when there are fewer than three).
 fn hull_xy(xy: &[f64]) -> Vec<f64> {
-    let mut pts: Vec<[f64; 2]> = xy.chunks_exact(2).map(|p| [p[0], p[1]]).collect();
-    if pts.len() < 3 {
+    if xy.len() < 6 {
         return xy.to_vec();
     }
-    pts.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
-    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
-        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-    };
-    let mut hull: Vec<[f64; 2]> = Vec::with_capacity(32);
-    for pass in 0..2 {
-        let start = hull.len();
-        let mut push = |p: [f64; 2]| {
-            while hull.len() >= start + 2
-                && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
-            {
-                hull.pop();
-            }
-            hull.push(p);
-        };
-        if pass == 0 {
-            pts.iter().for_each(|&p| push(p));
-        } else {
-            pts.iter().rev().for_each(|&p| push(p));
-        }
-        hull.pop(); // the last point starts the other chain
-    }
-    hull.into_iter().flatten().collect()
+    let mut pts: Vec<Point2<f64>> = xy
+        .chunks_exact(2)
+        .map(|p| Point2::new(p[0], p[1]))
+        .collect();
+    convex_hull(&mut pts)
+        .into_iter()
+        .flat_map(|p| [p.x, p.y])
+        .collect()
 }
 
 /// An axis-aligned rectangle in the frame turned by θ: `lo[k] ≤ coordinate k ≤ hi[k]`.

@@ -339,8 +339,8 @@ impl PlanePatch {
 
 /// Convex hull (Andrew's monotone chain), counter-clockwise, without collinear points.
 /// Sorts `pts` in place. Returns one point for a single (or all-equal) input and two for
-/// collinear input.
-fn convex_hull(pts: &mut [Point2<f64>]) -> Vec<Point2<f64>> {
+/// collinear input; panics on an empty slice.
+pub(crate) fn convex_hull(pts: &mut [Point2<f64>]) -> Vec<Point2<f64>> {
     pts.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
     let cross = |o: &Point2<f64>, a: &Point2<f64>, b: &Point2<f64>| {
         (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x)
