@@ -132,6 +132,17 @@ pub(crate) fn grid_step(span: f64, lines: f64) -> f64 {
         .unwrap_or(10.0 * p)
 }
 
+/// The multiples of `step` in [a, b], ascending (each the previous plus `step`).
+pub(crate) fn grid_ticks(a: f64, b: f64, step: f64) -> Vec<f64> {
+    let mut v = Vec::new();
+    let mut g = (a / step).ceil() * step;
+    while g <= b {
+        v.push(g);
+        g += step;
+    }
+    v
+}
+
 /// Margins of the plot area in pixels: left (y tick labels), bottom (x tick labels and the
 /// axis name), right, and the top without a title.
 const LEFT: u32 = 56;
@@ -210,15 +221,7 @@ impl Draw for BirdsEyePlot {
             .map_err(err)?;
         let grid = RGBColor(225, 225, 225);
         let step = grid_step(xr[1] - xr[0], 10.0);
-        let ticks = |a: f64, b: f64| {
-            let mut v = Vec::new();
-            let mut g = (a / step).ceil() * step;
-            while g <= b {
-                v.push(g);
-                g += step;
-            }
-            v
-        };
+        let ticks = |a: f64, b: f64| grid_ticks(a, b, step);
         let label = |v: f64| format!("{:.0}", v + 0.0);
         for g in ticks(xr[0], xr[1]) {
             chart

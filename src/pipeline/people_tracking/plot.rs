@@ -13,8 +13,8 @@ use super::PeopleRun;
 use crate::error::{Error, Result};
 use crate::filter::Label;
 use crate::laser2d::Scan;
-use crate::plot::grid_step;
 use crate::plot::text::{draw_text, text_width, HEIGHT};
+use crate::plot::{grid_step, grid_ticks};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -290,15 +290,7 @@ impl Scene<'_> {
 
         // Grid and tick labels in metres.
         let step = grid_step((x1 - x0).max(y1 - y0), 12.0);
-        let ticks = |a: f64, b: f64| {
-            let mut v = Vec::new();
-            let mut g = (a / step).ceil() * step;
-            while g <= b {
-                v.push(g);
-                g += step;
-            }
-            v
-        };
+        let ticks = |a: f64, b: f64| grid_ticks(a, b, step);
         let fmt = |v: f64| {
             if step >= 1.0 {
                 format!("{:.0}", v + 0.0)
