@@ -14,27 +14,14 @@ use smc_lmb::laser2d::{
 };
 use smc_lmb::pipeline::people_tracking::{config_for_scans, track_scans};
 use smc_lmb::Error;
-use std::io::Write;
 use std::path::Path;
 
 mod common;
-use common::{shared_laser2d as shared, vendored_laser2d as vendored};
+use common::{bz2, gz, shared_laser2d as shared, vendored_laser2d as vendored};
 
 const ODOM: &str = "ODOM 0.0 0.0 0.1 0.0 0.0 0.0 100.0 nohost 0.0";
 const FLASER: &str =
     "FLASER 6 1.50 1.52 0.00 3.10 3.12 81.83 0.0 0.0 0.1 0.0 0.0 0.1 100.05 nohost 0.05";
-
-fn gz(bytes: &[u8]) -> Vec<u8> {
-    let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
-    e.write_all(bytes).unwrap();
-    e.finish().unwrap()
-}
-
-fn bz2(bytes: &[u8]) -> Vec<u8> {
-    let mut e = bzip2::write::BzEncoder::new(Vec::new(), bzip2::Compression::default());
-    e.write_all(bytes).unwrap();
-    e.finish().unwrap()
-}
 
 /// The error of reading `text` as a plain log with the default (strict) options, checking
 /// that its message starts with the file's name; (line, field, message).

@@ -34,10 +34,12 @@ use smc_lmb::laser2d::{
 };
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
-use std::io::Write;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
+
+mod common;
+use common::{bz2, gz};
 
 // ---------------------------------------------------------------- allocation watch
 
@@ -362,18 +364,6 @@ fn carmen_log_excerpt() -> Vec<u8> {
         .find(|&i| i > 3000)
         .unwrap_or(all.len());
     all[..end].to_vec()
-}
-
-fn gz(bytes: &[u8]) -> Vec<u8> {
-    let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
-    e.write_all(bytes).unwrap();
-    e.finish().unwrap()
-}
-
-fn bz2(bytes: &[u8]) -> Vec<u8> {
-    let mut e = bzip2::write::BzEncoder::new(Vec::new(), bzip2::Compression::default());
-    e.write_all(bytes).unwrap();
-    e.finish().unwrap()
 }
 
 fn scans() -> Vec<Scan> {

@@ -200,3 +200,21 @@ pub fn shared_data(relative: &str) -> Option<PathBuf> {
 pub fn shared_laser2d(name: &str) -> Option<PathBuf> {
     shared_data(&format!("laser2d/{name}"))
 }
+
+/// `bytes` gzip-compressed, as a `.gz` log would hold them.
+#[cfg(feature = "laser2d")]
+pub fn gz(bytes: &[u8]) -> Vec<u8> {
+    use std::io::Write;
+    let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+    e.write_all(bytes).unwrap();
+    e.finish().unwrap()
+}
+
+/// `bytes` bzip2-compressed, as a `.bz2` log would hold them.
+#[cfg(feature = "laser2d")]
+pub fn bz2(bytes: &[u8]) -> Vec<u8> {
+    use std::io::Write;
+    let mut e = bzip2::write::BzEncoder::new(Vec::new(), bzip2::Compression::default());
+    e.write_all(bytes).unwrap();
+    e.finish().unwrap()
+}
