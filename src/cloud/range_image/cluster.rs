@@ -105,16 +105,7 @@ pub fn range_image_clusters(
     params: &ImageClusterParams,
 ) -> Result<Vec<Cluster>> {
     params.validate()?;
-    if image.points() != cloud.len() {
-        return Err(Error::invalid(
-            "range image",
-            format!(
-                "built from {} points, the cloud has {}",
-                image.points(),
-                cloud.len()
-            ),
-        ));
-    }
+    image.check_cloud(cloud)?;
     if let Some(&bad) = indices.iter().find(|&&i| i as usize >= cloud.len()) {
         return Err(Error::invalid(
             "cluster indices",

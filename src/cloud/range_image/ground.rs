@@ -80,16 +80,7 @@ pub fn ground_mask(
     params: &GroundParams,
 ) -> Result<Vec<bool>> {
     params.validate()?;
-    if image.points() != cloud.len() {
-        return Err(Error::invalid(
-            "range image",
-            format!(
-                "built from {} points, the cloud has {}",
-                image.points(),
-                cloud.len()
-            ),
-        ));
-    }
+    image.check_cloud(cloud)?;
     let (xs, ys, zs) = (cloud.xs(), cloud.ys(), cloud.zs());
     let (rows, cols) = (image.rows(), image.cols());
     let holders = image.holders();

@@ -239,6 +239,22 @@ impl RangeImage {
         self.cell_of.len()
     }
 
+    /// An error unless `cloud` has as many points as the image was built from (the image's
+    /// cells index the points of the cloud it was built from).
+    pub fn check_cloud(&self, cloud: &PointCloud) -> Result<()> {
+        if self.points() != cloud.len() {
+            return Err(Error::invalid(
+                "range image",
+                format!(
+                    "built from {} points, the cloud has {}",
+                    self.points(),
+                    cloud.len()
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     /// The (row, column) of point `i`, `None` when it has no cell or is out of range.
     pub fn cell_of(&self, i: usize) -> Option<(usize, usize)> {
         match self.cell_of.get(i) {
