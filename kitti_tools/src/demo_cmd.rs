@@ -98,7 +98,7 @@ pub fn run(args: Args) -> Result<()> {
     );
 
     // Tracking: walls and clusters as labelled objects of one filter run.
-    println!("\ntracking walls and clusters (one LMB filter, 1000 particles per track):");
+    println!("\ntracking walls and clusters (one LMB filter, up to 1000 particles per track):");
     let b = bar(args.quiet, drive.frame_count(), "frames tracked");
     let tracks = track_drive(
         &drive,

@@ -249,7 +249,7 @@ pub fn print_summary(tracks: &DriveTracks) {
     let s = &tracks.summary;
     let t = &s.mean_times;
     println!(
-        "{}: {} frames (ego {}, {} particles/track, seed {})",
+        "{}: {} frames (ego {}, up to {} particles/track, seed {})",
         tracks.drive, s.frames, tracks.ego, tracks.particles, tracks.seed
     );
     println!(

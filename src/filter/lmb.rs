@@ -42,6 +42,14 @@ pub const MAX_TRACKS: usize = 1_000_000;
 pub struct LmbConfig {
     /// Particles per track after resampling, 1 to [`MAX_PARTICLES`]. Default 1000.
     pub particles: usize,
+    /// When set, particles follow existence: a track of existence r is resampled to
+    /// max(`min_particles`, ⌈r · `particles`⌉) particles (the allocation of Vo, Vo & Cantoni's
+    /// SMC multi-Bernoulli filter, IEEE TSP 2009), so the many unlikely tracks a cluttered
+    /// scene proposes cost little; it is resampled to a new count only when its count is less
+    /// than half or more than twice that number (or its effective sample size is low), so a
+    /// changing existence does not resample every step. 1 to `particles`. Default `None`:
+    /// every track keeps `particles`.
+    pub min_particles: Option<usize>,
     /// Resample a track when its effective sample size falls below this fraction of
     /// `particles` (1.0 resamples after every update that changed the weights). Default 0.5.
     pub resample_threshold: f64,
@@ -58,6 +66,7 @@ impl Default for LmbConfig {
     fn default() -> Self {
         LmbConfig {
             particles: 1000,
+            min_particles: None,
             resample_threshold: 0.5,
             jitter: Jitter::default(),
             prune_threshold: 1e-3,
@@ -80,6 +89,14 @@ impl LmbConfig {
                 "config field `particles`",
                 format!("{} is above the limit of {MAX_PARTICLES}", self.particles),
             ));
+        }
+        if let Some(m) = self.min_particles {
+            if m == 0 || m > self.particles {
+                return Err(Error::invalid(
+                    "config field `min_particles`",
+                    format!("{m} outside [1, particles = {}]", self.particles),
+                ));
+            }
         }
         if !(0.0..=1.0).contains(&self.resample_threshold) {
             return Err(Error::invalid(
@@ -726,21 +743,30 @@ impl LmbFilter {
         assigned
     }
 
-    /// Resampling, per track: back to `particles` particles (with jitter) when the count
-    /// differs or the effective sample size is below `resample_threshold · particles`. Returns
-    /// for every track whether it was resampled.
+    /// Resampling, per track: to the track's particle count ([`LmbConfig::particles`], or the
+    /// existence-scaled count of [`LmbConfig::min_particles`]) with jitter, when its count is
+    /// off that number (any difference for a fixed count, beyond a factor of two for a scaled
+    /// one) or its effective sample size is below `resample_threshold` times its count.
+    /// Returns for every track whether it was resampled.
     fn resample(&mut self, seed: u64) -> Vec<bool> {
         let cfg = &self.config;
         self.tracks
             .par_iter_mut()
             .map(|t| {
                 let n = t.particles.len();
-                let resample = n != cfg.particles
-                    || t.particles.effective_sample_size()
-                        < cfg.resample_threshold * cfg.particles as f64;
+                let (target, off) = match cfg.min_particles {
+                    None => (cfg.particles, n != cfg.particles),
+                    Some(min) => {
+                        let scaled = (t.existence * cfg.particles as f64).ceil();
+                        let target = (scaled as usize).clamp(min, cfg.particles);
+                        (target, 2 * n < target || n > 2 * target)
+                    }
+                };
+                let resample =
+                    off || t.particles.effective_sample_size() < cfg.resample_threshold * n as f64;
                 if resample {
                     let mut rng = stream(seed, KEY_RESAMPLE ^ t.label.key());
-                    t.particles.resample(cfg.particles, cfg.jitter, &mut rng);
+                    t.particles.resample(target, cfg.jitter, &mut rng);
                 }
                 resample
             })

@@ -260,7 +260,8 @@ impl Default for ClusterDetectionConfig {
 #[serde(default, deny_unknown_fields)]
 pub struct TrackingConfig {
     /// Filter tuning (particles per track, resampling, pruning). Default: the filter's
-    /// defaults with room for 200 tracks.
+    /// defaults with room for 200 tracks and particles that follow existence (at least 200,
+    /// 1000 for a certain track): a real street proposes a hundred unlikely tracks a frame.
     pub filter: LmbConfig,
     /// How walls follow the ego motion. Default: measured poses.
     pub ego: EgoModel,
@@ -290,6 +291,7 @@ impl Default for TrackingConfig {
         TrackingConfig {
             filter: LmbConfig {
                 max_tracks: 200,
+                min_particles: Some(200),
                 ..LmbConfig::default()
             },
             ego: EgoModel::Measured,
