@@ -173,16 +173,26 @@ fn particles_follow_existence_when_scaled() {
     );
     let good = frames_right(&est, &frames);
     assert!(good >= 20, "only {good} of 22 frames right");
-    // Out of range: 0, or more than `particles`.
-    for bad in [0, 501] {
-        let err = LmbConfig {
-            particles: 500,
-            min_particles: Some(bad),
-            ..LmbConfig::default()
-        }
-        .validate()
-        .unwrap_err();
-        assert!(err.to_string().contains("min_particles"), "{err}");
+    // 0 is refused; more than `particles` is `particles`.
+    let err = LmbConfig {
+        particles: 500,
+        min_particles: Some(0),
+        ..LmbConfig::default()
+    }
+    .validate()
+    .unwrap_err();
+    assert!(err.to_string().contains("min_particles"), "{err}");
+    let above = LmbConfig {
+        particles: 50,
+        min_particles: Some(200),
+        ..LmbConfig::default()
+    };
+    assert!(above.validate().is_ok());
+    let mut filter = adaptive_filter_with(AssociationMethod::default(), above);
+    let mut rng = seeded(5);
+    for (f, _) in &frames[..5] {
+        filter.step(f, &mut rng).unwrap();
+        assert!(filter.tracks().iter().all(|t| t.particles.len() == 50));
     }
 }
 

@@ -1,6 +1,7 @@
 //! `kitti-tools`: the command-line face of smc-lmb. Each subcommand parses its flags, builds a
 //! configuration and calls the library; no pipeline lives here.
 
+mod batch_cmd;
 mod config_file;
 mod convert_cmd;
 mod demo_cmd;
@@ -10,6 +11,7 @@ mod info_cmd;
 mod odometry_cmd;
 mod paper_tables;
 mod planes_cmd;
+mod recording;
 mod synth_cmd;
 mod track_cmd;
 mod tracking_eval_cmd;
@@ -54,6 +56,9 @@ enum Command {
     /// odometry sequence with one labelled multi-Bernoulli filter; write per-frame tracks
     /// (JSON), labelled clouds and a plot.
     Track(track_cmd::Args),
+    /// Track many recordings (a list file or a folder of raw drives), each into its own
+    /// folder, resumably (recordings already tracked are skipped), with one summary table.
+    Batch(batch_cmd::Args),
     /// Score the output of `track` against ground truth (a simulated street's truth.json,
     /// KITTI tracklets or a tracking sequence's label_02): OSPA, GOSPA and label switches of
     /// the clusters, wall accuracy, and optionally the recording's plane-prediction
@@ -71,6 +76,7 @@ fn main() -> Result<()> {
         Command::Planes(args) => planes_cmd::run(args),
         Command::Synth(args) => synth_cmd::run(args),
         Command::Track(args) => track_cmd::run(args),
+        Command::Batch(args) => batch_cmd::run(args),
         Command::Eval(args) => eval_cmd::run(args),
     }
 }

@@ -3,15 +3,15 @@
 //! labelled LAS/PLY clouds of chosen frames and a bird's-eye plot; prints a summary.
 
 use crate::config_file::read_config;
+use crate::recording::Recording;
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use smc_lmb::cloud::{write_las_labelled, write_ply_labelled};
 use smc_lmb::kitti::tracking::TrackingCalib;
-use smc_lmb::kitti::{OdometrySequence, RawDrive, TrackingSequence};
+use smc_lmb::kitti::TrackingSequence;
 use smc_lmb::pipeline::drive_tracking::kitti_out::{lmb_results, BaselineBoxes};
 use smc_lmb::pipeline::drive_tracking::{
-    drive_plot, point_labels, track_drive, track_odometry_sequence, track_tracking_sequence,
-    DriveTracks, EgoModel, FrameView, PoseSource, TrackingConfig,
+    drive_plot, point_labels, DriveTracks, EgoModel, FrameView, PoseSource, TrackingConfig,
 };
 use smc_lmb::pipeline::kitti_results::{results_path, write_tracking_results, ResultObject};
 use smc_lmb::trackers::ab3dmot::Ab3dmotConfig;
@@ -185,29 +185,15 @@ pub fn run(args: Args) -> Result<()> {
         }
         Ok(())
     };
-    let tracks = match (&args.drive, &args.odometry, &args.tracking, args.sequence) {
-        (Some(dir), _, _, _) => {
-            let drive =
-                RawDrive::open(dir).with_context(|| format!("opening drive {}", dir.display()))?;
-            track_drive(&drive, frames, &config, args.seed, on_frame)
-                .with_context(|| format!("tracking drive {}", dir.display()))?
-        }
-        (None, Some(root), _, Some(n)) => {
-            let what = format!("odometry sequence {n:02} of {}", root.display());
-            let seq = OdometrySequence::open(root, n).with_context(|| format!("opening {what}"))?;
-            track_odometry_sequence(&seq, frames, &config, args.seed, on_frame)
-                .with_context(|| format!("tracking {what}"))?
-        }
-        (None, None, Some(root), Some(n)) => {
-            let what = format!("tracking sequence {n:04} of {}", root.display());
-            let seq = TrackingSequence::open(root, n).with_context(|| format!("opening {what}"))?;
-            track_tracking_sequence(&seq, frames, &config, args.seed, on_frame)
-                .with_context(|| format!("tracking {what}"))?
-        }
+    let recording = match (&args.drive, &args.odometry, &args.tracking, args.sequence) {
+        (Some(dir), _, _, _) => Recording::Raw(dir.clone()),
+        (None, Some(root), _, Some(n)) => Recording::Odometry(root.clone(), n),
+        (None, None, Some(root), Some(n)) => Recording::Tracking(root.clone(), n),
         _ => bail!(
             "give --drive DIR, --odometry ROOT --sequence NN or --tracking ROOT --sequence NNNN"
         ),
     };
+    let tracks = recording.track(frames, &config, args.seed, on_frame)?;
     bar.finish_and_clear();
     tracks.write_json(&args.out)?;
     if let Some(p) = &args.plot {
@@ -262,7 +248,7 @@ pub fn print_summary(tracks: &DriveTracks) {
         t.planes_ms,
         t.clusters_ms,
         t.filter_ms,
-        t.read_ms + t.planes_ms + t.clusters_ms + t.filter_ms,
+        t.total_ms(),
         if t.ego_ms > 0.0 {
             format!(" (+ lidar odometry {:.1})", t.ego_ms)
         } else {

@@ -47,8 +47,8 @@ pub struct LmbConfig {
     /// SMC multi-Bernoulli filter, IEEE TSP 2009), so the many unlikely tracks a cluttered
     /// scene proposes cost little; it is resampled to a new count only when its count is less
     /// than half or more than twice that number (or its effective sample size is low), so a
-    /// changing existence does not resample every step. 1 to `particles`. Default `None`:
-    /// every track keeps `particles`.
+    /// changing existence does not resample every step. At least 1; a value above `particles`
+    /// acts as `particles`. Default `None`: every track keeps `particles`.
     pub min_particles: Option<usize>,
     /// Resample a track when its effective sample size falls below this fraction of
     /// `particles` (1.0 resamples after every update that changed the weights). Default 0.5.
@@ -90,13 +90,11 @@ impl LmbConfig {
                 format!("{} is above the limit of {MAX_PARTICLES}", self.particles),
             ));
         }
-        if let Some(m) = self.min_particles {
-            if m == 0 || m > self.particles {
-                return Err(Error::invalid(
-                    "config field `min_particles`",
-                    format!("{m} outside [1, particles = {}]", self.particles),
-                ));
-            }
+        if self.min_particles == Some(0) {
+            return Err(Error::invalid(
+                "config field `min_particles`",
+                "must be positive",
+            ));
         }
         if !(0.0..=1.0).contains(&self.resample_threshold) {
             return Err(Error::invalid(
@@ -758,7 +756,7 @@ impl LmbFilter {
                     None => (cfg.particles, n != cfg.particles),
                     Some(min) => {
                         let scaled = (t.existence * cfg.particles as f64).ceil();
-                        let target = (scaled as usize).clamp(min, cfg.particles);
+                        let target = (scaled as usize).max(min).min(cfg.particles);
                         (target, 2 * n < target || n > 2 * target)
                     }
                 };

@@ -113,6 +113,13 @@ pub struct StageTimes {
     pub ego_ms: f64,
 }
 
+impl StageTimes {
+    /// Read, planes, clusters and filter: the frame's work without lidar odometry.
+    pub fn total_ms(&self) -> f64 {
+        self.read_ms + self.planes_ms + self.clusters_ms + self.filter_ms
+    }
+}
+
 /// One frame of the tracking output.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TrackedFrame {
