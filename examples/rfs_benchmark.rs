@@ -33,6 +33,10 @@ struct Args {
     /// Particles per track.
     #[arg(long, default_value_t = 1000)]
     particles: usize,
+    /// Scale each track's particles with its existence, keeping at least this many
+    /// (`LmbConfig::min_particles`; default: every track keeps `--particles`).
+    #[arg(long)]
+    min_particles: Option<usize>,
     /// Diversity after resampling: `none`, `roughening:K` or `regularised:SCALE`.
     #[arg(long, default_value = "regularised:0.2")]
     jitter: String,
@@ -140,6 +144,7 @@ fn main() -> Result<()> {
     anyhow::ensure!(args.runs > 0, "--runs must be at least 1");
     let config = LmbConfig {
         particles: args.particles,
+        min_particles: args.min_particles,
         resample_threshold: args.resample_threshold,
         jitter: parse_jitter(&args.jitter)?,
         prune_threshold: 1e-3,

@@ -11,7 +11,8 @@ use smc_lmb::kitti::tracking::TrackingCalib;
 use smc_lmb::kitti::TrackingSequence;
 use smc_lmb::pipeline::drive_tracking::kitti_out::{lmb_results, BaselineBoxes};
 use smc_lmb::pipeline::drive_tracking::{
-    drive_plot, point_labels, DriveTracks, EgoModel, FrameView, PoseSource, TrackingConfig,
+    drive_plot, frame_plot, point_labels, DriveTracks, EgoModel, FrameView, PoseSource,
+    TrackingConfig,
 };
 use smc_lmb::pipeline::kitti_results::{results_path, write_tracking_results, ResultObject};
 use smc_lmb::trackers::ab3dmot::Ab3dmotConfig;
@@ -59,6 +60,14 @@ pub struct Args {
     /// Bird's-eye plot of the drive (.svg or .png).
     #[arg(long)]
     plot: Option<PathBuf>,
+    /// Bird's-eye plot of one frame with its point cloud (.svg or .png; PNG is the lighter
+    /// for a whole cloud): points coloured by ground, walls and tracked clusters by class,
+    /// wall rectangles and cluster boxes, in the sensor frame. The frame is `--frame-plot-at`.
+    #[arg(long)]
+    frame_plot: Option<PathBuf>,
+    /// The frame `--frame-plot` draws (default: the first tracked frame).
+    #[arg(long, requires = "frame_plot")]
+    frame_plot_at: Option<usize>,
     /// Models and tuning (.toml or .json); see `TrackingConfig`.
     #[arg(long)]
     config: Option<PathBuf>,
@@ -160,6 +169,19 @@ pub fn run(args: Args) -> Result<()> {
         ProgressStyle::with_template("{bar:40} {pos}/{len} frames {elapsed} {msg}")
             .expect("valid template"),
     );
+    let recording = match (&args.drive, &args.odometry, &args.tracking, args.sequence) {
+        (Some(dir), _, _, _) => Recording::Raw(dir.clone()),
+        (None, Some(root), _, Some(n)) => Recording::Odometry(root.clone(), n),
+        (None, None, Some(root), Some(n)) => Recording::Tracking(root.clone(), n),
+        _ => bail!(
+            "give --drive DIR, --odometry ROOT --sequence NN or --tracking ROOT --sequence NNNN"
+        ),
+    };
+    let frame_plotted = std::cell::RefCell::new(false);
+    let plot_at = args
+        .frame_plot_at
+        .or(frames.as_ref().map(|r| r.start))
+        .unwrap_or(0);
     let on_frame = |view: &FrameView<'_>| -> smc_lmb::Result<()> {
         let (done, total) = view.progress;
         bar.set_length(total as u64);
@@ -173,6 +195,13 @@ pub fn run(args: Args) -> Result<()> {
             baseline.borrow_mut().add(view);
         }
         let k = view.tracked.frame;
+        if let Some(path) = &args.frame_plot {
+            if k == plot_at {
+                let name = recording.name();
+                frame_plot(view, &name, config.clusters.max_range).write(path, 1000)?;
+                *frame_plotted.borrow_mut() = true;
+            }
+        }
         if args.export_frames.is_empty() || args.export_frames.contains(&k) {
             let labels = point_labels(view.cloud.len(), view.detections, view.tracked);
             let name = format!("{k:010}");
@@ -185,19 +214,19 @@ pub fn run(args: Args) -> Result<()> {
         }
         Ok(())
     };
-    let recording = match (&args.drive, &args.odometry, &args.tracking, args.sequence) {
-        (Some(dir), _, _, _) => Recording::Raw(dir.clone()),
-        (None, Some(root), _, Some(n)) => Recording::Odometry(root.clone(), n),
-        (None, None, Some(root), Some(n)) => Recording::Tracking(root.clone(), n),
-        _ => bail!(
-            "give --drive DIR, --odometry ROOT --sequence NN or --tracking ROOT --sequence NNNN"
-        ),
-    };
-    let tracks = recording.track(frames, &config, args.seed, on_frame)?;
+    let tracks = recording.track(frames.clone(), &config, args.seed, on_frame)?;
     bar.finish_and_clear();
     tracks.write_json(&args.out)?;
     if let Some(p) = &args.plot {
         drive_plot(&tracks).write(p, 1000)?;
+    }
+    if let Some(p) = &args.frame_plot {
+        if !frame_plotted.into_inner() {
+            bail!(
+                "--frame-plot {}: frame {plot_at} was not tracked (see --frames)",
+                p.display()
+            );
+        }
     }
     print_summary(&tracks);
     println!("wrote {}", args.out.display());

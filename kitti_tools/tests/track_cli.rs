@@ -166,3 +166,44 @@ fn the_ego_flag_picks_the_pose_source_and_refuses_what_is_not_there() {
         "{stdout}"
     );
 }
+
+#[test]
+fn draws_one_frame_with_its_cloud_and_names_a_frame_not_tracked() {
+    let tmp = tempfile::tempdir().unwrap();
+    let drive = static_drive(tmp.path(), 2);
+    let out = tmp.path().join("tracks.json");
+    let plot = tmp.path().join("frame.png");
+    let args = |at: &str| {
+        vec![
+            "track".to_string(),
+            "--drive".into(),
+            drive.to_str().unwrap().into(),
+            "--particles".into(),
+            "200".into(),
+            "--out".into(),
+            out.to_str().unwrap().into(),
+            "--frame-plot".into(),
+            plot.to_str().unwrap().into(),
+            "--frame-plot-at".into(),
+            at.into(),
+            "--quiet".into(),
+        ]
+    };
+    fn strs(v: &[String]) -> Vec<&str> {
+        v.iter().map(String::as_str).collect()
+    }
+    let (ok, stdout, stderr) = run(&strs(&args("1")));
+    assert!(ok, "{stdout}\n{stderr}");
+    let png = std::fs::read(&plot).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+    // A whole cloud's points make the picture much heavier than an empty plot's frame.
+    assert!(png.len() > 20_000, "{} bytes", png.len());
+    std::fs::remove_file(&plot).unwrap();
+    let (ok, _, stderr) = run(&strs(&args("7")));
+    assert!(!ok);
+    assert!(
+        stderr.contains("frame 7 was not tracked") && stderr.contains("frame.png"),
+        "{stderr}"
+    );
+    assert!(!plot.exists());
+}

@@ -1,4 +1,4 @@
-//! Bird's-eye plots: poly-lines, segments and dots on a metric x–y plane at equal scale,
+//! Bird's-eye plots: point clouds, poly-lines, segments and dots on a metric x–y plane at equal scale,
 //! written as SVG or PNG (chosen by the file extension) with `plotters`, with a grid of round
 //! metre steps and tick labels, axis names, a scale bar, an optional title and legend. Text is
 //! drawn with [`text`], a 5×7 pixel font, so no font engine is needed (it serves the people
@@ -88,6 +88,16 @@ pub struct Dot {
     pub radius: u32,
 }
 
+/// Many points of one colour, drawn as single pixels under everything else (a point cloud
+/// seen from above).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PointLayer {
+    /// The points (x, y), metres.
+    pub points: Vec<[f64; 2]>,
+    /// RGB colour.
+    pub colour: [u8; 3],
+}
+
 /// How a legend entry shows its colour.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub enum LegendMark {
@@ -119,6 +129,8 @@ pub struct BirdsEyePlot {
     pub lines: Vec<Polyline>,
     /// Dots, drawn over the lines.
     pub dots: Vec<Dot>,
+    /// Point layers, drawn first, in order.
+    pub points: Vec<PointLayer>,
 }
 
 /// A round grid step (1, 2 or 5 × 10ⁿ) giving at most about `lines` lines over `span`.
@@ -161,6 +173,7 @@ impl BirdsEyePlot {
             .iter()
             .flat_map(|l| l.points.iter())
             .chain(self.dots.iter().map(|d| &d.at))
+            .chain(self.points.iter().flat_map(|l| l.points.iter()))
             .filter(|p| p[0].is_finite() && p[1].is_finite());
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for p in pts {
@@ -269,6 +282,19 @@ impl Draw for BirdsEyePlot {
             ink,
         )
         .map_err(err)?;
+        for layer in &self.points {
+            let [r, gr, b] = layer.colour;
+            let c = RGBColor(r, gr, b);
+            chart
+                .draw_series(
+                    layer
+                        .points
+                        .iter()
+                        .filter(|p| p[0].is_finite() && p[1].is_finite())
+                        .map(|p| Pixel::new((p[0], p[1]), c)),
+                )
+                .map_err(err)?;
+        }
         for l in &self.lines {
             let [r, gr, b] = l.colour;
             let pts: Vec<(f64, f64)> = l.points.iter().map(|p| (p[0], p[1])).collect();
@@ -390,6 +416,41 @@ mod tests {
         // The legend box is in the top-right corner of the plot area.
         let corner = |&&(x, y): &&(u32, u32)| x > w / 2 && y > 2 * TITLE_LINE && y < h / 3;
         assert!(dressed_px.iter().filter(|p| corner(p)).count() > 50);
+    }
+
+    #[test]
+    fn point_layers_are_pixels_inside_the_bounds() {
+        // A 10 × 10 grid of points 1 m apart; the bounds hold them with the 5 m margin.
+        let grid: Vec<[f64; 2]> = (0..100)
+            .map(|k| [(k % 10) as f64, (k / 10) as f64])
+            .collect();
+        let plot = BirdsEyePlot {
+            points: vec![PointLayer {
+                points: grid,
+                colour: [0, 0, 0],
+            }],
+            ..Default::default()
+        };
+        assert_eq!(plot.bounds().unwrap(), ([-5.0, 14.0], [-5.0, 14.0]));
+        // Each point is one dark pixel inside the plot area: 100 of them (the 19 m span at
+        // ≥ 10 px/m keeps them apart), and a plot without them has none there.
+        let (w, h) = (400, 384);
+        let inside = |px: &[(u32, u32)]| {
+            px.iter()
+                .filter(|&&(x, y)| {
+                    x > LEFT + 2 && x < w - RIGHT - 2 && y > TOP + 2 && y < h - BOTTOM - 2
+                })
+                .count()
+        };
+        assert_eq!(inside(&dark_pixels(&plot, w, h)), 100);
+        let empty = BirdsEyePlot {
+            points: vec![PointLayer {
+                points: Vec::new(),
+                colour: [0, 0, 0],
+            }],
+            ..Default::default()
+        };
+        assert_eq!(inside(&dark_pixels(&empty, w, h)), 0);
     }
 
     #[test]

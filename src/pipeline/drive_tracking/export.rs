@@ -40,6 +40,25 @@ pub fn point_labels(len: usize, detections: &FrameDetections, tracked: &TrackedF
 }
 
 #[cfg(feature = "plot")]
+/// The colour of walls in the plots.
+const WALL: [u8; 3] = [44, 160, 44];
+
+#[cfg(feature = "plot")]
+/// A wall rectangle's footprint in x–y: its two corners farthest apart.
+fn footprint(v: &[[f64; 3]; 4]) -> [[f64; 2]; 2] {
+    let mut best = (0.0, 0, 0);
+    for a in 0..4 {
+        for b in a + 1..4 {
+            let d = (v[a][0] - v[b][0]).hypot(v[a][1] - v[b][1]);
+            if d > best.0 {
+                best = (d, a, b);
+            }
+        }
+    }
+    [[v[best.1][0], v[best.1][1]], [v[best.2][0], v[best.2][1]]]
+}
+
+#[cfg(feature = "plot")]
 /// The colour of a cluster class in the drive plot (`None` for a name it does not know).
 fn class_colour(class: &str) -> Option<[u8; 3]> {
     Some(match class {
@@ -62,7 +81,6 @@ fn class_colour(class: &str) -> Option<[u8; 3]> {
 pub fn drive_plot(tracks: &DriveTracks) -> BirdsEyePlot {
     use crate::plot::{LegendEntry, LegendMark};
     use std::collections::{BTreeMap, BTreeSet};
-    const WALL: [u8; 3] = [44, 160, 44];
     let mut plot = BirdsEyePlot::default();
     let ego: Vec<[f64; 2]> = tracks
         .frames
@@ -87,18 +105,8 @@ pub fn drive_plot(tracks: &DriveTracks) -> BirdsEyePlot {
     }
     let wall_count = walls.len();
     for v in walls.into_values() {
-        // The two corners farthest apart in x–y span the wall's footprint.
-        let mut best = (0.0, 0, 0);
-        for a in 0..4 {
-            for b in a + 1..4 {
-                let d = (v[a][0] - v[b][0]).hypot(v[a][1] - v[b][1]);
-                if d > best.0 {
-                    best = (d, a, b);
-                }
-            }
-        }
         plot.lines.push(Polyline {
-            points: vec![[v[best.1][0], v[best.1][1]], [v[best.2][0], v[best.2][1]]],
+            points: footprint(&v).to_vec(),
             colour: WALL,
             width: 4,
         });
@@ -176,5 +184,126 @@ pub fn drive_plot(tracks: &DriveTracks) -> BirdsEyePlot {
         .push(entry("ego path", [0, 0, 0], LegendMark::Line(2)));
     plot.legend
         .push(entry("ego start", [0, 0, 0], LegendMark::Dot(4)));
+    plot
+}
+
+#[cfg(feature = "plot")]
+/// The bird's-eye plot of one frame in its sensor frame (x forward, y left), out to
+/// `max_range` metres: the cloud's points coloured by what they became (ground, wall inliers,
+/// points of a tracked cluster in its class colour, of an untracked cluster, the rest), each
+/// tracked wall's rectangle as a thick green segment, each tracked cluster's oriented box,
+/// and the sensor at the origin; `name` heads the title.
+pub fn frame_plot(view: &super::FrameView<'_>, name: &str, max_range: f64) -> BirdsEyePlot {
+    use crate::plot::{LegendEntry, LegendMark, PointLayer};
+    const GROUND: [u8; 3] = [205, 205, 205];
+    const REST: [u8; 3] = [150, 150, 150];
+    const UNTRACKED: [u8; 3] = [90, 90, 90];
+    const WALL_POINTS: [u8; 3] = [130, 205, 130];
+    let (cloud, det, tracked) = (view.cloud, view.detections, view.tracked);
+    // One colour per point: what it became.
+    let mut colour = vec![REST; cloud.len()];
+    let mut paint = |indices: &[u32], c: [u8; 3]| {
+        for &i in indices {
+            if let Some(slot) = colour.get_mut(i as usize) {
+                *slot = c;
+            }
+        }
+    };
+    paint(&det.ground, GROUND);
+    for w in &det.walls {
+        paint(&w.indices, WALL_POINTS);
+    }
+    for c in &det.clusters {
+        paint(&c.indices, UNTRACKED);
+    }
+    let cluster_colour = |c: &super::output::TrackedCluster| {
+        c.class
+            .as_deref()
+            .and_then(class_colour)
+            .unwrap_or_else(|| label_colour(c.id))
+    };
+    for c in &tracked.clusters {
+        if let Some(d) = c.detection.and_then(|j| det.clusters.get(j)) {
+            paint(&d.indices, cluster_colour(c));
+        }
+    }
+    // Layers by colour, the ground first so that everything else is drawn over it.
+    let mut layers: Vec<PointLayer> = Vec::new();
+    let (xs, ys) = (cloud.xs(), cloud.ys());
+    let mut shown = 0usize;
+    for i in 0..cloud.len() {
+        let (x, y) = (xs[i] as f64, ys[i] as f64);
+        let range = x.hypot(y);
+        if range.is_nan() || range > max_range {
+            continue;
+        }
+        shown += 1;
+        match layers.iter_mut().find(|l| l.colour == colour[i]) {
+            Some(l) => l.points.push([x, y]),
+            None => layers.push(PointLayer {
+                points: vec![[x, y]],
+                colour: colour[i],
+            }),
+        }
+    }
+    layers.sort_by_key(|l| l.colour != GROUND);
+    let mut plot = BirdsEyePlot {
+        points: layers,
+        ..Default::default()
+    };
+    for p in &tracked.planes {
+        if let Some(v) = &p.vertices {
+            plot.lines.push(Polyline {
+                points: footprint(v).to_vec(),
+                colour: WALL,
+                width: 4,
+            });
+        }
+    }
+    let mut classes = std::collections::BTreeSet::new();
+    for c in &tracked.clusters {
+        let Some(b) = &c.box_sensor else { continue };
+        let mut corners = b.to_box3().bev_corners().to_vec();
+        corners.push(corners[0]);
+        plot.lines.push(Polyline {
+            points: corners,
+            colour: cluster_colour(c),
+            width: 2,
+        });
+        if let Some(class) = c.class.as_deref().filter(|k| class_colour(k).is_some()) {
+            classes.insert(class.to_string());
+        }
+    }
+    plot.dots.push(Dot {
+        at: [0.0, 0.0],
+        colour: [0, 0, 0],
+        radius: 4,
+    });
+    plot.title = vec![
+        format!("{name}, frame {} (sensor frame)", tracked.frame),
+        format!(
+            "{shown} points within {max_range:.0} m; {} walls and {} clusters tracked",
+            tracked.planes.len(),
+            tracked.clusters.len()
+        ),
+    ];
+    let entry = |label: &str, colour: [u8; 3], mark: LegendMark| LegendEntry {
+        label: label.to_string(),
+        colour,
+        mark,
+    };
+    plot.legend = vec![
+        entry("ground", GROUND, LegendMark::Dot(2)),
+        entry("wall points, tracked walls", WALL, LegendMark::Line(4)),
+    ];
+    for class in &classes {
+        let colour = class_colour(class).expect("classes kept have a colour");
+        plot.legend.push(entry(class, colour, LegendMark::Line(2)));
+    }
+    plot.legend.extend([
+        entry("untracked clusters", UNTRACKED, LegendMark::Dot(2)),
+        entry("other points", REST, LegendMark::Dot(2)),
+        entry("sensor", [0, 0, 0], LegendMark::Dot(4)),
+    ]);
     plot
 }

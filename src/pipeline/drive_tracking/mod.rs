@@ -28,9 +28,9 @@ pub mod road_users;
 pub mod tracker;
 
 pub use detect::{detect_objects, ClusterDetection, FrameDetections, WallDetection};
-#[cfg(feature = "plot")]
-pub use export::drive_plot;
 pub use export::point_labels;
+#[cfg(feature = "plot")]
+pub use export::{drive_plot, frame_plot};
 pub use output::{
     DriveTracks, StageTimes, TrackedCluster, TrackedFrame, TrackedPlane, TrackingSummary,
 };
