@@ -8,14 +8,19 @@
 use nalgebra::{Isometry3, Matrix3, Matrix4, Rotation3, Translation3, UnitQuaternion};
 use numpy::ndarray::{Array2, ShapeBuilder};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods};
-use pyo3::exceptions::{PyOSError, PyValueError};
+use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyPermissionError, PyValueError};
 use pyo3::prelude::*;
 
-/// A library error as a Python exception: I/O problems as `OSError`, everything else (bad
+/// A library error as a Python exception: I/O problems as `OSError` (`FileNotFoundError`,
+/// `PermissionError` where they apply), everything else (bad
 /// values, parse errors) as `ValueError`, with the library's message (file, line, field).
 pub fn to_py_err(e: smc_lmb::Error) -> PyErr {
     match e {
-        smc_lmb::Error::Io { .. } => PyOSError::new_err(e.to_string()),
+        smc_lmb::Error::Io { ref source, .. } => match source.kind() {
+            std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(e.to_string()),
+            std::io::ErrorKind::PermissionDenied => PyPermissionError::new_err(e.to_string()),
+            _ => PyOSError::new_err(e.to_string()),
+        },
         _ => PyValueError::new_err(e.to_string()),
     }
 }
@@ -59,7 +64,9 @@ fn as_f64_array<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py,
 pub fn table(obj: &Bound<'_, PyAny>, what: &str, empty_cols: usize) -> PyResult<Table> {
     let arr = as_f64_array(obj, what)?;
     let arr = arr.cast_into::<numpy::PyArrayDyn<f64>>().map_err(|_| {
-        PyValueError::new_err(format!("{what}: numpy.asarray did not give a float64 array"))
+        PyValueError::new_err(format!(
+            "{what}: numpy.asarray did not give a float64 array"
+        ))
     })?;
     let ro = arr.readonly();
     let view = ro.as_array();
@@ -88,7 +95,9 @@ pub fn table(obj: &Bound<'_, PyAny>, what: &str, empty_cols: usize) -> PyResult<
 pub fn vector(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
     let arr = as_f64_array(obj, what)?;
     let arr = arr.cast_into::<numpy::PyArrayDyn<f64>>().map_err(|_| {
-        PyValueError::new_err(format!("{what}: numpy.asarray did not give a float64 array"))
+        PyValueError::new_err(format!(
+            "{what}: numpy.asarray did not give a float64 array"
+        ))
     })?;
     let ro = arr.readonly();
     let view = ro.as_array();

@@ -36,7 +36,11 @@ impl PyEstimate {
             "Estimate(label={:?}, existence={:.4}, state={}, age={})",
             self.label,
             self.existence,
-            self.state.bind(py).repr().map(|r| r.to_string()).unwrap_or_default(),
+            self.state
+                .bind(py)
+                .repr()
+                .map(|r| r.to_string())
+                .unwrap_or_default(),
             self.age
         )
     }
@@ -93,12 +97,15 @@ pub struct PyLmbFilter {
 fn read_config(config: &Bound<'_, PyAny>) -> PyResult<RunConfig> {
     if let Ok(s) = config.cast::<PyString>() {
         let text = s.to_str()?;
-        return toml::from_str(text).map_err(|e| {
-            PyValueError::new_err(format!("config (TOML): {}", e.message()))
-        });
+        return toml::from_str(text)
+            .map_err(|e| PyValueError::new_err(format!("config (TOML): {}", e.message())));
     }
     if config.cast::<PyDict>().is_ok() {
-        let json = config.py().import("json")?.getattr("dumps")?.call1((config,))?;
+        let json = config
+            .py()
+            .import("json")?
+            .getattr("dumps")?
+            .call1((config,))?;
         let text: String = json.extract()?;
         return serde_json::from_str(&text)
             .map_err(|e| PyValueError::new_err(format!("config: {e}")));
@@ -158,7 +165,10 @@ impl PyLmbFilter {
             }
             Ok(out)
         });
-        match (result, self.user_model.as_ref().and_then(|m| m.take_error())) {
+        match (
+            result,
+            self.user_model.as_ref().and_then(|m| m.take_error()),
+        ) {
             (Ok(out), None) => Ok(out),
             (result, Some(user)) => {
                 // Python 3.11+ keeps the library's view (which track, which step) as a note.
@@ -178,7 +188,11 @@ impl PyLmbFilter {
 impl PyLmbFilter {
     #[new]
     #[pyo3(signature = (config, transition=None))]
-    fn new(py: Python<'_>, config: &Bound<'_, PyAny>, transition: Option<Py<PyAny>>) -> PyResult<Self> {
+    fn new(
+        py: Python<'_>,
+        config: &Bound<'_, PyAny>,
+        transition: Option<Py<PyAny>>,
+    ) -> PyResult<Self> {
         let config = read_config(config)?;
         let (filter, user_model) = match transition {
             None => (lib(config.build())?, None),
@@ -211,7 +225,12 @@ impl PyLmbFilter {
         let z = table(measurements, "measurements", 0)?;
         let f = lib(frame(time, &z, platform(sensor_pose)?))?;
         let mut out = self.run_frames(py, vec![f])?;
-        Ok(out.pop().unwrap_or_default().into_iter().map(|e| estimate(py, e)).collect())
+        Ok(out
+            .pop()
+            .unwrap_or_default()
+            .into_iter()
+            .map(|e| estimate(py, e))
+            .collect())
     }
 
     /// Runs many frames in one call (`times[k]`, `measurements[k]`), the GIL released

@@ -97,8 +97,16 @@ fn ospa2<'py>(
     q: f64,
     window: Option<(usize, usize)>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let (a, b) = (histories(&truth, "truth")?, histories(&estimated, "estimated")?);
-    let steps = a.iter().chain(&b).map(|t| t.states.len()).max().unwrap_or(0);
+    let (a, b) = (
+        histories(&truth, "truth")?,
+        histories(&estimated, "estimated")?,
+    );
+    let steps = a
+        .iter()
+        .chain(&b)
+        .map(|t| t.states.len())
+        .max()
+        .unwrap_or(0);
     let (start, end) = window.unwrap_or((0, steps));
     if start > end {
         return Err(PyValueError::new_err(format!(
@@ -125,7 +133,10 @@ fn ospa2_series<'py>(
     p: f64,
     q: f64,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let (a, b) = (histories(&truth, "truth")?, histories(&estimated, "estimated")?);
+    let (a, b) = (
+        histories(&truth, "truth")?,
+        histories(&estimated, "estimated")?,
+    );
     let s = lib(py.detach(|| metrics::ospa2_series(&a, &b, window_len, c, p, q)))?;
     Ok(vec_array(py, s))
 }

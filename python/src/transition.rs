@@ -54,7 +54,13 @@ impl PyTransition {
         self.error.lock().unwrap_or_else(|p| p.into_inner()).take()
     }
 
-    fn call(&self, py: Python<'_>, particles: &mut ParticleSet, dt: f64, seed: u64) -> PyResult<()> {
+    fn call(
+        &self,
+        py: Python<'_>,
+        particles: &mut ParticleSet,
+        dt: f64,
+        seed: u64,
+    ) -> PyResult<()> {
         let (n, d) = (particles.len(), particles.dim());
         // The set is stored column by column: one Fortran-order array, no reordering.
         let data: Vec<f64> = particles.components().concat();
