@@ -252,3 +252,15 @@ def test_the_gil_is_released_while_the_filter_runs():
     inside = [x for x in ticks if t0 + 0.05 < x < t1 - 0.05]
     # With the GIL held throughout, the other thread could not tick at all in there.
     assert len(inside) > 10, (len(inside), t1 - t0)
+
+
+def test_the_custom_transition_example_tracks_its_three_objects():
+    example = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "examples", "custom_transition.py")
+    r = subprocess.run([sys.executable, example], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    last = r.stdout.strip().splitlines()[-1]
+    assert last.startswith("mean OSPA over 60 steps:"), r.stdout
+    # Three objects, position noise 0.5 m, c = 5 m: losing one object for good would cost
+    # about 5/3 m a step on its own.
+    assert float(last.split()[-2]) < 1.2, r.stdout
+    assert "step 60: 3 tracks" in r.stdout
