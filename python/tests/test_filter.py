@@ -264,3 +264,22 @@ def test_the_custom_transition_example_tracks_its_three_objects():
     # about 5/3 m a step on its own.
     assert float(last.split()[-2]) < 1.2, r.stdout
     assert "step 60: 3 tracks" in r.stdout
+
+
+def test_the_readme_example_runs_and_tracks_its_object(capsys):
+    from conftest import REPO
+
+    text = (REPO / "README.md").read_text()
+    block = text[text.index("## Python") :].split("```python\n", 1)[1].split("```", 1)[0]
+    cwd = os.getcwd()
+    os.chdir(REPO)
+    try:
+        exec(compile(block, "README.md (Python section)", "exec"), {})
+    finally:
+        os.chdir(cwd)
+    lines = capsys.readouterr().out.splitlines()
+    # The object moves along y = 5 from x = −10 at 2 m a step; at step 9 it is at (8, 5).
+    last = [l for l in lines if l.startswith("9 ")]
+    assert last, lines
+    x, y = (float(v) for v in last[-1].split("[")[1].rstrip("]").split())
+    assert abs(x - 8.0) < 1.0 and abs(y - 5.0) < 1.0, last
