@@ -84,6 +84,9 @@ impl PyTrack {
 /// `transition`, if given, is a callable `f(particles, dt, rng) -> particles` that replaces
 /// the configured motion model and must keep its state layout (the birth and measurement
 /// models read positions from it).
+///
+/// A step that raises (bad measurements, a library error, an exception of the motion model)
+/// may leave the filter part-way through that step; `reset()` starts it over.
 #[pyclass(name = "LmbFilter", module = "smc_lmb")]
 pub struct PyLmbFilter {
     filter: LmbFilter,
@@ -233,28 +236,34 @@ impl PyLmbFilter {
             .collect())
     }
 
-    /// Runs many frames in one call (`times[k]`, `measurements[k]`), the GIL released
-    /// throughout; returns the estimates of every frame.
+    /// Runs many frames in one call (`times[k]`, `measurements[k]`, optional
+    /// `sensor_poses[k]` as in `step`), the GIL released throughout; returns the estimates of
+    /// every frame.
+    #[pyo3(signature = (times, measurements, sensor_poses=None))]
     fn run(
         &mut self,
         py: Python<'_>,
         times: Vec<f64>,
         measurements: Vec<Bound<'_, PyAny>>,
+        sensor_poses: Option<Vec<Option<Vec<f64>>>>,
     ) -> PyResult<Vec<Vec<PyEstimate>>> {
-        if times.len() != measurements.len() {
+        let poses = sensor_poses.unwrap_or_else(|| vec![None; times.len()]);
+        if times.len() != measurements.len() || times.len() != poses.len() {
             return Err(PyValueError::new_err(format!(
-                "run: {} times but {} measurement arrays",
+                "run: {} times, {} measurement arrays and {} sensor poses",
                 times.len(),
-                measurements.len()
+                measurements.len(),
+                poses.len()
             )));
         }
         let frames = times
             .iter()
             .zip(&measurements)
+            .zip(poses)
             .enumerate()
-            .map(|(k, (&t, z))| {
+            .map(|(k, ((&t, z), pose))| {
                 let z = table(z, &format!("measurements[{k}]"), 0)?;
-                lib(frame(t, &z, None))
+                lib(frame(t, &z, platform(pose)?))
             })
             .collect::<PyResult<Vec<_>>>()?;
         let out = self.run_frames(py, frames)?;

@@ -283,3 +283,22 @@ def test_the_readme_example_runs_and_tracks_its_object(capsys):
     assert last, lines
     x, y = (float(v) for v in last[-1].split("[")[1].rstrip("]").split())
     assert abs(x - 8.0) < 1.0 and abs(y - 5.0) < 1.0, last
+
+
+def test_range_bearing_measurements_use_the_sensor_pose():
+    cfg = planar_config(clutter_rate=0.5)
+    cfg["measurement"] = {"model": "range_bearing", "sigma_range": 0.2, "sigma_bearing": 0.01}
+    cfg["clutter"]["volume"] = 50.0 * np.pi  # range 0–50 m × bearing −π/2–π/2
+    f = smc_lmb.LmbFilter(cfg)
+    rng = np.random.default_rng(2)
+    # A still object at (10, 5); the sensor drives along x at 1 m/s facing +x from (0, 0).
+    for k in range(15):
+        sx = float(k)
+        dx, dy = 10.0 - sx, 5.0
+        z = [[np.hypot(dx, dy) + rng.normal(0, 0.2), np.arctan2(dy, dx) + rng.normal(0, 0.01)]]
+        est = f.step(float(k), np.array(z), sensor_pose=[sx, 0.0, 0.0])
+    assert len(est) == 1
+    assert np.hypot(est[0].state[0] - 10.0, est[0].state[2] - 5.0) < 0.5, est
+    g = smc_lmb.LmbFilter(cfg)
+    with pytest.raises(ValueError, match="sensor_pose"):
+        g.step(0.0, np.array([[5.0, 0.1]]), sensor_pose=[1.0, 2.0])
