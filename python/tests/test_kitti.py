@@ -98,3 +98,68 @@ def test_real_tracking_labels_match_the_text():
     assert lab["type"] == [l[2] for l in lines]
     np.testing.assert_array_equal(lab["track_id"], [int(l[1]) for l in lines])
     np.testing.assert_allclose(lab["location"], [[float(v) for v in l[13:16]] for l in lines])
+
+
+def write_odometry_layout(root, poses_cam, tr, scans):
+    seq = root / "sequences" / "00"
+    (seq / "velodyne").mkdir(parents=True)
+    for k, s in enumerate(scans):
+        s.astype(np.float32).tofile(seq / "velodyne" / f"{k:06d}.bin")
+    proj = " ".join(["7.0e+02", "0", "6.0e+02", "0", "0", "7.0e+02", "1.8e+02", "0", "0", "0", "1", "0"])
+    lines = [f"P{i}: {proj}" for i in range(4)]
+    lines.append("Tr: " + " ".join(f"{v:.12e}" for v in tr[:3].ravel()))
+    (seq / "calib.txt").write_text("\n".join(lines) + "\n")
+    (seq / "times.txt").write_text("".join(f"{0.1 * k:.6e}\n" for k in range(len(scans))))
+    (root / "poses").mkdir()
+    (root / "poses" / "00.txt").write_text(
+        "".join(" ".join(f"{v:.12e}" for v in p[:3].ravel()) + "\n" for p in poses_cam)
+    )
+
+
+def test_an_odometry_layout_written_here_reads_back(tmp_path):
+    # Tr: Velodyne x → camera z, y → −x, z → −y, plus an offset (the KITTI mounting).
+    tr = np.eye(4)
+    tr[:3, :3] = [[0, -1, 0], [0, 0, -1], [1, 0, 0]]
+    tr[:3, 3] = [0.05, -0.08, -0.27]
+    # The camera drives forward (its z) 1 m a frame while turning about its y axis.
+    poses_cam = []
+    for k in range(3):
+        a = 0.05 * k
+        p = np.eye(4)
+        p[:3, :3] = [[np.cos(a), 0, np.sin(a)], [0, 1, 0], [-np.sin(a), 0, np.cos(a)]]
+        p[:3, 3] = [0.0, 0.0, float(k)]
+        poses_cam.append(p)
+    rng = np.random.default_rng(1)
+    scans = [rng.normal(0, 10, (50 + k, 4)) for k in range(3)]
+    write_odometry_layout(tmp_path, poses_cam, tr, scans)
+
+    seq = smc_lmb.OdometrySequence(tmp_path, 0)
+    assert (seq.name, seq.frame_count) == ("00", 3)
+    np.testing.assert_array_equal(seq.velodyne(2), scans[2].astype(np.float32))
+    np.testing.assert_allclose(seq.times(), [0.0, 0.1, 0.2])
+    # Velodyne poses V_k = Tr⁻¹ P_k Tr.
+    expected = np.array([np.linalg.inv(tr) @ p @ tr for p in poses_cam])
+    np.testing.assert_allclose(seq.poses(), expected, atol=1e-9)
+    # Forward in the camera is +x for the Velodyne: frame 2 is about 2 m ahead.
+    assert seq.poses()[2][0, 3] == pytest.approx(2.0, abs=0.1)
+
+
+def test_a_bad_pose_line_names_the_file_and_line(tmp_path):
+    write_odometry_layout(tmp_path, [np.eye(4)], np.eye(4), [np.zeros((1, 4))])
+    (tmp_path / "poses" / "00.txt").write_text("1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 oops 0 1 0 0 0 0 1 0\n")
+    with pytest.raises(ValueError, match=r"00.txt:2"):
+        smc_lmb.OdometrySequence(tmp_path, 0).poses()
+
+
+def test_real_tracking_sequence_poses_and_labels():
+    root = shared_data("kitti_tracking/training")
+    seq = smc_lmb.TrackingSequence(root, 0)
+    assert seq.name == "0000" and seq.frame_count == 50
+    poses = seq.poses()
+    assert poses.shape == (50, 4, 4)
+    np.testing.assert_allclose(poses[0], np.eye(4), atol=1e-12)
+    np.testing.assert_allclose(seq.times()[:3], [0.0, 0.1, 0.2])
+    lab = seq.labels()
+    direct = smc_lmb.read_tracking_labels(root / "label_02" / "0000.txt")
+    assert lab["type"] == direct["type"]
+    np.testing.assert_array_equal(lab["frame"], direct["frame"])
