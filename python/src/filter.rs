@@ -100,8 +100,15 @@ pub struct PyLmbFilter {
 fn read_config(config: &Bound<'_, PyAny>) -> PyResult<RunConfig> {
     if let Ok(s) = config.cast::<PyString>() {
         let text = s.to_str()?;
-        return toml::from_str(text)
-            .map_err(|e| PyValueError::new_err(format!("config (TOML): {}", e.message())));
+        return toml::from_str(text).map_err(|e| {
+            let line = e.span().map_or(0, |sp| {
+                1 + text.as_bytes()[..sp.start.min(text.len())]
+                    .iter()
+                    .filter(|&&b| b == b'\n')
+                    .count()
+            });
+            PyValueError::new_err(format!("config (TOML) line {line}: {}", e.message()))
+        });
     }
     if config.cast::<PyDict>().is_ok() {
         let json = config

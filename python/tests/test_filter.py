@@ -217,6 +217,10 @@ def test_bad_configurations_and_frames_are_value_errors():
         smc_lmb.LmbFilter(cfg)
     with pytest.raises(ValueError, match="TOML"):
         smc_lmb.LmbFilter("this is = not toml [")
+    # toml places an unknown key at its table's header: `[measurement]`, line 9 of the text
+    # (which starts with a newline).
+    with pytest.raises(ValueError, match=r"line 9: unknown field `sigmaa`"):
+        smc_lmb.LmbFilter(TOML.replace("sigma = 0.5", "sigmaa = 0.5"))
     f = smc_lmb.LmbFilter(planar_config())
     with pytest.raises(ValueError, match="dimension 3"):
         f.step(0.0, np.zeros((2, 3)))
