@@ -10,6 +10,7 @@ use numpy::ndarray::{Array2, ShapeBuilder};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods};
 use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyPermissionError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
 
 /// A library error as a Python exception: I/O problems as `OSError` (`FileNotFoundError`,
 /// `PermissionError` where they apply), everything else (bad
@@ -193,4 +194,36 @@ pub fn fixed_rows<'py, const N: usize>(
     let data: Vec<f64> = rows.into_iter().flatten().collect();
     let n = data.len() / N;
     rows_array(py, n, N, data)
+}
+
+/// Reads a configuration of type `T` (any serde type of the library) from a dict (through
+/// JSON) or TOML text; errors name `what` and, for TOML, the line.
+pub fn read_config_as<T: serde::de::DeserializeOwned>(
+    config: &Bound<'_, PyAny>,
+    what: &str,
+) -> PyResult<T> {
+    if let Ok(s) = config.cast::<PyString>() {
+        let text = s.to_str()?;
+        return toml::from_str(text).map_err(|e| {
+            let line = e.span().map_or(0, |sp| {
+                1 + text.as_bytes()[..sp.start.min(text.len())]
+                    .iter()
+                    .filter(|&&b| b == b'\n')
+                    .count()
+            });
+            PyValueError::new_err(format!("{what} (TOML) line {line}: {}", e.message()))
+        });
+    }
+    if config.cast::<PyDict>().is_ok() {
+        let json = config
+            .py()
+            .import("json")?
+            .getattr("dumps")?
+            .call1((config,))?;
+        let text: String = json.extract()?;
+        return serde_json::from_str(&text).map_err(|e| PyValueError::new_err(format!("{what}: {e}")));
+    }
+    Err(PyValueError::new_err(format!(
+        "{what}: expected a dict or TOML text"
+    )))
 }

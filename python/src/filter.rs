@@ -11,7 +11,6 @@ use nalgebra::{Isometry3, Vector3};
 use numpy::{PyArray1, PyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyString};
 use smc_lmb::config::{RunConfig, TransitionConfig};
 use smc_lmb::filter::{Estimate, Frame, LmbFilter, Measurements};
 use smc_lmb::rng::seeded;
@@ -98,31 +97,7 @@ pub struct PyLmbFilter {
 
 /// Reads a run configuration from a dict (through JSON) or TOML text.
 fn read_config(config: &Bound<'_, PyAny>) -> PyResult<RunConfig> {
-    if let Ok(s) = config.cast::<PyString>() {
-        let text = s.to_str()?;
-        return toml::from_str(text).map_err(|e| {
-            let line = e.span().map_or(0, |sp| {
-                1 + text.as_bytes()[..sp.start.min(text.len())]
-                    .iter()
-                    .filter(|&&b| b == b'\n')
-                    .count()
-            });
-            PyValueError::new_err(format!("config (TOML) line {line}: {}", e.message()))
-        });
-    }
-    if config.cast::<PyDict>().is_ok() {
-        let json = config
-            .py()
-            .import("json")?
-            .getattr("dumps")?
-            .call1((config,))?;
-        let text: String = json.extract()?;
-        return serde_json::from_str(&text)
-            .map_err(|e| PyValueError::new_err(format!("config: {e}")));
-    }
-    Err(PyValueError::new_err(
-        "config: expected a dict or TOML text",
-    ))
+    crate::convert::read_config_as(config, "config")
 }
 
 fn state_dim(config: &RunConfig) -> usize {

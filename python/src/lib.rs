@@ -1,5 +1,5 @@
 //! The `smc_lmb` Python module: the library's filter, KITTI readers, plane segmentation and
-//! prediction, and multi-object metrics, with NumPy arrays in and out. Every call that does
+//! prediction, the drive tracker over whole recordings, and multi-object metrics, with NumPy arrays in and out. Every call that does
 //! Rust work releases the GIL while it runs; library errors become Python exceptions carrying
 //! the library's message (which names the file, line and field where there is one).
 //!
@@ -7,6 +7,7 @@
 //! library, and converts the result; the meaning lives in `smc_lmb` (the Rust crate).
 
 mod convert;
+mod drives;
 mod filter;
 mod kitti;
 mod metrics;
@@ -21,6 +22,7 @@ use pyo3::prelude::*;
 #[pymodule(name = "smc_lmb")]
 fn smc_lmb_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    drives::register(m)?;
     filter::register(m)?;
     kitti::register(m)?;
     metrics::register(m)?;

@@ -1,0 +1,129 @@
+//! Whole recordings for Python: `track` runs the library's drive tracker (walls and clusters,
+//! one LMB filter) over a KITTI raw drive, tracking or odometry sequence and returns its
+//! summary, writing the per-frame tracks as JSON on request; `tracks_summary` reads that
+//! summary back from such a file; `synth_street` writes the simulated street as a raw drive.
+//! They are what a batch over many recordings (e.g. on Ray) needs.
+//!
+//! Not for: the tracker itself (`smc_lmb::pipeline::drive_tracking`).
+
+use crate::convert::{lib, read_config_as};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use smc_lmb::kitti::{OdometrySequence, RawDrive, TrackingSequence};
+use smc_lmb::pipeline::drive_tracking::{
+    track_drive, track_odometry_sequence, track_tracking_sequence, DriveTracks, TrackingConfig,
+};
+use smc_lmb::sim::street::{write_drive, StreetConfig};
+use std::path::PathBuf;
+
+/// A run's summary as a dict: `name`, `frames`, `ego`, `walls_per_frame`,
+/// `clusters_per_frame`, `wall_labels`, `cluster_labels`, `ms_per_frame` (read, planes,
+/// clusters and filter) and `odometry_ms_per_frame`.
+fn summary<'py>(py: Python<'py>, t: &DriveTracks) -> PyResult<Bound<'py, PyDict>> {
+    let s = &t.summary;
+    let d = PyDict::new(py);
+    d.set_item("name", &t.drive)?;
+    d.set_item("frames", s.frames)?;
+    d.set_item("ego", &t.ego)?;
+    d.set_item("walls_per_frame", s.mean_planes)?;
+    d.set_item("clusters_per_frame", s.mean_clusters)?;
+    d.set_item("wall_labels", s.plane_labels)?;
+    d.set_item("cluster_labels", s.cluster_labels)?;
+    d.set_item("ms_per_frame", s.mean_times.total_ms())?;
+    d.set_item("odometry_ms_per_frame", s.mean_times.ego_ms)?;
+    Ok(d)
+}
+
+/// Tracks walls and clusters over a whole recording with one LMB filter and returns the run's
+/// summary (see `tracks_summary`). `layout` is `"raw"` (`path` a raw drive folder),
+/// `"tracking"` (`path` a tracking split folder, with `sequence`) or `"odometry"` (`path` an
+/// odometry root, with `sequence`). `config` is the tracking configuration (`TrackingConfig`:
+/// a dict or TOML text; default: the library's); `particles` overrides its particles per
+/// track. With `out`, the per-frame tracks are written there as JSON (atomically), as
+/// `kitti-tools track --out` writes them. The GIL is released while it runs.
+#[pyfunction]
+#[pyo3(signature = (path, layout = "raw", sequence = None, out = None, config = None, seed = 1, particles = None))]
+#[allow(clippy::too_many_arguments)]
+fn track<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    layout: &str,
+    sequence: Option<u32>,
+    out: Option<PathBuf>,
+    config: Option<&Bound<'py, PyAny>>,
+    seed: u64,
+    particles: Option<usize>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let mut cfg: TrackingConfig = match config {
+        Some(c) => read_config_as(c, "tracking config")?,
+        None => TrackingConfig::default(),
+    };
+    if let Some(n) = particles {
+        cfg.filter.particles = n;
+    }
+    let need_sequence = || {
+        sequence.ok_or_else(|| {
+            PyValueError::new_err(format!("layout \"{layout}\" needs a sequence number"))
+        })
+    };
+    let none = |_: &smc_lmb::pipeline::drive_tracking::FrameView<'_>| Ok(());
+    let tracks = match layout {
+        "raw" => py.detach(|| {
+            let drive = RawDrive::open(&path)?;
+            track_drive(&drive, None, &cfg, seed, none)
+        }),
+        "tracking" => {
+            let n = need_sequence()?;
+            py.detach(|| {
+                let seq = TrackingSequence::open(&path, n)?;
+                track_tracking_sequence(&seq, None, &cfg, seed, none)
+            })
+        }
+        "odometry" => {
+            let n = need_sequence()?;
+            py.detach(|| {
+                let seq = OdometrySequence::open(&path, n)?;
+                track_odometry_sequence(&seq, None, &cfg, seed, none)
+            })
+        }
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "layout \"{other}\": expected \"raw\", \"tracking\" or \"odometry\""
+            )))
+        }
+    };
+    let tracks = lib(tracks)?;
+    if let Some(out) = &out {
+        lib(py.detach(|| tracks.write_json(out)))?;
+    }
+    summary(py, &tracks)
+}
+
+/// The summary (as `track` returns it) of a tracks file written by `track(out=...)` or
+/// `kitti-tools track --out`.
+#[pyfunction]
+fn tracks_summary<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>> {
+    let tracks = lib(py.detach(|| DriveTracks::read_json(&path)))?;
+    summary(py, &tracks)
+}
+
+/// Writes the simulated street (the library's default street: walls, parked and moving cars,
+/// pedestrians) as a KITTI raw drive under `out` (`out/DATE/DATE_drive_NNNN_sync`, with OXTS,
+/// calibration and `truth.json`) and returns the drive folder. `drive` is the drive number
+/// NNNN, so that several streets can share one `out`.
+#[pyfunction]
+#[pyo3(signature = (out, frames = 40, seed = 1, drive = 1))]
+fn synth_street(py: Python<'_>, out: PathBuf, frames: usize, seed: u64, drive: u32) -> PyResult<String> {
+    let mut config = StreetConfig::default();
+    config.recording.drive_number = drive;
+    let written = lib(py.detach(|| write_drive(&out, &config, frames, seed, |_| {})))?;
+    Ok(written.dir.display().to_string())
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(track, m)?)?;
+    m.add_function(wrap_pyfunction!(tracks_summary, m)?)?;
+    m.add_function(wrap_pyfunction!(synth_street, m)?)?;
+    Ok(())
+}
