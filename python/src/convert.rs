@@ -221,7 +221,8 @@ pub fn read_config_as<T: serde::de::DeserializeOwned>(
             .getattr("dumps")?
             .call1((config,))?;
         let text: String = json.extract()?;
-        return serde_json::from_str(&text).map_err(|e| PyValueError::new_err(format!("{what}: {e}")));
+        return serde_json::from_str(&text)
+            .map_err(|e| PyValueError::new_err(format!("{what}: {e}")));
     }
     Err(PyValueError::new_err(format!(
         "{what}: expected a dict or TOML text"

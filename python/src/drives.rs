@@ -114,7 +114,13 @@ fn tracks_summary<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, Py
 /// NNNN, so that several streets can share one `out`.
 #[pyfunction]
 #[pyo3(signature = (out, frames = 40, seed = 1, drive = 1))]
-fn synth_street(py: Python<'_>, out: PathBuf, frames: usize, seed: u64, drive: u32) -> PyResult<String> {
+fn synth_street(
+    py: Python<'_>,
+    out: PathBuf,
+    frames: usize,
+    seed: u64,
+    drive: u32,
+) -> PyResult<String> {
     let mut config = StreetConfig::default();
     config.recording.drive_number = drive;
     let written = lib(py.detach(|| write_drive(&out, &config, frames, seed, |_| {})))?;
