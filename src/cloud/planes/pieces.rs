@@ -104,42 +104,41 @@ pub(super) fn connected_pieces(
     cell: f64,
     min_cell: usize,
 ) -> Vec<Vec<u32>> {
-    let (u, v) = plane.basis();
-    let inv = 1.0 / cell;
-    let cell_of = |i: u32| {
-        let p = pts[i as usize];
-        let q = Vector3::new(p[0] as f64, p[1] as f64, p[2] as f64);
-        (
-            (q.dot(&u) * inv).floor() as i64,
-            (q.dot(&v) * inv).floor() as i64,
-        )
-    };
-    let cells: Vec<(i64, i64)> = idx.iter().map(|&i| cell_of(i)).collect();
-    let mut counts: HashMap<(i64, i64), usize> = HashMap::with_capacity(idx.len() / 4);
-    for c in &cells {
-        *counts.entry(*c).or_default() += 1;
-    }
-    // Occupied cell -> component id (usize::MAX = not yet labelled).
-    let mut label: HashMap<(i64, i64), usize> = counts
+    let cells = plane_cells(plane, idx, pts, cell);
+    let grid = CellSlots::new(&cells);
+    let slots: Vec<usize> = cells
         .iter()
-        .filter(|(_, &n)| n >= min_cell.max(1))
-        .map(|(c, _)| (*c, usize::MAX))
+        .map(|&c| grid.slot(c).expect("every point's cell has a slot"))
+        .collect();
+    let mut counts = vec![0usize; grid.len()];
+    for &s in &slots {
+        counts[s] += 1;
+    }
+    // Per slot: the component, UNSEEN for a cell kept but not yet labelled, OUT otherwise.
+    const UNSEEN: usize = usize::MAX - 1;
+    const OUT: usize = usize::MAX;
+    let mut label: Vec<usize> = counts
+        .iter()
+        .map(|&n| if n >= min_cell.max(1) { UNSEEN } else { OUT })
         .collect();
     let mut n_comp = 0usize;
     let mut stack: Vec<(i64, i64)> = Vec::new();
-    for c in &cells {
-        if label.get(c).is_none_or(|&l| l != usize::MAX) {
+    for (&c, &s) in cells.iter().zip(&slots) {
+        if label[s] != UNSEEN {
             continue;
         }
-        label.insert(*c, n_comp);
-        stack.push(*c);
+        label[s] = n_comp;
+        stack.push(c);
         while let Some((cx, cy)) = stack.pop() {
-            for dx in -1..=1 {
-                for dy in -1..=1 {
-                    let nb = (cx + dx, cy + dy);
-                    if let Some(l) = label.get_mut(&nb) {
-                        if *l == usize::MAX {
-                            *l = n_comp;
+            for dx in -1..=1i64 {
+                for dy in -1..=1i64 {
+                    let nb = match (cx.checked_add(dx), cy.checked_add(dy)) {
+                        (Some(x), Some(y)) => (x, y),
+                        _ => continue,
+                    };
+                    if let Some(t) = grid.slot(nb) {
+                        if label[t] == UNSEEN {
+                            label[t] = n_comp;
                             stack.push(nb);
                         }
                     }
@@ -149,10 +148,165 @@ pub(super) fn connected_pieces(
         n_comp += 1;
     }
     let mut pieces: Vec<Vec<u32>> = vec![Vec::new(); n_comp];
-    for (&i, c) in idx.iter().zip(&cells) {
-        if let Some(&l) = label.get(c) {
-            pieces[l].push(i);
+    for (&i, &s) in idx.iter().zip(&slots) {
+        if label[s] < UNSEEN {
+            pieces[label[s]].push(i);
         }
     }
     pieces
+}
+
+/// The grid cell (edge `cell`, in the plane's own coordinates) of each point `idx`.
+fn plane_cells(plane: &Plane, idx: &[u32], pts: &[[f32; 3]], cell: f64) -> Vec<(i64, i64)> {
+    let (u, v) = plane.basis();
+    let inv = 1.0 / cell;
+    idx.iter()
+        .map(|&i| {
+            let p = pts[i as usize];
+            let q = Vector3::new(p[0] as f64, p[1] as f64, p[2] as f64);
+            (
+                (q.dot(&u) * inv).floor() as i64,
+                (q.dot(&v) * inv).floor() as i64,
+            )
+        })
+        .collect()
+}
+
+/// Numbers the cells of a set: every cell of the bounding box when the box is small (a plane's
+/// pieces fill much of theirs), else only the occupied cells through a hash table.
+enum CellSlots {
+    /// Row-major over the box `[x0, x0 + w) × [y0, y0 + h)`.
+    Dense { x0: i64, y0: i64, w: i64, h: i64 },
+    /// One slot per occupied cell.
+    Sparse(HashMap<(i64, i64), usize>),
+}
+
+impl CellSlots {
+    fn new(cells: &[(i64, i64)]) -> Self {
+        let (mut lo, mut hi) = ((i64::MAX, i64::MAX), (i64::MIN, i64::MIN));
+        for &(x, y) in cells {
+            lo = (lo.0.min(x), lo.1.min(y));
+            hi = (hi.0.max(x), hi.1.max(y));
+        }
+        let extent = |a: i64, b: i64| (b as i128 - a as i128 + 1).max(0);
+        let area = extent(lo.0, hi.0) * extent(lo.1, hi.1);
+        if !cells.is_empty() && area <= 4 * cells.len() as i128 + 4096 {
+            return CellSlots::Dense {
+                x0: lo.0,
+                y0: lo.1,
+                w: extent(lo.0, hi.0) as i64,
+                h: extent(lo.1, hi.1) as i64,
+            };
+        }
+        let mut map = HashMap::with_capacity(cells.len() / 4);
+        for &c in cells {
+            let next = map.len();
+            map.entry(c).or_insert(next);
+        }
+        CellSlots::Sparse(map)
+    }
+
+    /// Number of slots.
+    fn len(&self) -> usize {
+        match self {
+            CellSlots::Dense { w, h, .. } => (w * h) as usize,
+            CellSlots::Sparse(map) => map.len(),
+        }
+    }
+
+    /// The slot of cell `c` (`None` outside the box or not occupied).
+    fn slot(&self, c: (i64, i64)) -> Option<usize> {
+        match self {
+            CellSlots::Dense { x0, y0, w, h } => {
+                let (dx, dy) = (c.0 as i128 - *x0 as i128, c.1 as i128 - *y0 as i128);
+                ((0..*w as i128).contains(&dx) && (0..*h as i128).contains(&dy))
+                    .then(|| (dx + dy * *w as i128) as usize)
+            }
+            CellSlots::Sparse(map) => map.get(&c).copied(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The pieces by their definition: two kept cells are joined when they touch (including
+    /// diagonally), found by repeated merging of cell sets without any grid index.
+    fn pieces_by_definition(cells: &[(i64, i64)], min_cell: usize) -> Vec<Vec<usize>> {
+        let mut count: std::collections::BTreeMap<(i64, i64), usize> = Default::default();
+        for &c in cells {
+            *count.entry(c).or_default() += 1;
+        }
+        let kept: Vec<(i64, i64)> = count
+            .iter()
+            .filter(|(_, &n)| n >= min_cell.max(1))
+            .map(|(&c, _)| c)
+            .collect();
+        let mut comp: Vec<usize> = (0..kept.len()).collect();
+        loop {
+            let mut changed = false;
+            for a in 0..kept.len() {
+                for b in 0..kept.len() {
+                    let touch =
+                        (kept[a].0 - kept[b].0).abs() <= 1 && (kept[a].1 - kept[b].1).abs() <= 1;
+                    if touch && comp[a] != comp[b] {
+                        let m = comp[a].min(comp[b]);
+                        comp[a] = m;
+                        comp[b] = m;
+                        changed = true;
+                    }
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+        // Points grouped by component, components in order of their first point.
+        let mut order: Vec<usize> = Vec::new();
+        let mut groups: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
+        for (k, c) in cells.iter().enumerate() {
+            if let Ok(j) = kept.binary_search(c) {
+                if !groups.contains_key(&comp[j]) {
+                    order.push(comp[j]);
+                }
+                groups.entry(comp[j]).or_default().push(k);
+            }
+        }
+        order.iter().map(|c| groups[c].clone()).collect()
+    }
+
+    proptest! {
+        #[test]
+        fn pieces_are_the_touching_cell_sets(
+            raw in proptest::collection::vec((-12i64..12, -6i64..6), 0..120),
+            far in proptest::option::of(1_000_000i64..2_000_000),
+            min_cell in 1usize..3,
+        ) {
+            // Points of a vertical plane x = 0 (basis u, v of its normal), one per listed cell
+            // centre, and optionally one cell far away (the sparse index).
+            let plane = Plane::from_point_normal(&Point3::origin(), Vector3::x()).unwrap();
+            let (u, v) = plane.basis();
+            let mut cells = raw.clone();
+            if let Some(f) = far {
+                cells.push((f, 0));
+            }
+            let pts: Vec<[f32; 3]> = cells
+                .iter()
+                .map(|&(a, b)| {
+                    let p = u * (a as f64 + 0.5) + v * (b as f64 + 0.5);
+                    [p.x as f32, p.y as f32, p.z as f32]
+                })
+                .collect();
+            let idx: Vec<u32> = (0..pts.len() as u32).collect();
+            prop_assert_eq!(plane_cells(&plane, &idx, &pts, 1.0), cells.clone());
+            let got = connected_pieces(&plane, &idx, &pts, 1.0, min_cell);
+            let want: Vec<Vec<u32>> = pieces_by_definition(&cells, min_cell)
+                .into_iter()
+                .map(|g| g.into_iter().map(|k| k as u32).collect())
+                .collect();
+            prop_assert_eq!(got, want);
+        }
+    }
 }
