@@ -5,6 +5,7 @@
 
 use crate::geometry::Plane;
 use nalgebra::{Point3, Vector3};
+use rayon::prelude::*;
 use std::collections::HashMap;
 
 /// RMS distance of the points `idx` to `plane`.
@@ -35,13 +36,10 @@ pub(super) fn hull_candidates(plane: &Plane, idx: &[u32], pts: &[[f32; 3]]) -> V
     }
     let (u, v) = plane.basis();
     let origin = plane.project(&point64(pts[idx[0] as usize]));
-    let uv: Vec<[f64; 2]> = idx
-        .iter()
-        .map(|&i| {
-            let q = point64(pts[i as usize]) - origin;
-            [q.dot(&u), q.dot(&v)]
-        })
-        .collect();
+    let uv_of = |i: u32| {
+        let q = point64(pts[i as usize]) - origin;
+        [q.dot(&u), q.dot(&v)]
+    };
     // Directions in counter-clockwise order; their extreme points lie on the hull in order.
     const DIRS: [[f64; 2]; 8] = [
         [1.0, 0.0],
@@ -53,13 +51,27 @@ pub(super) fn hull_candidates(plane: &Plane, idx: &[u32], pts: &[[f32; 3]]) -> V
         [0.0, -1.0],
         [1.0, -1.0],
     ];
-    // One pass for the extreme point in every direction (ties: the earliest point).
+    // The extreme point in every direction (ties: the earliest point): per chunk of points in
+    // parallel, then the chunks in order, a later one winning only when strictly beyond.
+    let extremes = |chunk: &[u32]| {
+        let mut best = [(f64::NEG_INFINITY, [0.0f64; 2]); 8];
+        for &i in chunk {
+            let q = uv_of(i);
+            for (b, d) in best.iter_mut().zip(&DIRS) {
+                let s = q[0] * d[0] + q[1] * d[1];
+                if s > b.0 {
+                    *b = (s, q);
+                }
+            }
+        }
+        best
+    };
+    let per_chunk: Vec<_> = idx.par_chunks(HULL_CHUNK).map(extremes).collect();
     let mut best = [(f64::NEG_INFINITY, [0.0f64; 2]); 8];
-    for q in &uv {
-        for (b, d) in best.iter_mut().zip(&DIRS) {
-            let s = q[0] * d[0] + q[1] * d[1];
-            if s > b.0 {
-                *b = (s, *q);
+    for chunk in per_chunk {
+        for (b, c) in best.iter_mut().zip(chunk) {
+            if c.0 > b.0 {
+                *b = c;
             }
         }
     }
@@ -85,13 +97,15 @@ pub(super) fn hull_candidates(plane: &Plane, idx: &[u32], pts: &[[f32; 3]]) -> V
             (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]) > MARGIN * len
         })
     };
-    idx.iter()
-        .zip(&uv)
+    idx.par_iter()
         .enumerate()
-        .filter(|(k, (_, q))| *k == 0 || !inside(q))
-        .map(|(_, (&i, _))| point64(pts[i as usize]))
+        .filter(|&(k, &i)| k == 0 || !inside(&uv_of(i)))
+        .map(|(_, &i)| point64(pts[i as usize]))
         .collect()
 }
+
+/// Points per parallel chunk of [`hull_candidates`].
+const HULL_CHUNK: usize = 8192;
 
 /// Splits the points `idx` of `plane` into spatially connected pieces: flood fill with
 /// 8-connectivity over the occupied cells of a 2-D grid (edge `cell`) in the plane's
@@ -278,6 +292,37 @@ mod tests {
     }
 
     proptest! {
+        #![proptest_config(ProptestConfig::with_cases(24))]
+        #[test]
+        fn hull_candidates_keep_the_patch_of_all_points(
+            n in 64usize..20_000,
+            seed in 0u64..1000,
+            tilt in 0.0f64..1.5,
+        ) {
+            // Points scattered over a blob on a tilted plane (several parallel chunks when n
+            // is large): the rectangle of the candidates is that of all points.
+            use rand::RngExt;
+            let mut rng = crate::rng::seeded(seed);
+            let normal = Vector3::new(tilt.sin(), 0.2, tilt.cos());
+            let plane = Plane::from_point_normal(&Point3::new(1.0, 2.0, 3.0), normal).unwrap();
+            let (u, v) = plane.basis();
+            let pts: Vec<[f32; 3]> = (0..n)
+                .map(|_| {
+                    let (a, b): (f64, f64) = (rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+                    let p = Point3::new(1.0, 2.0, 3.0) + u * (20.0 * a * a.abs()) + v * (5.0 * b);
+                    [p.x as f32, p.y as f32, p.z as f32]
+                })
+                .collect();
+            let idx: Vec<u32> = (0..n as u32).rev().collect();
+            let all: Vec<Point3<f64>> = idx.iter().map(|&i| point64(pts[i as usize])).collect();
+            let cand = hull_candidates(&plane, &idx, &pts);
+            prop_assert!(cand.len() < all.len() / 2, "{} of {}", cand.len(), all.len());
+            prop_assert_eq!(cand[0], all[0]);
+            let whole = crate::geometry::PlanePatch::from_points(plane, &all).unwrap();
+            let kept = crate::geometry::PlanePatch::from_points(plane, &cand).unwrap();
+            prop_assert_eq!(kept, whole);
+        }
+
         #[test]
         fn pieces_are_the_touching_cell_sets(
             raw in proptest::collection::vec((-12i64..12, -6i64..6), 0..120),
