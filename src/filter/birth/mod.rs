@@ -6,11 +6,26 @@
 //! measurement of the previous step that the existing tracks explained poorly proposes a new
 //! track, with an existence probability that grows with how unexplained it was. Not for:
 //! assigning labels (the filter does that).
+//!
+//! A static birth term is a broad density, and few of its particles would land where a new
+//! object is seen. Given a [`BirthProposal`] (the default in [`crate::config`]), static birth
+//! samples each term from a mixture of the term and the term conditioned on each of the
+//! step's measurements that no existing track explains ([`proposal`], [`unexplained`]), and
+//! weights the particles prior / proposal: the same birth density, better sampled. The filter
+//! hands a birth model the step's measurements through [`BirthModel::birth_guided`].
+
+mod proposal;
+mod unexplained;
+
+pub use proposal::{BirthProposal, DEFAULT_PRIOR_SHARE};
+pub use unexplained::unexplained;
 
 use super::{Measurements, ParticleSet};
 use crate::error::{ensure_finite, Error, Result};
 use crate::filter::{StepContext, MAX_PARTICLES};
-use crate::rng::FilterRng;
+use crate::rng::{stream, FilterRng};
+use rand::Rng;
+use rayon::prelude::*;
 
 /// A proposed new track, before it gets its label.
 #[derive(Clone, Debug, PartialEq)]
@@ -35,6 +50,17 @@ pub struct BirthEvidence<'a> {
     pub context: &'a StepContext,
 }
 
+/// The step's own measurements, the ones its birth tracks will be updated with, for birth
+/// models that sample where they are.
+#[derive(Clone, Debug)]
+pub struct CurrentMeasurements<'a> {
+    /// This step's measurements.
+    pub measurements: &'a Measurements,
+    /// For each of them, u(z) ∈ [0, 1]: how unexplained the predicted tracks leave it (see
+    /// [`unexplained`]). An empty slice means every measurement counts as unexplained.
+    pub unexplained: &'a [f64],
+}
+
 /// Produces the birth LMB of a step.
 pub trait BirthModel: Send + Sync {
     /// The birth tracks of the step described by `ctx`. `evidence` holds the previous step's
@@ -45,6 +71,27 @@ pub trait BirthModel: Send + Sync {
         evidence: Option<&BirthEvidence<'_>>,
         rng: &mut FilterRng,
     ) -> Vec<BirthTrack>;
+
+    /// Whether [`BirthModel::birth_guided`] looks at the step's measurements; when false the
+    /// filter does not work out which of them are unexplained. Default false.
+    fn uses_current_measurements(&self) -> bool {
+        false
+    }
+
+    /// The birth tracks of the step, told also the step's own measurements. The filter calls
+    /// this one. A model may use the measurements to decide *how* to sample its densities
+    /// (importance sampling), never *what* they are: its existence probabilities and densities
+    /// must be those of [`BirthModel::birth`]. Default: [`BirthModel::birth`].
+    fn birth_guided(
+        &self,
+        ctx: &StepContext,
+        evidence: Option<&BirthEvidence<'_>>,
+        current: &CurrentMeasurements<'_>,
+        rng: &mut FilterRng,
+    ) -> Vec<BirthTrack> {
+        let _ = current;
+        self.birth(ctx, evidence, rng)
+    }
 }
 
 impl<T: BirthModel + ?Sized> BirthModel for Box<T> {
@@ -55,6 +102,18 @@ impl<T: BirthModel + ?Sized> BirthModel for Box<T> {
         rng: &mut FilterRng,
     ) -> Vec<BirthTrack> {
         (**self).birth(ctx, evidence, rng)
+    }
+    fn uses_current_measurements(&self) -> bool {
+        (**self).uses_current_measurements()
+    }
+    fn birth_guided(
+        &self,
+        ctx: &StepContext,
+        evidence: Option<&BirthEvidence<'_>>,
+        current: &CurrentMeasurements<'_>,
+        rng: &mut FilterRng,
+    ) -> Vec<BirthTrack> {
+        (**self).birth_guided(ctx, evidence, current, rng)
     }
 }
 
@@ -84,11 +143,14 @@ fn check_particles(particles: usize) -> Result<()> {
     Ok(())
 }
 
-/// A fixed list of Gaussian birth terms, proposed at every step.
+/// A fixed list of Gaussian birth terms, proposed at every step. Without a proposal each
+/// term's particles are drawn from the term itself; with one ([`StaticBirth::with_proposal`])
+/// they are drawn near the step's unexplained measurements and importance-weighted.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StaticBirth {
     terms: Vec<BirthTerm>,
     particles: usize,
+    proposal: Option<BirthProposal>,
 }
 
 impl StaticBirth {
@@ -115,12 +177,31 @@ impl StaticBirth {
             }
         }
         check_particles(particles)?;
-        Ok(StaticBirth { terms, particles })
+        Ok(StaticBirth {
+            terms,
+            particles,
+            proposal: None,
+        })
+    }
+
+    /// The same terms, sampled with a measurement-guided proposal (the birth density is
+    /// unchanged). Fails when the proposal observes a component the terms do not have.
+    pub fn with_proposal(mut self, proposal: BirthProposal) -> Result<Self> {
+        for t in &self.terms {
+            proposal.check_state_dim(t.mean.len())?;
+        }
+        self.proposal = Some(proposal);
+        Ok(self)
     }
 
     /// The terms.
     pub fn terms(&self) -> &[BirthTerm] {
         &self.terms
+    }
+
+    /// The measurement-guided proposal, if any.
+    pub fn proposal(&self) -> Option<&BirthProposal> {
+        self.proposal.as_ref()
     }
 }
 
@@ -136,6 +217,35 @@ impl BirthModel for StaticBirth {
             .map(|t| BirthTrack {
                 existence: t.existence,
                 particles: ParticleSet::gaussian(&t.mean, &t.std, self.particles, rng),
+                at_previous_step: false,
+            })
+            .collect()
+    }
+
+    fn uses_current_measurements(&self) -> bool {
+        self.proposal.is_some()
+    }
+
+    /// With a proposal, every term is sampled from its own random stream (derived from one
+    /// draw of `rng` and the term's index), in parallel; the result does not depend on the
+    /// thread count.
+    fn birth_guided(
+        &self,
+        ctx: &StepContext,
+        evidence: Option<&BirthEvidence<'_>>,
+        current: &CurrentMeasurements<'_>,
+        rng: &mut FilterRng,
+    ) -> Vec<BirthTrack> {
+        let Some(proposal) = &self.proposal else {
+            return self.birth(ctx, evidence, rng);
+        };
+        let seed = rng.next_u64();
+        self.terms
+            .par_iter()
+            .enumerate()
+            .map(|(i, t)| BirthTrack {
+                existence: t.existence,
+                particles: proposal.sample(t, current, self.particles, &mut stream(seed, i as u64)),
                 at_previous_step: false,
             })
             .collect()
