@@ -31,11 +31,26 @@
 //! method = "lbp"                # or "murty" (k), "gibbs" (samples)
 //! ```
 //!
+//! Static birth terms (`model = "static"`) are sampled near the step's measurements that no
+//! existing track explains and importance-weighted, which leaves the birth density as written
+//! but puts its particles where a new object is seen ([`crate::filter::BirthProposal`]). This
+//! needs a position measurement; with range-bearing the terms are sampled as they are. To
+//! sample every term from its own Gaussian instead, set `measurement_proposal = false`:
+//!
+//! ```toml
+//! [birth]
+//! model = "static"
+//! particles = 1000
+//! measurement_proposal = false  # default true
+//! terms = [{ existence = 0.01, mean = [0.0, 0.0, 0.0, 0.0], std = [50.0, 10.0, 50.0, 10.0] }]
+//! ```
+//!
 //! Not for: parsing the file text (the command-line tool does that with `toml`/`serde_json`).
 
 use crate::error::{ensure_finite, Error, Result};
 use crate::filter::{
-    AdaptiveBirth, AssociationMethod, BirthTerm, LmbConfig, LmbFilter, ParticleSet, StaticBirth,
+    AdaptiveBirth, AssociationMethod, BirthProposal, BirthTerm, LmbConfig, LmbFilter, ParticleSet,
+    StaticBirth,
 };
 use crate::filter::{ConstantSurvival, StepContext};
 use crate::models::{
@@ -194,6 +209,10 @@ pub enum BirthConfig {
         terms: Vec<BirthTerm>,
         /// Particles per birth track, 1 to [`crate::filter::MAX_PARTICLES`].
         particles: usize,
+        /// Sample the terms near the step's unexplained measurements, importance-weighted
+        /// ([`BirthProposal`]; position measurements only). Default true.
+        #[serde(default = "default_measurement_proposal")]
+        measurement_proposal: bool,
     },
     /// [`AdaptiveBirth`] from unexplained measurements.
     Adaptive {
@@ -215,6 +234,10 @@ pub enum BirthConfig {
 
 fn default_turn_std() -> f64 {
     0.1
+}
+
+fn default_measurement_proposal() -> bool {
+    true
 }
 
 impl RunConfig {
@@ -293,7 +316,11 @@ impl RunConfig {
             (_, None) => unreachable!("range-bearing model built above"),
         };
         let builder = match &self.birth {
-            BirthConfig::Static { terms, particles } => {
+            BirthConfig::Static {
+                terms,
+                particles,
+                measurement_proposal,
+            } => {
                 if let Some((i, t)) = terms
                     .iter()
                     .enumerate()
@@ -307,7 +334,16 @@ impl RunConfig {
                         ),
                     ));
                 }
-                builder.birth(StaticBirth::new(terms.clone(), *particles)?)
+                let birth = StaticBirth::new(terms.clone(), *particles)?;
+                let birth = match (&self.measurement, measurement_proposal) {
+                    (MeasurementConfig::Position { sigma }, true) => {
+                        // The built-in layouts keep position in components 0, 2 (and 4).
+                        let observed = (0..axes).map(|a| 2 * a).collect();
+                        birth.with_proposal(BirthProposal::new(observed, vec![*sigma; axes])?)?
+                    }
+                    _ => birth,
+                };
+                builder.birth(birth)
             }
             BirthConfig::Adaptive {
                 expected_births,
@@ -438,6 +474,7 @@ mod tests {
                 std: vec![1.0; 3],
             }],
             particles: 10,
+            measurement_proposal: true,
         };
         assert!(c
             .build()
@@ -447,6 +484,36 @@ mod tests {
         let err = serde_json::from_str::<RunConfig>(r#"{"transition": {"model": "warp_drive"}}"#)
             .unwrap_err();
         assert!(err.to_string().contains("warp_drive"));
+    }
+
+    #[test]
+    fn static_birth_uses_the_measurement_proposal_unless_turned_off() {
+        let static_birth = |extra: &str| -> BirthConfig {
+            let text = format!(
+                r#"{{"model": "static", "particles": 10{extra},
+                    "terms": [{{"existence": 0.01, "mean": [0, 0, 0, 0], "std": [50, 10, 50, 10]}}]}}"#
+            );
+            serde_json::from_str(&text).unwrap()
+        };
+        assert!(matches!(
+            static_birth(""),
+            BirthConfig::Static {
+                measurement_proposal: true,
+                ..
+            }
+        ));
+        assert!(matches!(
+            static_birth(r#", "measurement_proposal": false"#),
+            BirthConfig::Static {
+                measurement_proposal: false,
+                ..
+            }
+        ));
+        let mut c = sample();
+        c.birth = static_birth("");
+        assert!(c.build().is_ok());
+        c.birth = static_birth(r#", "measurement_proposal": false"#);
+        assert!(c.build().is_ok());
     }
 
     #[test]

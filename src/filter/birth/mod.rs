@@ -438,6 +438,57 @@ mod tests {
     }
 
     #[test]
+    fn guided_static_birth_does_not_depend_on_the_thread_count() {
+        let terms: Vec<BirthTerm> = (0..6)
+            .map(|i| BirthTerm {
+                existence: 0.01,
+                mean: vec![30.0 * i as f64, 0.0, 0.0, 0.0],
+                std: vec![50.0, 10.0, 50.0, 10.0],
+            })
+            .collect();
+        let proposal = BirthProposal::new(vec![0, 2], vec![1.0, 1.0]).unwrap();
+        let birth = StaticBirth::new(terms, 500)
+            .unwrap()
+            .with_proposal(proposal)
+            .unwrap();
+        assert!(birth.uses_current_measurements());
+        let z = Measurements::from_rows(2, &[[40.0, 10.0], [100.0, -30.0]]).unwrap();
+        let ctx = StepContext::new(1, 1.0, 1.0);
+        let current = CurrentMeasurements {
+            measurements: &z,
+            unexplained: &[1.0, 1.0],
+        };
+        let run = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| birth.birth_guided(&ctx, None, &current, &mut seeded(8)))
+        };
+        let one = run(1);
+        assert_eq!(one.len(), 6);
+        assert!(one
+            .iter()
+            .all(|b| b.existence == 0.01 && !b.at_previous_step));
+        // Guided: some term's weights are not all equal.
+        assert!(one
+            .iter()
+            .any(|b| b.particles.weights().windows(2).any(|w| w[0] != w[1])));
+        assert_eq!(one, run(3));
+        // Without the proposal the same model samples every term plainly.
+        let plain = StaticBirth::new(birth.terms().to_vec(), 500).unwrap();
+        assert!(!plain.uses_current_measurements());
+        let b = plain.birth_guided(&ctx, None, &current, &mut seeded(8));
+        assert!(b
+            .iter()
+            .all(|b| b.particles.weights().windows(2).all(|w| w[0] == w[1])));
+        assert!(StaticBirth::new(birth.terms().to_vec(), 10)
+            .unwrap()
+            .with_proposal(BirthProposal::new(vec![0, 4], vec![1.0, 1.0]).unwrap())
+            .is_err());
+    }
+
+    #[test]
     fn static_birth_validates_terms() {
         let bad = BirthTerm {
             existence: 1.5,
