@@ -189,21 +189,23 @@ fn config(birth: &str, particles: usize, seed: u64) -> Result<RunConfig> {
     })
 }
 
-/// Mean OSPA over the steps and every step's wall time (ms).
-fn run(scenario: &Scenario, cfg: &RunConfig) -> Result<(f64, Vec<f64>)> {
+/// Mean OSPA over the steps, every step's wall time (ms) and the mean number of tracks kept.
+fn run(scenario: &Scenario, cfg: &RunConfig) -> Result<(f64, Vec<f64>, f64)> {
     let mut filter = cfg.build()?;
     let mut rng = seeded(cfg.seed);
     let mut total = 0.0;
     let mut ms = Vec::with_capacity(STEPS);
+    let mut tracks = 0;
     for (k, z) in scenario.measurements.iter().enumerate() {
         let frame = Frame::new(k as f64, Measurements::from_rows(2, z)?);
         let t0 = Instant::now();
         let est = filter.step(&frame, &mut rng)?;
         ms.push(t0.elapsed().as_secs_f64() * 1e3);
+        tracks += filter.tracks().len();
         let x: Vec<[f64; 2]> = est.iter().map(|e| [e.state[0], e.state[2]]).collect();
         total += ospa(&scenario.truth[k], &x, 100.0, 1.0)?.distance;
     }
-    Ok((total / STEPS as f64, ms))
+    Ok((total / STEPS as f64, ms, tracks as f64 / STEPS as f64))
 }
 
 /// The scenario in the layout of the peer's `generate_scenarios.py` (one sensor), with the
@@ -275,8 +277,10 @@ fn main() -> Result<()> {
         return Ok(());
     }
     if !args.json {
-        println!("| objects | birth | mean OSPA (m) | ms/step mean | ms/step median |");
-        println!("|---|---|---|---|---|");
+        println!(
+            "| objects | birth | mean OSPA (m) | ms/step mean | ms/step median | tracks kept |"
+        );
+        println!("|---|---|---|---|---|---|");
     }
     for &n in &args.objects {
         let scenarios: Vec<Scenario> = (0..args.runs)
@@ -285,11 +289,13 @@ fn main() -> Result<()> {
         for birth in &args.birth {
             let mut ospas = Vec::new();
             let mut ms = Vec::new();
+            let mut tracks = Vec::new();
             for (r, s) in scenarios.iter().enumerate() {
                 let cfg = config(birth, args.particles, args.seed + r as u64)?;
-                let (o, t) = run(s, &cfg).with_context(|| format!("{n} objects, {birth}"))?;
+                let (o, t, k) = run(s, &cfg).with_context(|| format!("{n} objects, {birth}"))?;
                 ospas.push(o);
                 ms.extend(t);
+                tracks.push(k);
             }
             if args.json {
                 println!(
@@ -299,14 +305,16 @@ fn main() -> Result<()> {
                         "particles": args.particles, "threads": rayon::current_num_threads(),
                         "mean_ospa": mean(&ospas), "ospa_per_run": ospas,
                         "ms_per_step_mean": mean(&ms), "ms_per_step_median": median(&ms),
+                        "tracks_per_step": mean(&tracks),
                     })
                 );
             } else {
                 println!(
-                    "| {n} | {birth} | {:.2} | {:.2} | {:.2} |",
+                    "| {n} | {birth} | {:.2} | {:.2} | {:.2} | {:.1} |",
                     mean(&ospas),
                     mean(&ms),
-                    median(&ms)
+                    median(&ms),
+                    mean(&tracks)
                 );
             }
         }
