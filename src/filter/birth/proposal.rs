@@ -20,6 +20,7 @@
 use super::{BirthTerm, CurrentMeasurements};
 use crate::error::{ensure_finite, Error, Result};
 use crate::filter::ParticleSet;
+use crate::numerics::exp::exp_in_place;
 use crate::rng::FilterRng;
 use rand_distr::{Distribution, StandardNormal};
 
@@ -260,42 +261,56 @@ fn sample_plan(
     if plan.components.is_empty() {
         return set;
     }
-    // log w = log b(x) − log q(x) over the observed components only: the unobserved ones are
-    // drawn from the prior in every component and cancel. Common constants (2π) cancel too.
+    // w = b(x) / q(x) over the observed components only: the unobserved ones are drawn from
+    // the prior in every component and cancel, and so do common constants (2π). Component by
+    // component over all particles (contiguous rows, vectorised exp): row 0 holds
+    // ln π₀ + ln b(xᵢ), row j the j-th conditional's ln π_j + ln q_j(xᵢ); with each particle's
+    // largest entry t, b/q = e^(row₀ − t) / (π₀ · Σ_j e^(row_j − t)).
     let nf = n as f64;
-    let log_prior_coef = (p0 as f64 / nf).ln();
+    let pi0 = p0 as f64 / nf;
+    let m = plan.components.len();
     let prior_var: Vec<f64> = observed.iter().map(|&c| term.std[c].powi(2)).collect();
     let prior_norm: f64 = -0.5 * prior_var.iter().map(|v| v.ln()).sum::<f64>();
     let post_norm: f64 = -0.5 * plan.post_var.iter().map(|v| v.ln()).sum::<f64>();
-    let comp_coef: Vec<f64> = plan
-        .components
-        .iter()
-        .map(|c| (c.count as f64 / nf).ln() + post_norm)
-        .collect();
     let cols: Vec<&[f64]> = observed.iter().map(|&c| set.component(c)).collect();
-    let mut log_w = vec![0.0; n];
-    let mut terms = vec![0.0; plan.components.len()];
-    for (i, lw) in log_w.iter_mut().enumerate() {
-        let mut log_b = prior_norm;
-        for (k, col) in cols.iter().enumerate() {
-            let d = col[i] - term.mean[observed[k]];
-            log_b -= 0.5 * d * d / prior_var[k];
+    let mut rows = vec![0.0; (m + 1) * n];
+    for (r, row) in rows.chunks_exact_mut(n).enumerate() {
+        let (coef, mean, var): (f64, Vec<f64>, &[f64]) = if r == 0 {
+            let mean = observed.iter().map(|&c| term.mean[c]).collect();
+            (pi0.ln() + prior_norm, mean, &prior_var)
+        } else {
+            let comp = &plan.components[r - 1];
+            let coef = (comp.count as f64 / nf).ln() + post_norm;
+            (coef, comp.mean.clone(), &plan.post_var)
+        };
+        row.fill(coef);
+        for ((col, mu), v) in cols.iter().zip(&mean).zip(var) {
+            let h = -0.5 / v;
+            row.iter_mut().zip(col.iter()).for_each(|(l, x)| {
+                let d = x - mu;
+                *l += h * d * d;
+            });
         }
-        let first = log_prior_coef + log_b;
-        let mut top = first;
-        for ((t, comp), coef) in terms.iter_mut().zip(&plan.components).zip(&comp_coef) {
-            let mut l = *coef;
-            for (k, col) in cols.iter().enumerate() {
-                let d = col[i] - comp.mean[k];
-                l -= 0.5 * d * d / plan.post_var[k];
-            }
-            *t = l;
-            top = top.max(l);
-        }
-        let sum: f64 = (first - top).exp() + terms.iter().map(|t| (t - top).exp()).sum::<f64>();
-        *lw = log_b - (top + sum.ln());
     }
-    set.reweight_log(&log_w);
+    let mut top = vec![f64::NEG_INFINITY; n];
+    for row in rows.chunks_exact(n) {
+        top.iter_mut().zip(row).for_each(|(t, l)| *t = t.max(*l));
+    }
+    for row in rows.chunks_exact_mut(n) {
+        row.iter_mut().zip(&top).for_each(|(l, t)| *l -= t);
+        exp_in_place(row);
+    }
+    let (first, rest) = rows.split_at_mut(n);
+    let mut sum = vec![0.0; n];
+    for row in rest.chunks_exact(n) {
+        sum.iter_mut().zip(row).for_each(|(s, e)| *s += e);
+    }
+    // first[i] ≤ 1 and sum[i] + first[i] ≥ 1 (the largest entry is e⁰), so w ≤ 1/π₀.
+    first
+        .iter_mut()
+        .zip(&sum)
+        .for_each(|(w, s)| *w /= pi0 * (*w + s));
+    set.reweight(first);
     set
 }
 
