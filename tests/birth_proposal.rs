@@ -107,16 +107,24 @@ fn the_proposal_confirms_an_object_far_from_the_birth_mean_sooner() {
 }
 
 #[test]
-fn the_guided_filter_repeats_itself_for_a_seed() {
-    let run = || {
-        let mut filter = config(true, 3).build().unwrap();
-        let mut rng = seeded(3);
-        scene(3)
-            .iter()
-            .map(|(f, _)| filter.step(f, &mut rng).unwrap())
-            .collect::<Vec<_>>()
+fn the_guided_filter_repeats_itself_for_a_seed_at_any_thread_count() {
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut filter = config(true, 3).build().unwrap();
+            let mut rng = seeded(3);
+            scene(3)
+                .iter()
+                .map(|(f, _)| filter.step(f, &mut rng).unwrap())
+                .collect::<Vec<_>>()
+        })
     };
-    let a = run();
+    let a = run(2);
     assert!(a.iter().any(|e| !e.is_empty()));
-    assert_eq!(a, run());
+    assert_eq!(a, run(2));
+    assert_eq!(a, run(1));
+    assert_eq!(a, run(3));
 }
