@@ -11,6 +11,11 @@
 //! Gaussian in closed form, component by component: variance `s²σ²/(s² + σ²)`, mean
 //! `m + s²/(s² + σ²)·(z − m)`; unobserved components keep the prior.
 //!
+//! Other measurements (range-bearing, boxes) can use it once converted to points in the
+//! observed components, with the converted points' spread as noise: any conversion keeps the
+//! sample unbiased, since the weights involve only the term's density and the mixture actually
+//! sampled, never the measurement model; a poor conversion only wastes particles.
+//!
 //! The mixture is allocated deterministically (stratified): `n_j` particles from component
 //! `j`, with the mixture coefficients exactly `n_j / n`, so the weights b(x)/q(x) with
 //! q = Σ_j (n_j/n)·q_j are those of the deterministic-mixture (balance heuristic) estimator,
