@@ -39,6 +39,9 @@ pub const DEFAULT_PRIOR_SHARE: f64 = 0.2;
 /// of its mass beyond, per component).
 const GATE_SIGMAS: f64 = 5.0;
 
+/// Particles per block of the weight computation (bounds its buffers whatever the count).
+const CHUNK: usize = 4096;
+
 /// How the measurements observe the state, for guiding birth particles to them: measurement
 /// component `k` is state component `observed[k]` plus Gaussian noise of standard deviation
 /// `noise_std[k]` (the built-in position measurement with the built-in state layouts:
@@ -277,45 +280,55 @@ fn sample_plan(
     let prior_var: Vec<f64> = observed.iter().map(|&c| term.std[c].powi(2)).collect();
     let prior_norm: f64 = -0.5 * prior_var.iter().map(|v| v.ln()).sum::<f64>();
     let post_norm: f64 = -0.5 * plan.post_var.iter().map(|v| v.ln()).sum::<f64>();
+    // (coefficient, mean, variance) of every row.
+    let mut row_params: Vec<(f64, Vec<f64>, &[f64])> = Vec::with_capacity(m + 1);
+    let prior_mean: Vec<f64> = observed.iter().map(|&c| term.mean[c]).collect();
+    row_params.push((pi0.ln() + prior_norm, prior_mean, &prior_var));
+    for comp in &plan.components {
+        let coef = (comp.count as f64 / nf).ln() + post_norm;
+        row_params.push((coef, comp.mean.clone(), &plan.post_var));
+    }
     let cols: Vec<&[f64]> = observed.iter().map(|&c| set.component(c)).collect();
-    let mut rows = vec![0.0; (m + 1) * n];
-    for (r, row) in rows.chunks_exact_mut(n).enumerate() {
-        let (coef, mean, var): (f64, Vec<f64>, &[f64]) = if r == 0 {
-            let mean = observed.iter().map(|&c| term.mean[c]).collect();
-            (pi0.ln() + prior_norm, mean, &prior_var)
-        } else {
-            let comp = &plan.components[r - 1];
-            let coef = (comp.count as f64 / nf).ln() + post_norm;
-            (coef, comp.mean.clone(), &plan.post_var)
-        };
-        row.fill(coef);
-        for ((col, mu), v) in cols.iter().zip(&mean).zip(var) {
-            let h = -0.5 / v;
-            row.iter_mut().zip(col.iter()).for_each(|(l, x)| {
-                let d = x - mu;
-                *l += h * d * d;
-            });
+    // Particles in blocks, so the rows take (m + 1) · CHUNK values whatever n is.
+    let chunk = n.min(CHUNK);
+    let mut rows = vec![0.0; (m + 1) * chunk];
+    let mut top = vec![0.0; chunk];
+    let mut sum = vec![0.0; chunk];
+    let mut factor = vec![0.0; n];
+    for (b, out) in factor.chunks_mut(chunk).enumerate() {
+        let (lo, len) = (b * chunk, out.len());
+        let rows = &mut rows[..(m + 1) * len];
+        for (row, (coef, mean, var)) in rows.chunks_exact_mut(len).zip(&row_params) {
+            row.fill(*coef);
+            for ((col, mu), v) in cols.iter().zip(mean).zip(var.iter()) {
+                let h = -0.5 / v;
+                row.iter_mut().zip(&col[lo..lo + len]).for_each(|(l, x)| {
+                    let d = x - mu;
+                    *l += h * d * d;
+                });
+            }
         }
+        let (top, sum) = (&mut top[..len], &mut sum[..len]);
+        top.fill(f64::NEG_INFINITY);
+        for row in rows.chunks_exact(len) {
+            top.iter_mut().zip(row).for_each(|(t, l)| *t = t.max(*l));
+        }
+        for row in rows.chunks_exact_mut(len) {
+            row.iter_mut().zip(top.iter()).for_each(|(l, t)| *l -= t);
+            exp_in_place(row);
+        }
+        let (first, rest) = rows.split_at(len);
+        sum.fill(0.0);
+        for row in rest.chunks_exact(len) {
+            sum.iter_mut().zip(row).for_each(|(s, e)| *s += e);
+        }
+        // first[i] ≤ 1 and first[i] + sum[i] ≥ 1 (the largest entry is e⁰), so w ≤ 1/π₀.
+        out.iter_mut()
+            .zip(first)
+            .zip(sum.iter())
+            .for_each(|((w, f), s)| *w = f / (pi0 * (f + s)));
     }
-    let mut top = vec![f64::NEG_INFINITY; n];
-    for row in rows.chunks_exact(n) {
-        top.iter_mut().zip(row).for_each(|(t, l)| *t = t.max(*l));
-    }
-    for row in rows.chunks_exact_mut(n) {
-        row.iter_mut().zip(&top).for_each(|(l, t)| *l -= t);
-        exp_in_place(row);
-    }
-    let (first, rest) = rows.split_at_mut(n);
-    let mut sum = vec![0.0; n];
-    for row in rest.chunks_exact(n) {
-        sum.iter_mut().zip(row).for_each(|(s, e)| *s += e);
-    }
-    // first[i] ≤ 1 and sum[i] + first[i] ≥ 1 (the largest entry is e⁰), so w ≤ 1/π₀.
-    first
-        .iter_mut()
-        .zip(&sum)
-        .for_each(|(w, s)| *w /= pi0 * (*w + s));
-    set.reweight(first);
+    set.reweight(&factor);
     set
 }
 
