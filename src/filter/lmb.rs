@@ -518,9 +518,10 @@ impl LmbFilter {
             context: &p.context,
         });
         let m = &self.models;
-        let u = match m.birth.uses_current_measurements() {
-            true => unexplained(&self.tracks, z, &*m.measurement, ctx),
-            false => Vec::new(),
+        let u = if m.birth.uses_current_measurements() {
+            unexplained(&self.tracks, z, &*m.measurement, ctx)
+        } else {
+            Vec::new()
         };
         let current = CurrentMeasurements {
             measurements: z,
