@@ -236,16 +236,46 @@ impl BirthModel for StaticBirth {
         current: &CurrentMeasurements<'_>,
         rng: &mut FilterRng,
     ) -> Vec<BirthTrack> {
-        let Some(proposal) = &self.proposal else {
-            return self.birth(ctx, evidence, rng);
-        };
+        match &self.proposal {
+            None => self.birth(ctx, evidence, rng),
+            Some(proposal) => self.each_term(rng, |t, n, rng| proposal.sample(t, current, n, rng)),
+        }
+    }
+}
+
+impl StaticBirth {
+    /// The birth tracks of a step with every term sampled near `points`: the step's
+    /// measurements converted to the proposal's observed components, with their spreads and
+    /// u(z) (see [`BirthProposal::sample_points`]). For birth models that wrap a static birth
+    /// for measurements that are not positions (range-bearing); without a proposal this is
+    /// [`BirthModel::birth`].
+    pub fn birth_near_points(
+        &self,
+        points: &Measurements,
+        noise_std: &[f64],
+        unexplained: &[f64],
+        rng: &mut FilterRng,
+    ) -> Vec<BirthTrack> {
+        match &self.proposal {
+            None => self.birth(&StepContext::new(0, 0.0, 0.0), None, rng),
+            Some(proposal) => self.each_term(rng, |t, n, rng| {
+                proposal.sample_points(t, points, noise_std, unexplained, n, rng)
+            }),
+        }
+    }
+
+    /// One birth track per term, its particles from `sample` with the term's own stream.
+    fn each_term<F>(&self, rng: &mut FilterRng, sample: F) -> Vec<BirthTrack>
+    where
+        F: Fn(&BirthTerm, usize, &mut FilterRng) -> ParticleSet + Sync,
+    {
         let seed = rng.next_u64();
         self.terms
             .par_iter()
             .enumerate()
             .map(|(i, t)| BirthTrack {
                 existence: t.existence,
-                particles: proposal.sample(t, current, self.particles, &mut stream(seed, i as u64)),
+                particles: sample(t, self.particles, &mut stream(seed, i as u64)),
                 at_previous_step: false,
             })
             .collect()

@@ -24,7 +24,7 @@
 
 use super::{BirthTerm, CurrentMeasurements};
 use crate::error::{ensure_finite, Error, Result};
-use crate::filter::ParticleSet;
+use crate::filter::{Measurements, ParticleSet};
 use crate::numerics::exp::exp_in_place;
 use crate::rng::FilterRng;
 use rand_distr::{Distribution, StandardNormal};
@@ -131,50 +131,74 @@ impl BirthProposal {
         n: usize,
         rng: &mut FilterRng,
     ) -> ParticleSet {
-        let plan = self.plan(term, current, n);
+        let noise = |_: usize, k: usize| self.noise_std[k];
+        let plan = self.plan(term, current.measurements, current.unexplained, &noise, n);
         sample_plan(term, &self.observed, &plan, n, rng)
     }
 
-    /// The mixture for one term: the conditional components and their particle counts.
-    fn plan(&self, term: &BirthTerm, current: &CurrentMeasurements<'_>, n: usize) -> Plan {
+    /// As [`BirthProposal::sample`], with the components centred on `points` — measurements
+    /// converted to the observed components (e.g. range-bearing to Cartesian) — each with its
+    /// own spread: `noise_std[j · d + k]` for point `j`, component `k` of `d`. `unexplained`
+    /// holds u(z) of each point's measurement (empty: all 1). Points whose spread is not
+    /// finite and positive get no component.
+    pub fn sample_points(
+        &self,
+        term: &BirthTerm,
+        points: &Measurements,
+        noise_std: &[f64],
+        unexplained: &[f64],
+        n: usize,
+        rng: &mut FilterRng,
+    ) -> ParticleSet {
+        let d = points.dim();
+        let noise = |j: usize, k: usize| noise_std.get(j * d + k).copied().unwrap_or(f64::NAN);
+        let plan = self.plan(term, points, unexplained, &noise, n);
+        sample_plan(term, &self.observed, &plan, n, rng)
+    }
+
+    /// The mixture for one term: the conditional components and their particle counts;
+    /// `noise(j, k)` is the spread of point `j` in observed component `k`.
+    fn plan(
+        &self,
+        term: &BirthTerm,
+        z: &Measurements,
+        unexplained: &[f64],
+        noise: &dyn Fn(usize, usize) -> f64,
+        n: usize,
+    ) -> Plan {
         let obs = &self.observed;
         let empty = Plan {
-            post_var: Vec::new(),
             components: Vec::new(),
             prior_count: n,
         };
-        let z = current.measurements;
         if z.is_empty() || z.dim() != obs.len() || obs.iter().any(|&c| term.std[c] <= 0.0) {
             return empty;
         }
         // Per observed component: prior variance s², predictive variance s² + σ², gain.
         let s2: Vec<f64> = obs.iter().map(|&c| term.std[c] * term.std[c]).collect();
-        let pred_var: Vec<f64> = s2
-            .iter()
-            .zip(&self.noise_std)
-            .map(|(s2, n)| s2 + n * n)
-            .collect();
         // Candidates: (measurement, log of u_j times its prior predictive density).
         let mut cand: Vec<(usize, f64)> = Vec::new();
-        let mut unexplained = 0.0;
+        let mut total_u = 0.0;
         for (j, zj) in z.iter().enumerate() {
-            let u = current.unexplained.get(j).copied().unwrap_or(1.0);
+            let u = unexplained.get(j).copied().unwrap_or(1.0);
             if !(u > 0.0 && u <= 1.0) {
                 continue;
             }
             let mut log_pred = u.ln();
             let mut inside = true;
             for (k, &c) in obs.iter().enumerate() {
+                let nz = noise(j, k);
+                let pred_var = s2[k] + nz * nz;
                 let d = zj[k] - term.mean[c];
-                if d.abs() > GATE_SIGMAS * pred_var[k].sqrt() {
+                if !(nz > 0.0 && pred_var.is_finite()) || d.abs() > GATE_SIGMAS * pred_var.sqrt() {
                     inside = false;
                     break;
                 }
-                log_pred -= 0.5 * (d * d / pred_var[k] + pred_var[k].ln());
+                log_pred -= 0.5 * (d * d / pred_var + pred_var.ln());
             }
             if inside {
                 cand.push((j, log_pred));
-                unexplained += u;
+                total_u += u;
             }
         }
         if cand.is_empty() {
@@ -182,16 +206,10 @@ impl BirthProposal {
         }
         // Share of the particles near measurements: (1 − prior_share) when at least one
         // unexplained measurement is expected near the term, less when fewer are.
-        let share = (1.0 - self.prior_share) * unexplained.min(1.0);
+        let share = (1.0 - self.prior_share) * total_u.min(1.0);
         let top = cand.iter().map(|c| c.1).fold(f64::NEG_INFINITY, f64::max);
         let total: f64 = cand.iter().map(|c| (c.1 - top).exp()).sum();
         let budget = share * n as f64;
-        let post_var: Vec<f64> = s2
-            .iter()
-            .zip(&pred_var)
-            .zip(&self.noise_std)
-            .map(|((s2, p), nz)| s2 * nz * nz / p)
-            .collect();
         let mut components = Vec::new();
         let mut used = 0;
         for (j, lp) in cand {
@@ -201,35 +219,38 @@ impl BirthProposal {
                 continue;
             }
             let zj = z.get(j);
-            let mean: Vec<f64> = obs
-                .iter()
-                .enumerate()
-                .map(|(k, &c)| {
-                    let m = term.mean[c];
-                    m + s2[k] / pred_var[k] * (zj[k] - m)
-                })
-                .collect();
+            let mut mean = Vec::with_capacity(obs.len());
+            let mut post_var = Vec::with_capacity(obs.len());
+            for (k, &c) in obs.iter().enumerate() {
+                let (m, nz) = (term.mean[c], noise(j, k));
+                let pred_var = s2[k] + nz * nz;
+                mean.push(m + s2[k] / pred_var * (zj[k] - m));
+                post_var.push(s2[k] * nz * nz / pred_var);
+            }
             used += count;
-            components.push(Component { mean, count });
+            components.push(Component {
+                mean,
+                post_var,
+                count,
+            });
         }
         Plan {
-            post_var,
             components,
             prior_count: n - used,
         }
     }
 }
 
-/// One conditional component: its mean in the observed components and its particle count.
+/// One conditional component: its mean and variance in the observed components and its
+/// particle count.
 struct Component {
     mean: Vec<f64>,
+    post_var: Vec<f64>,
     count: usize,
 }
 
-/// A term's mixture: the conditional variance of each observed component (shared by all
-/// conditional components), the components, and the count drawn from the prior.
+/// A term's mixture: the conditional components and the count drawn from the prior.
 struct Plan {
-    post_var: Vec<f64>,
     components: Vec<Component>,
     prior_count: usize,
 }
@@ -257,7 +278,7 @@ fn sample_plan(
             let (block, tail) = rest.split_at_mut(comp.count);
             rest = tail;
             let (mean, std) = match k {
-                Some(k) => (comp.mean[k], plan.post_var[k].sqrt()),
+                Some(k) => (comp.mean[k], comp.post_var[k].sqrt()),
                 None => (m, s),
             };
             for x in block.iter_mut() {
@@ -279,14 +300,14 @@ fn sample_plan(
     let m = plan.components.len();
     let prior_var: Vec<f64> = observed.iter().map(|&c| term.std[c].powi(2)).collect();
     let prior_norm: f64 = -0.5 * prior_var.iter().map(|v| v.ln()).sum::<f64>();
-    let post_norm: f64 = -0.5 * plan.post_var.iter().map(|v| v.ln()).sum::<f64>();
     // (coefficient, mean, variance) of every row.
     let mut row_params: Vec<(f64, Vec<f64>, &[f64])> = Vec::with_capacity(m + 1);
     let prior_mean: Vec<f64> = observed.iter().map(|&c| term.mean[c]).collect();
     row_params.push((pi0.ln() + prior_norm, prior_mean, &prior_var));
     for comp in &plan.components {
+        let post_norm = -0.5 * comp.post_var.iter().map(|v| v.ln()).sum::<f64>();
         let coef = (comp.count as f64 / nf).ln() + post_norm;
-        row_params.push((coef, comp.mean.clone(), &plan.post_var));
+        row_params.push((coef, comp.mean.clone(), &comp.post_var));
     }
     let cols: Vec<&[f64]> = observed.iter().map(|&c| set.component(c)).collect();
     // Particles in blocks, so the rows take (m + 1) · CHUNK values whatever n is.

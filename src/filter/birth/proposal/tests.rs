@@ -187,3 +187,51 @@ fn bad_proposals_are_refused() {
         .to_string();
     assert!(msg.contains("component 4"), "{msg}");
 }
+
+#[test]
+fn converted_points_with_their_own_spread_keep_the_prior() {
+    // Two points with different spreads (as range-bearing points at different ranges would
+    // have); the weighted sample still has the prior's mean and variances, and the particles
+    // drawn near the wide point spread as its conditional: sd = 50·8/√(50² + 8²) ≈ 7.90.
+    let t = term();
+    let pts = Measurements::from_rows(2, &[[90.0, 40.0], [-20.0, -75.0]]).unwrap();
+    let noise = [0.5, 0.5, 8.0, 8.0];
+    let p = proposal().sample_points(&t, &pts, &noise, &[], 100_000, &mut seeded(21));
+    let e = ess(&p);
+    let mean = p.mean();
+    let sd = p.std_dev();
+    for c in 0..4 {
+        let s = t.std[c];
+        assert!(
+            (mean[c] - t.mean[c]).abs() < 4.0 * s / e.sqrt(),
+            "mean {c}: {mean:?}"
+        );
+        assert!(
+            (sd[c] * sd[c] - s * s).abs() < 4.0 * s * s * (2.0 / e).sqrt(),
+            "sd {c}: {sd:?}"
+        );
+    }
+    let (x, y) = (p.component(0), p.component(2));
+    let near: Vec<f64> = x
+        .iter()
+        .zip(y)
+        .filter(|(x, y)| (*x + 20.0).hypot(*y + 75.0) < 30.0)
+        .map(|(x, _)| *x)
+        .collect();
+    assert!(near.len() > 10_000, "{} near the wide point", near.len());
+    let m = near.iter().sum::<f64>() / near.len() as f64;
+    let v = near.iter().map(|x| (x - m).powi(2)).sum::<f64>() / near.len() as f64;
+    let expected = 50.0 * 8.0 / (50.0f64 * 50.0 + 64.0).sqrt();
+    assert!(
+        (v.sqrt() / expected - 1.0).abs() < 0.1,
+        "sd {} vs {expected}",
+        v.sqrt()
+    );
+    // A point whose spread is not usable gets no component: plain prior sampling.
+    let bad = [f64::NAN, 1.0, 0.0, 1.0];
+    let plain = ParticleSet::gaussian(&t.mean, &t.std, 300, &mut seeded(2));
+    assert_eq!(
+        proposal().sample_points(&t, &pts, &bad, &[], 300, &mut seeded(2)),
+        plain
+    );
+}
