@@ -34,8 +34,9 @@
 //! Static birth terms (`model = "static"`) are sampled near the step's measurements that no
 //! existing track explains and importance-weighted, which leaves the birth density as written
 //! but puts its particles where a new object is seen ([`crate::filter::BirthProposal`]). This
-//! needs a position measurement; with range-bearing the terms are sampled as they are. To
-//! sample every term from its own Gaussian instead, set `measurement_proposal = false`:
+//! works with position measurements and, converted to world points with the frame's sensor
+//! pose, range-bearing ones. To sample every term from its own Gaussian instead, set
+//! `measurement_proposal = false`:
 //!
 //! ```toml
 //! [birth]
@@ -48,11 +49,12 @@
 //! Not for: parsing the file text (the command-line tool does that with `toml`/`serde_json`).
 
 use crate::error::{ensure_finite, Error, Result};
+use crate::filter::birth::{BirthEvidence, CurrentMeasurements};
 use crate::filter::{
     AdaptiveBirth, AssociationMethod, BirthProposal, BirthTerm, LmbConfig, LmbFilter, ParticleSet,
     StaticBirth,
 };
-use crate::filter::{ConstantSurvival, StepContext};
+use crate::filter::{BirthModel, BirthTrack, ConstantSurvival, Measurements, StepContext};
 use crate::models::{
     BearingConvention, ConstantDetection, ConstantVelocity, CoordinatedTurn, FieldOfViewDetection,
     GaussianRangeDetection, PositionMeasurement, RangeBearing, UniformClutter,
@@ -210,7 +212,8 @@ pub enum BirthConfig {
         /// Particles per birth track, 1 to [`crate::filter::MAX_PARTICLES`].
         particles: usize,
         /// Sample the terms near the step's unexplained measurements, importance-weighted
-        /// ([`BirthProposal`]; position measurements only). Default true.
+        /// ([`BirthProposal`]; range-bearing measurements converted to world points). Default
+        /// true.
         #[serde(default = "default_measurement_proposal")]
         measurement_proposal: bool,
     },
@@ -335,15 +338,23 @@ impl RunConfig {
                     ));
                 }
                 let birth = StaticBirth::new(terms.clone(), *particles)?;
-                let birth = match (&self.measurement, measurement_proposal) {
-                    (MeasurementConfig::Position { sigma }, true) => {
-                        // The built-in layouts keep position in components 0, 2 (and 4).
-                        let observed = (0..axes).map(|a| 2 * a).collect();
-                        birth.with_proposal(BirthProposal::new(observed, vec![*sigma; axes])?)?
+                // The built-in layouts keep position in components 0, 2 (and 4).
+                let observed: Vec<usize> = (0..axes).map(|a| 2 * a).collect();
+                match (&self.measurement, &range_bearing, measurement_proposal) {
+                    (MeasurementConfig::Position { sigma }, _, true) => builder.birth(
+                        birth.with_proposal(BirthProposal::new(observed, vec![*sigma; axes])?)?,
+                    ),
+                    (_, Some(rb), true) => {
+                        // The proposal's own noise is not used: every point brings its spread.
+                        let (sr, _) = rb.noise();
+                        let proposal = BirthProposal::new(observed, vec![sr; axes])?;
+                        builder.birth(RangeBearingGuidedBirth {
+                            birth: birth.with_proposal(proposal)?,
+                            sensor: *rb,
+                        })
                     }
-                    _ => birth,
-                };
-                builder.birth(birth)
+                    _ => builder.birth(birth),
+                }
             }
             BirthConfig::Adaptive {
                 expected_births,
@@ -380,6 +391,77 @@ impl RunConfig {
             }
         };
         Ok(builder)
+    }
+}
+
+/// Static birth guided by range-bearing measurements: each measurement converted to the world
+/// point it reads (with the frame's sensor pose), spread per axis as the measurement's
+/// along-range and cross-range noise (σ_r, r·σ_b) rotated into x and y (the diagonal of that
+/// covariance; the proposal stays unbiased whatever the spread, see
+/// [`BirthProposal::sample_points`]).
+struct RangeBearingGuidedBirth {
+    birth: StaticBirth,
+    sensor: RangeBearing,
+}
+
+impl RangeBearingGuidedBirth {
+    /// World points and their per-axis spreads for the measurements `z`; `None` when a
+    /// conversion is not finite.
+    fn points(&self, z: &Measurements, ctx: &StepContext) -> Option<(Measurements, Vec<f64>)> {
+        let (sr, sb) = self.sensor.noise();
+        let (sx, sy, _) = ctx.platform_xy_heading();
+        let mut rows = Vec::with_capacity(z.len());
+        let mut noise = Vec::with_capacity(2 * z.len());
+        for zj in z.iter() {
+            let p = self.sensor.to_cartesian([zj[0], zj[1]], ctx);
+            // Direction of the line of sight, from the platform to the point (close enough
+            // to the sensor's for the spread's orientation).
+            let theta = (p[1] - sy).atan2(p[0] - sx);
+            let (s, c) = theta.sin_cos();
+            let cross = zj[0].abs() * sb;
+            noise.push((sr * sr * c * c + cross * cross * s * s).sqrt());
+            noise.push((sr * sr * s * s + cross * cross * c * c).sqrt());
+            rows.push(p);
+        }
+        let points = Measurements::from_rows(2, &rows).ok()?;
+        noise
+            .iter()
+            .all(|v| v.is_finite())
+            .then_some((points, noise))
+    }
+}
+
+impl BirthModel for RangeBearingGuidedBirth {
+    fn birth(
+        &self,
+        ctx: &StepContext,
+        evidence: Option<&BirthEvidence<'_>>,
+        rng: &mut FilterRng,
+    ) -> Vec<BirthTrack> {
+        self.birth.birth(ctx, evidence, rng)
+    }
+
+    fn uses_current_measurements(&self) -> bool {
+        true
+    }
+
+    fn birth_guided(
+        &self,
+        ctx: &StepContext,
+        evidence: Option<&BirthEvidence<'_>>,
+        current: &CurrentMeasurements<'_>,
+        rng: &mut FilterRng,
+    ) -> Vec<BirthTrack> {
+        if current.measurements.dim() != 2 {
+            return self.birth.birth(ctx, evidence, rng);
+        }
+        match self.points(current.measurements, ctx) {
+            Some((points, noise)) => {
+                self.birth
+                    .birth_near_points(&points, &noise, current.unexplained, rng)
+            }
+            None => self.birth.birth(ctx, evidence, rng),
+        }
     }
 }
 
@@ -514,6 +596,63 @@ mod tests {
         assert!(c.build().is_ok());
         c.birth = static_birth(r#", "measurement_proposal": false"#);
         assert!(c.build().is_ok());
+        // Range-bearing measurements: the guided birth runs through the filter.
+        c.measurement = MeasurementConfig::RangeBearing {
+            sigma_range: 1.0,
+            sigma_bearing: 0.01,
+            offset: [0.0, 0.0],
+            convention: BearingConvention::default(),
+        };
+        c.birth = static_birth("");
+        let mut f = c.build().unwrap();
+        let z = crate::filter::Measurements::from_rows(2, &[[50.0, 0.3], [20.0, -1.0]]).unwrap();
+        let mut rng = crate::rng::seeded(1);
+        for k in 0..3 {
+            let frame = crate::filter::Frame::new(k as f64, z.clone());
+            assert!(f.step(&frame, &mut rng).is_ok());
+        }
+        assert!(!f.tracks().is_empty());
+    }
+
+    #[test]
+    fn range_bearing_static_birth_is_guided_to_the_world_point() {
+        // Sensor at the origin facing +x; z = (100 m, 90°) reads the point (0, 100). Along the
+        // line of sight (y) the spread is σ_r = 1 m, across it (x) r·σ_b = 100 · 0.05 = 5 m.
+        let rb = RangeBearing::new(1.0, 0.05).unwrap();
+        let term = BirthTerm {
+            existence: 0.01,
+            mean: vec![0.0; 4],
+            std: vec![200.0, 10.0, 200.0, 10.0],
+        };
+        let proposal = BirthProposal::new(vec![0, 2], vec![1.0, 1.0]).unwrap();
+        let guided = RangeBearingGuidedBirth {
+            birth: StaticBirth::new(vec![term], 2000)
+                .unwrap()
+                .with_proposal(proposal)
+                .unwrap(),
+            sensor: rb,
+        };
+        let ctx = StepContext::new(1, 1.0, 1.0);
+        let z = Measurements::from_rows(2, &[[100.0, std::f64::consts::FRAC_PI_2]]).unwrap();
+        let (points, noise) = guided.points(&z, &ctx).unwrap();
+        let p = points.get(0);
+        assert!(p[0].abs() < 1e-9 && (p[1] - 100.0).abs() < 1e-9, "{p:?}");
+        assert!((noise[0] - 5.0).abs() < 1e-9 && (noise[1] - 1.0).abs() < 1e-9);
+        let current = CurrentMeasurements {
+            measurements: &z,
+            unexplained: &[1.0],
+        };
+        let b = guided.birth_guided(&ctx, None, &current, &mut crate::rng::seeded(1));
+        let set = &b[0].particles;
+        let near = set
+            .component(0)
+            .iter()
+            .zip(set.component(2))
+            .filter(|(x, y)| x.hypot(*y - 100.0) < 15.0)
+            .count();
+        // The prior puts ≈ 0.3 % of its particles within 15 m of the point.
+        assert!(near > 1000, "{near} of 2000 near the point");
+        assert!(set.weights().windows(2).any(|w| w[0] != w[1]));
     }
 
     #[test]
