@@ -31,19 +31,35 @@
 //! method = "lbp"                # or "murty" (k), "gibbs" (samples)
 //! ```
 //!
+//! Static birth terms (`model = "static"`) are sampled near the step's measurements that no
+//! existing track explains and importance-weighted, which leaves the birth density as written
+//! but puts its particles where a new object is seen ([`crate::filter::BirthProposal`]). This
+//! works with position measurements and, converted to world points with the frame's sensor
+//! pose, range-bearing ones. To sample every term from its own Gaussian instead, set
+//! `measurement_proposal = false`:
+//!
+//! ```toml
+//! [birth]
+//! model = "static"
+//! particles = 1000
+//! measurement_proposal = false  # default true
+//! terms = [{ existence = 0.01, mean = [0.0, 0.0, 0.0, 0.0], std = [50.0, 10.0, 50.0, 10.0] }]
+//! ```
+//!
 //! Not for: parsing the file text (the command-line tool does that with `toml`/`serde_json`).
+
+mod birth;
 
 use crate::error::{ensure_finite, Error, Result};
 use crate::filter::{
-    AdaptiveBirth, AssociationMethod, BirthTerm, LmbConfig, LmbFilter, ParticleSet, StaticBirth,
+    AdaptiveBirth, AssociationMethod, BirthProposal, BirthTerm, ConstantSurvival, LmbConfig,
+    LmbFilter, StaticBirth,
 };
-use crate::filter::{ConstantSurvival, StepContext};
 use crate::models::{
     BearingConvention, ConstantDetection, ConstantVelocity, CoordinatedTurn, FieldOfViewDetection,
     GaussianRangeDetection, PositionMeasurement, RangeBearing, UniformClutter,
 };
-use crate::rng::FilterRng;
-use rand_distr::{Distribution, StandardNormal};
+use birth::{MeasurementBirth, RangeBearingGuidedBirth};
 use serde::{Deserialize, Serialize};
 
 /// A complete, serialisable filter description.
@@ -194,6 +210,11 @@ pub enum BirthConfig {
         terms: Vec<BirthTerm>,
         /// Particles per birth track, 1 to [`crate::filter::MAX_PARTICLES`].
         particles: usize,
+        /// Sample the terms near the step's unexplained measurements, importance-weighted
+        /// ([`BirthProposal`]; range-bearing measurements converted to world points). Default
+        /// true.
+        #[serde(default = "default_measurement_proposal")]
+        measurement_proposal: bool,
     },
     /// [`AdaptiveBirth`] from unexplained measurements.
     Adaptive {
@@ -215,6 +236,10 @@ pub enum BirthConfig {
 
 fn default_turn_std() -> f64 {
     0.1
+}
+
+fn default_measurement_proposal() -> bool {
+    true
 }
 
 impl RunConfig {
@@ -293,7 +318,11 @@ impl RunConfig {
             (_, None) => unreachable!("range-bearing model built above"),
         };
         let builder = match &self.birth {
-            BirthConfig::Static { terms, particles } => {
+            BirthConfig::Static {
+                terms,
+                particles,
+                measurement_proposal,
+            } => {
                 if let Some((i, t)) = terms
                     .iter()
                     .enumerate()
@@ -307,7 +336,24 @@ impl RunConfig {
                         ),
                     ));
                 }
-                builder.birth(StaticBirth::new(terms.clone(), *particles)?)
+                let birth = StaticBirth::new(terms.clone(), *particles)?;
+                // The built-in layouts keep position in components 0, 2 (and 4).
+                let observed: Vec<usize> = (0..axes).map(|a| 2 * a).collect();
+                match (&self.measurement, &range_bearing, measurement_proposal) {
+                    (MeasurementConfig::Position { sigma }, _, true) => builder.birth(
+                        birth.with_proposal(BirthProposal::new(observed, vec![*sigma; axes])?)?,
+                    ),
+                    (_, Some(rb), true) => {
+                        // The proposal's own noise is not used: every point brings its spread.
+                        let (sr, _) = rb.noise();
+                        let proposal = BirthProposal::new(observed, vec![sr; axes])?;
+                        builder.birth(RangeBearingGuidedBirth {
+                            birth: birth.with_proposal(proposal)?,
+                            sensor: *rb,
+                        })
+                    }
+                    _ => builder.birth(birth),
+                }
             }
             BirthConfig::Adaptive {
                 expected_births,
@@ -344,53 +390,6 @@ impl RunConfig {
             }
         };
         Ok(builder)
-    }
-}
-
-/// Birth particles around a measured point: position from the measurement (converted from
-/// range-bearing with the frame's sensor pose) plus Gaussian spread, velocity and turn rate
-/// around zero.
-struct MeasurementBirth {
-    range_bearing: Option<RangeBearing>,
-    axes: usize,
-    turn_rate: bool,
-    position_std: f64,
-    velocity_std: f64,
-    turn_rate_std: f64,
-}
-
-impl crate::filter::BirthSampler for MeasurementBirth {
-    fn sample(&self, z: &[f64], ctx: &StepContext, n: usize, rng: &mut FilterRng) -> ParticleSet {
-        let position: Vec<f64> = match &self.range_bearing {
-            Some(rb) => rb.to_cartesian([z[0], z[1]], ctx).to_vec(),
-            None => z[..self.axes].to_vec(),
-        };
-        let mut mean: Vec<f64> = position.iter().flat_map(|&p| [p, 0.0]).collect();
-        let mut std: Vec<f64> = position
-            .iter()
-            .flat_map(|_| [self.position_std, self.velocity_std])
-            .collect();
-        if self.turn_rate {
-            mean.push(0.0);
-            std.push(self.turn_rate_std);
-        }
-        let mut set = ParticleSet::gaussian(&mean, &std, n, rng);
-        if let Some(rb) = &self.range_bearing {
-            // Spread along the measurement's own uncertainty as well: perturb each particle's
-            // range and bearing and convert again.
-            let (sr, sb) = rb.noise();
-            let comps = set.components_mut();
-            let mut it = comps.into_iter();
-            let (x, _, y) = (it.next().unwrap(), it.next().unwrap(), it.next().unwrap());
-            for (xi, yi) in x.iter_mut().zip(y.iter_mut()) {
-                let er: f64 = StandardNormal.sample(rng);
-                let eb: f64 = StandardNormal.sample(rng);
-                let p = rb.to_cartesian([z[0] + sr * er, z[1] + sb * eb], ctx);
-                *xi += p[0] - position[0];
-                *yi += p[1] - position[1];
-            }
-        }
-        set
     }
 }
 
@@ -438,6 +437,7 @@ mod tests {
                 std: vec![1.0; 3],
             }],
             particles: 10,
+            measurement_proposal: true,
         };
         assert!(c
             .build()
@@ -450,31 +450,48 @@ mod tests {
     }
 
     #[test]
-    fn range_bearing_birth_lands_on_the_measured_point() {
-        let rb = RangeBearing::new(1.0, 0.01).unwrap();
-        let s = MeasurementBirth {
-            range_bearing: Some(rb),
-            axes: 2,
-            turn_rate: true,
-            position_std: 0.1,
-            velocity_std: 1.0,
-            turn_rate_std: 0.1,
+    fn static_birth_uses_the_measurement_proposal_unless_turned_off() {
+        let static_birth = |extra: &str| -> BirthConfig {
+            let text = format!(
+                r#"{{"model": "static", "particles": 10{extra},
+                    "terms": [{{"existence": 0.01, "mean": [0, 0, 0, 0], "std": [50, 10, 50, 10]}}]}}"#
+            );
+            serde_json::from_str(&text).unwrap()
         };
-        let mut ctx = StepContext::new(0, 0.0, 1.0);
-        ctx.platform = Some(nalgebra::Isometry3::translation(10.0, 0.0, 0.0));
-        use crate::filter::BirthSampler;
-        let p = s.sample(
-            &[5.0, std::f64::consts::FRAC_PI_2],
-            &ctx,
-            4000,
-            &mut crate::rng::seeded(2),
-        );
-        let m = p.mean();
-        assert_eq!(p.dim(), 5);
-        // sensor at (10, 0) facing +x, bearing 90° → point (10, 5)
-        assert!(
-            (m[0] - 10.0).abs() < 0.1 && (m[2] - 5.0).abs() < 0.1,
-            "{m:?}"
-        );
+        assert!(matches!(
+            static_birth(""),
+            BirthConfig::Static {
+                measurement_proposal: true,
+                ..
+            }
+        ));
+        assert!(matches!(
+            static_birth(r#", "measurement_proposal": false"#),
+            BirthConfig::Static {
+                measurement_proposal: false,
+                ..
+            }
+        ));
+        let mut c = sample();
+        c.birth = static_birth("");
+        assert!(c.build().is_ok());
+        c.birth = static_birth(r#", "measurement_proposal": false"#);
+        assert!(c.build().is_ok());
+        // Range-bearing measurements: the guided birth runs through the filter.
+        c.measurement = MeasurementConfig::RangeBearing {
+            sigma_range: 1.0,
+            sigma_bearing: 0.01,
+            offset: [0.0, 0.0],
+            convention: BearingConvention::default(),
+        };
+        c.birth = static_birth("");
+        let mut f = c.build().unwrap();
+        let z = crate::filter::Measurements::from_rows(2, &[[50.0, 0.3], [20.0, -1.0]]).unwrap();
+        let mut rng = crate::rng::seeded(1);
+        for k in 0..3 {
+            let frame = crate::filter::Frame::new(k as f64, z.clone());
+            assert!(f.step(&frame, &mut rng).is_ok());
+        }
+        assert!(!f.tracks().is_empty());
     }
 }

@@ -12,7 +12,7 @@
 //! [`super::association`]).
 
 use super::association::{AssociationMethod, AssociationProblem, Associator, Marginals};
-use super::birth::{BirthEvidence, BirthModel};
+use super::birth::{unexplained, BirthEvidence, BirthModel, CurrentMeasurements};
 use super::estimate::map_estimates;
 use super::groups::partition;
 use super::track::{Estimate, Track};
@@ -417,7 +417,7 @@ impl LmbFilter {
         let seed = rng.next_u64();
 
         self.predict(&ctx, seed)?;
-        self.add_births(&ctx, seed);
+        self.add_births(&ctx, z, seed);
         let predicted = self.predicted_copies();
         let likelihoods = self.likelihoods(z, &ctx)?;
         let marginals = self.associate(z, &ctx, &likelihoods, seed);
@@ -523,17 +523,31 @@ impl LmbFilter {
         }
     }
 
-    /// Appends the birth tracks of this step, labelled (step, index).
-    fn add_births(&mut self, ctx: &StepContext, seed: u64) {
+    /// Appends the birth tracks of this step, labelled (step, index). A birth model that
+    /// samples near this step's measurements is told how unexplained the predicted tracks
+    /// leave each of them.
+    fn add_births(&mut self, ctx: &StepContext, z: &Measurements, seed: u64) {
         let evidence = self.previous.as_ref().map(|p| BirthEvidence {
             measurements: &p.measurements,
             assigned: &p.assigned,
             context: &p.context,
         });
-        let births = self
-            .models
-            .birth
-            .birth(ctx, evidence.as_ref(), &mut stream(seed, KEY_BIRTH));
+        let m = &self.models;
+        let u = if m.birth.uses_current_measurements() {
+            unexplained(&self.tracks, z, &*m.measurement, ctx)
+        } else {
+            Vec::new()
+        };
+        let current = CurrentMeasurements {
+            measurements: z,
+            unexplained: &u,
+        };
+        let births = m.birth.birth_guided(
+            ctx,
+            evidence.as_ref(),
+            &current,
+            &mut stream(seed, KEY_BIRTH),
+        );
         let step = self.step;
         let transition = &self.models.transition;
         let new: Vec<Track> = births

@@ -26,8 +26,8 @@ pub mod track;
 
 pub use association::{AssociationMethod, Associator};
 pub use birth::{
-    AdaptiveBirth, BirthModel, BirthSampler, BirthTerm, BirthTrack, PositionBirthSampler,
-    StaticBirth,
+    AdaptiveBirth, BirthModel, BirthProposal, BirthSampler, BirthTerm, BirthTrack,
+    CurrentMeasurements, PositionBirthSampler, StaticBirth,
 };
 pub use label::Label;
 pub use lmb::{

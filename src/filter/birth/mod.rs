@@ -6,11 +6,26 @@
 //! measurement of the previous step that the existing tracks explained poorly proposes a new
 //! track, with an existence probability that grows with how unexplained it was. Not for:
 //! assigning labels (the filter does that).
+//!
+//! A static birth term is a broad density, and few of its particles would land where a new
+//! object is seen. Given a [`BirthProposal`] (the default in [`crate::config`]), static birth
+//! samples each term from a mixture of the term and the term conditioned on each of the
+//! step's measurements that no existing track explains ([`proposal`], [`unexplained`]), and
+//! weights the particles prior / proposal: the same birth density, better sampled. The filter
+//! hands a birth model the step's measurements through [`BirthModel::birth_guided`].
+
+mod proposal;
+mod unexplained;
+
+pub use proposal::{BirthProposal, DEFAULT_PRIOR_SHARE};
+pub use unexplained::unexplained;
 
 use super::{Measurements, ParticleSet};
 use crate::error::{ensure_finite, Error, Result};
 use crate::filter::{StepContext, MAX_PARTICLES};
-use crate::rng::FilterRng;
+use crate::rng::{stream, FilterRng};
+use rand::Rng;
+use rayon::prelude::*;
 
 /// A proposed new track, before it gets its label.
 #[derive(Clone, Debug, PartialEq)]
@@ -35,6 +50,17 @@ pub struct BirthEvidence<'a> {
     pub context: &'a StepContext,
 }
 
+/// The step's own measurements, the ones its birth tracks will be updated with, for birth
+/// models that sample where they are.
+#[derive(Clone, Debug)]
+pub struct CurrentMeasurements<'a> {
+    /// This step's measurements.
+    pub measurements: &'a Measurements,
+    /// For each of them, u(z) ∈ [0, 1]: how unexplained the predicted tracks leave it (see
+    /// [`unexplained`]). An empty slice means every measurement counts as unexplained.
+    pub unexplained: &'a [f64],
+}
+
 /// Produces the birth LMB of a step.
 pub trait BirthModel: Send + Sync {
     /// The birth tracks of the step described by `ctx`. `evidence` holds the previous step's
@@ -45,6 +71,27 @@ pub trait BirthModel: Send + Sync {
         evidence: Option<&BirthEvidence<'_>>,
         rng: &mut FilterRng,
     ) -> Vec<BirthTrack>;
+
+    /// Whether [`BirthModel::birth_guided`] looks at the step's measurements; when false the
+    /// filter does not work out which of them are unexplained. Default false.
+    fn uses_current_measurements(&self) -> bool {
+        false
+    }
+
+    /// The birth tracks of the step, told also the step's own measurements. The filter calls
+    /// this one. A model may use the measurements to decide *how* to sample its densities
+    /// (importance sampling), never *what* they are: its existence probabilities and densities
+    /// must be those of [`BirthModel::birth`]. Default: [`BirthModel::birth`].
+    fn birth_guided(
+        &self,
+        ctx: &StepContext,
+        evidence: Option<&BirthEvidence<'_>>,
+        current: &CurrentMeasurements<'_>,
+        rng: &mut FilterRng,
+    ) -> Vec<BirthTrack> {
+        let _ = current;
+        self.birth(ctx, evidence, rng)
+    }
 }
 
 impl<T: BirthModel + ?Sized> BirthModel for Box<T> {
@@ -55,6 +102,18 @@ impl<T: BirthModel + ?Sized> BirthModel for Box<T> {
         rng: &mut FilterRng,
     ) -> Vec<BirthTrack> {
         (**self).birth(ctx, evidence, rng)
+    }
+    fn uses_current_measurements(&self) -> bool {
+        (**self).uses_current_measurements()
+    }
+    fn birth_guided(
+        &self,
+        ctx: &StepContext,
+        evidence: Option<&BirthEvidence<'_>>,
+        current: &CurrentMeasurements<'_>,
+        rng: &mut FilterRng,
+    ) -> Vec<BirthTrack> {
+        (**self).birth_guided(ctx, evidence, current, rng)
     }
 }
 
@@ -84,11 +143,14 @@ fn check_particles(particles: usize) -> Result<()> {
     Ok(())
 }
 
-/// A fixed list of Gaussian birth terms, proposed at every step.
+/// A fixed list of Gaussian birth terms, proposed at every step. Without a proposal each
+/// term's particles are drawn from the term itself; with one ([`StaticBirth::with_proposal`])
+/// they are drawn near the step's unexplained measurements and importance-weighted.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StaticBirth {
     terms: Vec<BirthTerm>,
     particles: usize,
+    proposal: Option<BirthProposal>,
 }
 
 impl StaticBirth {
@@ -115,12 +177,31 @@ impl StaticBirth {
             }
         }
         check_particles(particles)?;
-        Ok(StaticBirth { terms, particles })
+        Ok(StaticBirth {
+            terms,
+            particles,
+            proposal: None,
+        })
+    }
+
+    /// The same terms, sampled with a measurement-guided proposal (the birth density is
+    /// unchanged). Fails when the proposal observes a component the terms do not have.
+    pub fn with_proposal(mut self, proposal: BirthProposal) -> Result<Self> {
+        for t in &self.terms {
+            proposal.check_state_dim(t.mean.len())?;
+        }
+        self.proposal = Some(proposal);
+        Ok(self)
     }
 
     /// The terms.
     pub fn terms(&self) -> &[BirthTerm] {
         &self.terms
+    }
+
+    /// The measurement-guided proposal, if any.
+    pub fn proposal(&self) -> Option<&BirthProposal> {
+        self.proposal.as_ref()
     }
 }
 
@@ -136,6 +217,65 @@ impl BirthModel for StaticBirth {
             .map(|t| BirthTrack {
                 existence: t.existence,
                 particles: ParticleSet::gaussian(&t.mean, &t.std, self.particles, rng),
+                at_previous_step: false,
+            })
+            .collect()
+    }
+
+    fn uses_current_measurements(&self) -> bool {
+        self.proposal.is_some()
+    }
+
+    /// With a proposal, every term is sampled from its own random stream (derived from one
+    /// draw of `rng` and the term's index), in parallel; the result does not depend on the
+    /// thread count.
+    fn birth_guided(
+        &self,
+        ctx: &StepContext,
+        evidence: Option<&BirthEvidence<'_>>,
+        current: &CurrentMeasurements<'_>,
+        rng: &mut FilterRng,
+    ) -> Vec<BirthTrack> {
+        match &self.proposal {
+            None => self.birth(ctx, evidence, rng),
+            Some(proposal) => self.each_term(rng, |t, n, rng| proposal.sample(t, current, n, rng)),
+        }
+    }
+}
+
+impl StaticBirth {
+    /// The birth tracks of a step with every term sampled near `points`: the step's
+    /// measurements converted to the proposal's observed components, with their spreads and
+    /// u(z) (see [`BirthProposal::sample_points`]). For birth models that wrap a static birth
+    /// for measurements that are not positions (range-bearing); without a proposal this is
+    /// [`BirthModel::birth`].
+    pub fn birth_near_points(
+        &self,
+        points: &Measurements,
+        noise_std: &[f64],
+        unexplained: &[f64],
+        rng: &mut FilterRng,
+    ) -> Vec<BirthTrack> {
+        match &self.proposal {
+            None => self.birth(&StepContext::new(0, 0.0, 0.0), None, rng),
+            Some(proposal) => self.each_term(rng, |t, n, rng| {
+                proposal.sample_points(t, points, noise_std, unexplained, n, rng)
+            }),
+        }
+    }
+
+    /// One birth track per term, its particles from `sample` with the term's own stream.
+    fn each_term<F>(&self, rng: &mut FilterRng, sample: F) -> Vec<BirthTrack>
+    where
+        F: Fn(&BirthTerm, usize, &mut FilterRng) -> ParticleSet + Sync,
+    {
+        let seed = rng.next_u64();
+        self.terms
+            .par_iter()
+            .enumerate()
+            .map(|(i, t)| BirthTrack {
+                existence: t.existence,
+                particles: sample(t, self.particles, &mut stream(seed, i as u64)),
                 at_previous_step: false,
             })
             .collect()
@@ -325,6 +465,57 @@ mod tests {
         assert!((mean[0] - 10.0).abs() < 0.1 && (mean[2] + 4.0).abs() < 0.1 && mean[1].abs() < 0.1);
         assert!(births[0].at_previous_step);
         assert!(b.birth(&ctx, None, &mut seeded(4)).is_empty());
+    }
+
+    #[test]
+    fn guided_static_birth_does_not_depend_on_the_thread_count() {
+        let terms: Vec<BirthTerm> = (0..6)
+            .map(|i| BirthTerm {
+                existence: 0.01,
+                mean: vec![30.0 * i as f64, 0.0, 0.0, 0.0],
+                std: vec![50.0, 10.0, 50.0, 10.0],
+            })
+            .collect();
+        let proposal = BirthProposal::new(vec![0, 2], vec![1.0, 1.0]).unwrap();
+        let birth = StaticBirth::new(terms, 500)
+            .unwrap()
+            .with_proposal(proposal)
+            .unwrap();
+        assert!(birth.uses_current_measurements());
+        let z = Measurements::from_rows(2, &[[40.0, 10.0], [100.0, -30.0]]).unwrap();
+        let ctx = StepContext::new(1, 1.0, 1.0);
+        let current = CurrentMeasurements {
+            measurements: &z,
+            unexplained: &[1.0, 1.0],
+        };
+        let run = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| birth.birth_guided(&ctx, None, &current, &mut seeded(8)))
+        };
+        let one = run(1);
+        assert_eq!(one.len(), 6);
+        assert!(one
+            .iter()
+            .all(|b| b.existence == 0.01 && !b.at_previous_step));
+        // Guided: some term's weights are not all equal.
+        assert!(one
+            .iter()
+            .any(|b| b.particles.weights().windows(2).any(|w| w[0] != w[1])));
+        assert_eq!(one, run(3));
+        // Without the proposal the same model samples every term plainly.
+        let plain = StaticBirth::new(birth.terms().to_vec(), 500).unwrap();
+        assert!(!plain.uses_current_measurements());
+        let b = plain.birth_guided(&ctx, None, &current, &mut seeded(8));
+        assert!(b
+            .iter()
+            .all(|b| b.particles.weights().windows(2).all(|w| w[0] == w[1])));
+        assert!(StaticBirth::new(birth.terms().to_vec(), 10)
+            .unwrap()
+            .with_proposal(BirthProposal::new(vec![0, 4], vec![1.0, 1.0]).unwrap())
+            .is_err());
     }
 
     #[test]
