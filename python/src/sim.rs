@@ -48,9 +48,12 @@ fn linear_config(sc: &Scenario, seed: u64, particles: usize) -> PyResult<RunConf
             rate,
             volume: (x[1] - x[0]) * (y[1] - y[0]),
         },
+        // Sampled from the prior, as `rfs_benchmark` (Rust) samples it, so that the two time
+        // the same filter.
         birth: BirthConfig::Static {
             terms: sc.birth.clone(),
             particles,
+            measurement_proposal: false,
         },
         association: Default::default(),
     })
