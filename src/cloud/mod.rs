@@ -1,5 +1,6 @@
 //! Point clouds: the [`PointCloud`] type (structure of arrays, f32) and the KITTI Velodyne
-//! `.bin` reader and writer, LAS, PLY and PCD import/export (optionally coloured by label),
+//! `.bin` reader and writer, LAS, PLY and PCD import/export, a scan read by its format
+//! ([`read_scan_with`]) (optionally coloured by label),
 //! Euclidean clustering of points into object candidates, the range image of a spinning
 //! scan with its ground and angle-criterion clusters ([`range_image`]), and lidar odometry
 //! (the scanner's motion from its own scans, [`odometry`]).
@@ -20,6 +21,7 @@ pub mod planes;
 pub mod ply_io;
 pub mod points;
 pub mod range_image;
+pub mod scan_file;
 
 pub use cluster::{euclidean_clusters, euclidean_clusters_of, Cluster, ClusterParams};
 pub use kitti_bin::{read_kitti_bin, read_kitti_bin_with, write_kitti_bin, BinScan, NonFinite};
@@ -31,3 +33,4 @@ pub use pcd_io::{
 };
 pub use ply_io::{read_ply, write_ply, write_ply_labelled};
 pub use points::{Bounds, Point, PointCloud};
+pub use scan_file::{is_pcd, read_scan_with};

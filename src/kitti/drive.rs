@@ -8,6 +8,8 @@
 //!     oxts/data/0000000000.txt ...              oxts/timestamps.txt
 //! ```
 //!
+//! The scans may also be numbered `.pcd` files (a recording kept as PCD) in place of `.bin`.
+//!
 //! Opening lists the frame files only; clouds, packets, stamps and calibration are read when
 //! asked for. Either sensor folder may be absent: a drive without OXTS still gives point clouds,
 //! and asking it for poses is an error naming the missing folder. [`RawDrive::check`] reports
@@ -17,12 +19,15 @@
 //! tracking benchmark layout (see [`super::tracking`]).
 
 use super::calib::{read_cam_to_cam, read_rigid_calib, CamToCamCalib, RigidCalib};
-use super::frames::{frame_file_name, list_frame_files, numbering_gaps, require_contiguous};
+use super::frames::{
+    frame_file_name, list_frame_files, list_scan_files, listed_path, numbering_gaps,
+    require_contiguous,
+};
 use super::issue::Issue;
 use super::oxts::{read_oxts_file, OxtsPacket};
 use super::poses::{self, VehicleState};
 use super::timestamps::{read_timestamps, Timestamps};
-use crate::cloud::{read_kitti_bin_with, BinScan, NonFinite, PointCloud};
+use crate::cloud::{read_scan_with, BinScan, NonFinite, PointCloud};
 use crate::error::{Error, Result};
 use nalgebra::Isometry3;
 use std::path::{Path, PathBuf};
@@ -85,7 +90,12 @@ impl RawDrive {
             Some(_) => PathBuf::from("."),
             None => dir.clone(),
         };
-        let velodyne = list_if_present(&dir.join("velodyne_points").join("data"), "bin")?;
+        let vdir = dir.join("velodyne_points").join("data");
+        let velodyne = if vdir.is_dir() {
+            Some(list_scan_files(&vdir)?)
+        } else {
+            None
+        };
         let oxts = list_if_present(&dir.join("oxts").join("data"), "txt")?;
         Ok(RawDrive {
             dir,
@@ -143,7 +153,8 @@ impl RawDrive {
         self.oxts.is_some()
     }
 
-    /// Number of `.bin` files in `velodyne_points/data` (0 when the folder is missing).
+    /// Number of scan files (`.bin`, or `.pcd` when there is no `.bin`) in
+    /// `velodyne_points/data` (0 when the folder is missing).
     pub fn velodyne_count(&self) -> usize {
         self.velodyne.as_ref().map_or(0, Vec::len)
     }
@@ -163,9 +174,14 @@ impl RawDrive {
         }
     }
 
-    /// Path of Velodyne frame `k` (whether or not it exists).
+    /// Path of Velodyne frame `k`: the listed `.bin` or `.pcd` file, else (whether or not it
+    /// exists) the `.bin` name.
     pub fn velodyne_path(&self, k: usize) -> PathBuf {
-        self.velodyne_dir().join(frame_file_name(k as u64, "bin"))
+        self.velodyne
+            .as_deref()
+            .and_then(|v| listed_path(v, k as u64))
+            .map(Path::to_path_buf)
+            .unwrap_or_else(|| self.velodyne_dir().join(frame_file_name(k as u64, "bin")))
     }
 
     /// Reads Velodyne frame `k`; a non-finite value is an error naming the file and point.
@@ -181,7 +197,7 @@ impl RawDrive {
                 "this drive has no Velodyne point clouds",
             ));
         }
-        read_kitti_bin_with(self.velodyne_path(k), policy)
+        read_scan_with(self.velodyne_path(k), policy)
     }
 
     /// Reads every OXTS packet, in frame order.

@@ -51,6 +51,37 @@ pub fn list_frame_files(dir: &Path, ext: &str) -> Result<Vec<(u64, PathBuf)>> {
     Ok(files)
 }
 
+/// The scan files of a Velodyne folder: its numbered `.bin` files, or its numbered `.pcd`
+/// files when it holds no `.bin` (a recording kept as PCD). A folder holding both kinds is an
+/// error naming it.
+pub fn list_scan_files(dir: &Path) -> Result<Vec<(u64, PathBuf)>> {
+    let bin = list_frame_files(dir, "bin")?;
+    let pcd = list_frame_files(dir, "pcd")?;
+    match (bin.is_empty(), pcd.is_empty()) {
+        (false, false) => Err(Error::invalid(
+            format!("scan folder {}", dir.display()),
+            format!(
+                "holds both .bin ({}) and .pcd ({}) scans; keep one kind",
+                bin.len(),
+                pcd.len()
+            ),
+        )),
+        (true, false) => Ok(pcd),
+        _ => Ok(bin),
+    }
+}
+
+/// The path of frame `k` in a sorted frame list, when listed.
+pub(crate) fn listed_path(files: &[(u64, PathBuf)], k: u64) -> Option<&Path> {
+    match files.get(k as usize) {
+        Some((n, p)) if *n == k => Some(p),
+        _ => files
+            .binary_search_by_key(&k, |f| f.0)
+            .ok()
+            .map(|i| files[i].1.as_path()),
+    }
+}
+
 /// Frame numbers missing from `0..=max` in a sorted list of frame numbers, as inclusive ranges.
 pub fn numbering_gaps(numbers: impl IntoIterator<Item = u64>) -> Vec<(u64, u64)> {
     let mut gaps = Vec::new();

@@ -15,11 +15,11 @@
 //! Not for: the raw-drive layout (see [`super::drive`]).
 
 use super::calib::{rigid_from_parts, CalibFile};
-use super::frames::{list_frame_files, numbering_gaps};
+use super::frames::{list_scan_files, listed_path, numbering_gaps};
 use super::issue::Issue;
 use super::text::{numbered_lines, parse_f64, read_text};
 use crate::atomic::write_atomically;
-use crate::cloud::{read_kitti_bin_with, BinScan, NonFinite, PointCloud};
+use crate::cloud::{read_scan_with, BinScan, NonFinite, PointCloud};
 use crate::error::{Error, Result};
 use nalgebra::{Isometry3, Matrix3, Vector3};
 use std::io::Write;
@@ -121,7 +121,7 @@ impl OdometrySequence {
         }
         let vdir = dir.join("velodyne");
         let velodyne = if vdir.is_dir() {
-            Some(list_frame_files(&vdir, "bin")?)
+            Some(list_scan_files(&vdir)?)
         } else {
             None
         };
@@ -167,9 +167,14 @@ impl OdometrySequence {
         self.velodyne.as_ref().map_or(0, Vec::len)
     }
 
-    /// Path of scan `k` (`NNNNNN.bin`, six digits as in the benchmark).
+    /// Path of scan `k`: the listed `.bin` or `.pcd` file, else (whether or not it exists)
+    /// `NNNNNN.bin`, six digits as in the benchmark.
     pub fn velodyne_path(&self, k: usize) -> PathBuf {
-        self.velodyne_dir().join(format!("{k:06}.bin"))
+        self.velodyne
+            .as_deref()
+            .and_then(|v| listed_path(v, k as u64))
+            .map(Path::to_path_buf)
+            .unwrap_or_else(|| self.velodyne_dir().join(format!("{k:06}.bin")))
     }
 
     /// Reads scan `k`; a non-finite value is an error naming the file and point.
@@ -186,7 +191,7 @@ impl OdometrySequence {
                 std::io::Error::new(std::io::ErrorKind::NotFound, "folder missing; no scans"),
             ));
         }
-        read_kitti_bin_with(self.velodyne_path(k), policy)
+        read_scan_with(self.velodyne_path(k), policy)
     }
 
     /// The frame times, seconds.

@@ -21,13 +21,13 @@
 //! [`super::odometry`]).
 
 use super::calib::{rigid_from_parts, CalibEntry, CalibFile};
-use super::frames::{list_frame_files, numbering_gaps};
+use super::frames::{list_scan_files, listed_path, numbering_gaps};
 use super::issue::Issue;
 use super::labels::{read_tracking_labels, TrackingLabel};
 use super::oxts::OxtsPacket;
 use super::poses::{self, VehicleState};
 use super::text::{numbered_lines, read_text};
-use crate::cloud::{read_kitti_bin_with, BinScan, NonFinite, PointCloud};
+use crate::cloud::{read_scan_with, BinScan, NonFinite, PointCloud};
 use crate::error::{Error, Result};
 use nalgebra::{Isometry3, Matrix3, Matrix3x4, Point3, Translation3, UnitQuaternion, Vector3};
 use std::path::{Path, PathBuf};
@@ -240,7 +240,7 @@ impl TrackingSequence {
         let name = format!("{sequence:04}");
         let vdir = root.join("velodyne").join(&name);
         let velodyne = if vdir.is_dir() {
-            Some(list_frame_files(&vdir, "bin")?)
+            Some(list_scan_files(&vdir)?)
         } else {
             None
         };
@@ -319,9 +319,14 @@ impl TrackingSequence {
         }
     }
 
-    /// Path of scan `k` (`NNNNNN.bin`, six digits as in the benchmark).
+    /// Path of scan `k`: the listed `.bin` or `.pcd` file, else (whether or not it exists)
+    /// `NNNNNN.bin`, six digits as in the benchmark.
     pub fn velodyne_path(&self, k: usize) -> PathBuf {
-        self.velodyne_dir().join(format!("{k:06}.bin"))
+        self.velodyne
+            .as_deref()
+            .and_then(|v| listed_path(v, k as u64))
+            .map(Path::to_path_buf)
+            .unwrap_or_else(|| self.velodyne_dir().join(format!("{k:06}.bin")))
     }
 
     /// Reads scan `k`; a non-finite value is an error naming the file and point.
@@ -338,7 +343,7 @@ impl TrackingSequence {
                 std::io::Error::new(std::io::ErrorKind::NotFound, "folder missing; no scans"),
             ));
         }
-        read_kitti_bin_with(self.velodyne_path(k), policy)
+        read_scan_with(self.velodyne_path(k), policy)
     }
 
     /// Every packet of the OXTS file, whatever the number of scans.

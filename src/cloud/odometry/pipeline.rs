@@ -7,7 +7,7 @@ use super::registration::{align_points_to_map, IcpParams};
 use super::se3::renormalized;
 use super::threshold::AdaptiveThreshold;
 use super::voxel_map::VoxelHashMap;
-use crate::cloud::{read_kitti_bin, read_pcd_with, NonFinite, PointCloud};
+use crate::cloud::{is_pcd, read_scan_with, NonFinite, PointCloud};
 use crate::error::{Error, Result};
 use nalgebra::Isometry3;
 use std::path::{Path, PathBuf};
@@ -172,16 +172,15 @@ pub fn odometry_of_frames(
     Ok(odometry.poses.clone())
 }
 
-/// Reads one scan by its extension: `.pcd` without its non-finite points, else `.bin`.
+/// Reads one scan by its extension: `.pcd` without its non-finite points (an organised
+/// cloud's invalid points), else `.bin`.
 fn read_scan(path: &Path) -> Result<PointCloud> {
-    let pcd = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("pcd"));
-    if pcd {
-        Ok(read_pcd_with(path, NonFinite::Skip)?.cloud)
+    let policy = if is_pcd(path) {
+        NonFinite::Skip
     } else {
-        read_kitti_bin(path)
-    }
+        NonFinite::Error
+    };
+    Ok(read_scan_with(path, policy)?.cloud)
 }
 
 fn named(path: &Path, e: Error) -> Error {
