@@ -6,11 +6,13 @@
 //! layout with its cars and pedestrians as `label_02` labels; [`generate`] keeps it in memory
 //! with per-point labels.
 //!
-//! The pieces: [`ego`] (the vehicle's motion), [`world`] (the scene), [`lidar`] (the ray
+//! The pieces: [`ego`] (the vehicle's motion), [`world`] (the scene), [`ground`] (the road
+//! surface's relief), [`lidar`] (the ray
 //! caster), [`truth`] (what is written as ground truth), [`writer`] (the raw layout's files),
 //! [`tracking_writer`] (the tracking layout's).
 //!
-//! **Poses.** The OXTS unit is simulated level (roll = pitch = 0) at constant height; the
+//! **Poses.** The OXTS unit rolls, pitches and heaves a little with the body (see [`body`]);
+//! the
 //! Velodyne pose follows from the IMU→Velodyne calibration exactly as the reader derives it
 //! (W_velo = W_imu·T_velo_imu⁻¹, with the calibration as the reader parses it), and the
 //! mounting height is that of the Velodyne origin. Latitude and longitude are the world x/y
@@ -24,15 +26,19 @@
 //!
 //! Not for: reading drives back (see [`crate::kitti`]) or scoring trackers against the truth.
 
+pub mod body;
 pub mod calib_files;
 pub mod ego;
+pub mod ground;
 pub mod lidar;
 pub mod tracking_writer;
 pub mod truth;
 pub mod world;
 pub mod writer;
 
+pub use body::{BodyMotion, BodyMotionConfig};
 pub use ego::{EgoState, EgoTrajectory, LegSpec};
+pub use ground::{Ground, GroundConfig, ReliefOctave};
 pub use lidar::{LidarConfig, LidarScan, Surface};
 pub use tracking_writer::{write_tracking_sequence, WrittenSequence};
 pub use truth::{FrameTruth, ObjectState, ObjectTruth, PoseTruth, StreetTruth, WallTruth};
@@ -51,6 +57,10 @@ use std::path::Path;
 
 /// Key of the scene's random stream.
 const SCENE_KEY: u64 = 0x5743_4E45;
+/// Key of the ground relief's hash.
+const GROUND_KEY: u64 = 0x4752_4E44;
+/// Key of the body motion's random stream.
+const BODY_KEY: u64 = 0x424F_4459;
 /// Standard gravity, m/s² (OXTS accelerations include it, as the real unit's do).
 const GRAVITY: f64 = 9.80665;
 
@@ -185,6 +195,10 @@ pub struct StreetConfig {
     pub route: Vec<LegSpec>,
     /// Street geometry.
     pub street: StreetLayout,
+    /// The ground's relief.
+    pub ground: GroundConfig,
+    /// The vehicle body's roll, pitch and heave.
+    pub body: BodyMotionConfig,
     /// Cars and pedestrians.
     pub traffic: TrafficConfig,
     /// The lidar.
@@ -217,6 +231,8 @@ impl Default for StreetConfig {
                 },
             ],
             street: StreetLayout::default(),
+            ground: GroundConfig::default(),
+            body: BodyMotionConfig::default(),
             traffic: TrafficConfig::default(),
             lidar: LidarConfig::default(),
             recording: Recording::default(),
@@ -270,6 +286,8 @@ impl StreetConfig {
         ensure_non_negative("street.min_wall_piece", s.min_wall_piece)?;
         ensure_non_negative("street.behind_start", s.behind_start)?;
         ensure_positive("street.beyond_end", s.beyond_end)?;
+        self.ground.validate()?;
+        self.body.validate()?;
         let t = &self.traffic;
         for (i, v) in t.car_size.iter().enumerate() {
             ensure_positive(&format!("traffic.car_size[{i}]"), *v)?;
@@ -356,6 +374,8 @@ pub struct StreetSimulator {
     seed: u64,
     trajectory: EgoTrajectory,
     street: Street,
+    ground: Ground,
+    body: BodyMotion,
     t_velo_imu: Isometry3<f64>,
     imu_height: f64,
     mercator: Mercator,
@@ -407,6 +427,8 @@ impl StreetSimulator {
         let mut rng = stream(seed, SCENE_KEY);
         let street =
             world::build_street(config, &trajectory.straight_lines(), &ego, &times, &mut rng)?;
+        let ground = Ground::new(&config.ground, mix64(seed ^ mix64(GROUND_KEY)));
+        let body = BodyMotion::new(&config.body, &mut stream(seed, BODY_KEY));
         let r = &config.recording;
         let mercator = Mercator::from_reference_latitude(r.latitude)?;
         let origin_xy = mercator.project(r.latitude, r.longitude);
@@ -416,6 +438,8 @@ impl StreetSimulator {
             seed,
             trajectory,
             street,
+            ground,
+            body,
             t_velo_imu,
             imu_height,
             mercator,
@@ -439,6 +463,11 @@ impl StreetSimulator {
         &self.street
     }
 
+    /// The ground surface.
+    pub fn ground(&self) -> &Ground {
+        &self.ground
+    }
+
     /// Time of frame k since frame 0, seconds.
     pub fn time(&self, k: usize) -> f64 {
         k as f64 * self.config.frame_period
@@ -460,12 +489,15 @@ impl StreetSimulator {
         self.t_velo_imu
     }
 
-    /// The IMU pose in the world at frame k (level, heading wrapped as in the OXTS packet).
+    /// The IMU pose in the world at frame k (roll, pitch and heave of the body, heading
+    /// wrapped as in the OXTS packet).
     pub fn imu_pose(&self, k: usize) -> Isometry3<f64> {
         let s = self.ego(k);
+        let t = self.time(k);
+        let (roll, pitch) = self.body.attitude(t);
         Isometry3::from_parts(
-            Translation3::new(s.x, s.y, self.imu_height),
-            oxts_rotation(0.0, 0.0, wrap_angle(s.yaw)),
+            Translation3::new(s.x, s.y, self.imu_height + self.body.heave(t)),
+            oxts_rotation(roll, pitch, wrap_angle(s.yaw)),
         )
     }
 
@@ -487,29 +519,33 @@ impl StreetSimulator {
             .unproject(self.origin_xy.0 + s.x, self.origin_xy.1 + s.y);
         let (ve, vn) = s.velocity();
         let lateral = s.speed * s.yaw_rate;
+        let t = self.time(k);
+        let (roll, pitch) = self.body.attitude(t);
+        let (roll_rate, pitch_rate) = self.body.attitude_rate(t);
+        let (sy, cy) = s.yaw.sin_cos();
         OxtsPacket {
             lat,
             lon,
-            alt: self.config.recording.altitude + self.imu_height,
-            roll: 0.0,
-            pitch: 0.0,
+            alt: self.config.recording.altitude + self.imu_height + self.body.heave(t),
+            roll,
+            pitch,
             yaw: wrap_angle(s.yaw),
             vn,
             ve,
             vf: s.speed,
             vl: 0.0,
-            vu: 0.0,
+            vu: self.body.heave_rate(t),
             ax: 0.0,
             ay: lateral,
             az: GRAVITY,
             af: 0.0,
             al: lateral,
             au: GRAVITY,
-            wx: 0.0,
-            wy: 0.0,
+            wx: cy * roll_rate - sy * pitch_rate,
+            wy: sy * roll_rate + cy * pitch_rate,
             wz: s.yaw_rate,
-            wf: 0.0,
-            wl: 0.0,
+            wf: roll_rate,
+            wl: pitch_rate,
             wu: s.yaw_rate,
             pos_accuracy: 0.02,
             vel_accuracy: 0.01,
@@ -525,7 +561,13 @@ impl StreetSimulator {
     pub fn scan(&self, k: usize) -> LidarScan {
         let shapes = self.street.shapes_at(self.time(k));
         let seed = mix64(self.seed ^ mix64(0x5CA4_0000 + k as u64));
-        lidar::cast_scan(&shapes, &self.velodyne_pose(k), &self.config.lidar, seed)
+        lidar::cast_scan(
+            &shapes,
+            &self.ground,
+            &self.velodyne_pose(k),
+            &self.config.lidar,
+            seed,
+        )
     }
 
     /// The truth without point counts (all zero); add them with [`record_scan`](Self::record_scan).

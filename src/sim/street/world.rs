@@ -1,4 +1,5 @@
-//! The simulated street scene in the world frame (x east, y north, z up, ground z = 0): the
+//! The simulated street scene in the world frame (x east, y north, z up, ground near z = 0,
+//! see [`super::ground`]): the
 //! street segments that follow the ego route, building walls along both sides, and the
 //! parked cars, moving cars and pedestrians with their motion.
 //!
