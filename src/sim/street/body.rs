@@ -109,7 +109,10 @@ impl Oscillation {
     }
 
     fn value(&self, t: f64) -> f64 {
-        self.0.iter().map(|(a, w, p)| a * (w * t + p).sin()).sum()
+        // From +0.0, so that a zero amplitude gives +0.0 (as written to OXTS files).
+        self.0
+            .iter()
+            .fold(0.0, |s, (a, w, p)| s + a * (w * t + p).sin())
     }
 
     fn rate(&self, t: f64) -> f64 {
