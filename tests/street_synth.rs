@@ -7,7 +7,8 @@ use smc_lmb::cloud::planes::{extract_planes, PlaneConfig};
 use smc_lmb::cloud::{read_kitti_bin, PointCloud};
 use smc_lmb::kitti::RawDrive;
 use smc_lmb::sim::street::{
-    generate, write_drive, LegSpec, StreetConfig, StreetTruth, Surface, WrittenDrive,
+    generate, write_drive, LegSpec, StreetConfig, StreetSimulator, StreetTruth, Surface,
+    WrittenDrive,
 };
 use std::path::Path;
 use std::time::Instant;
@@ -138,12 +139,15 @@ fn full_resolution_frame_has_kitti_density_and_points_lie_on_their_surfaces() {
     let truth = &run.truth;
     let pose = truth.frames[0].velodyne_pose.to_isometry();
     let pts = world_points(&scan.cloud, &pose);
-    // Ground points at z = 0 in the world.
+    // Ground points on the ground's surface in the world, which is near z = 0.
+    let sim = StreetSimulator::new(&config, 1, 3).unwrap();
+    let surface = sim.ground();
+    assert!(surface.bound() <= 0.1, "{}", surface.bound());
     let ground: Vec<f64> = pts
         .iter()
         .zip(&scan.surfaces)
         .filter(|(_, s)| **s == Surface::Ground)
-        .map(|(p, _)| p.z)
+        .map(|(p, _)| p.z - surface.height(p.x, p.y))
         .collect();
     let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt();
     assert!(ground.len() > 20_000, "{}", ground.len());

@@ -1,6 +1,6 @@
 //! A spinning multi-beam lidar (HDL-64E-like) cast into the street: for every column (azimuth)
 //! and beam (elevation) one exact ray from the sensor pose, nearest hit among the ground
-//! plane z = 0, wall rectangles, oriented car boxes and pedestrian cylinders.
+//! (see [`super::ground`]), wall rectangles, oriented car boxes and pedestrian cylinders.
 //!
 //! **Rays.** Beam b of column c has the direction (cos e_b cos a_c, cos e_b sin a_c, sin e_b) in
 //! the sensor frame (x forward, y left, z up), with a_c = 2π·c/columns and the elevations of
@@ -19,6 +19,7 @@
 //!
 //! Not for: the scene's layout (see [`super::world`]) or writing `.bin` files.
 
+use super::ground::Ground;
 use crate::cloud::PointCloud;
 use crate::rng::stream;
 use nalgebra::{Isometry3, Point3, Vector3};
@@ -373,9 +374,10 @@ const NO_HIT: Hit = Hit {
 const GROUND_REFLECTANCE: f64 = 0.25;
 
 /// Casts one scan from `sensor_to_world` (the sensor's pose in the world frame) into `shapes`
-/// and the ground plane z = 0. `seed` identifies the scan's random streams.
+/// and the `ground`. `seed` identifies the scan's random streams.
 pub fn cast_scan(
     shapes: &[Shape],
+    ground: &Ground,
     sensor_to_world: &Isometry3<f64>,
     lidar: &LidarConfig,
     seed: u64,
@@ -403,15 +405,19 @@ pub fn cast_scan(
                 let local = Vector3::new(cos_e[b] * ca, cos_e[b] * sa, sin_e[b]);
                 let d = rotation * local;
                 let mut best: Option<(f64, f64, usize)> = None;
-                if d.z < 0.0 {
-                    let t = -origin.z / d.z;
-                    best = Some((t, -d.z, usize::MAX));
-                }
                 for &i in candidates.iter() {
                     if let Some((t, cos)) = intersect(&shapes[i].geometry, &origin, &d) {
                         if best.is_none_or(|(bt, _, _)| t < bt) {
                             best = Some((t, cos, i));
                         }
+                    }
+                }
+                // The ground, if it comes first (searched no farther than the nearest shape).
+                let limit = best.map_or(lidar.max_range, |(bt, _, _)| bt.min(lidar.max_range));
+                let (o, dir) = ([origin.x, origin.y, origin.z], [d.x, d.y, d.z]);
+                if let Some(t) = ground.intersect(o, dir, limit) {
+                    if best.is_none_or(|(bt, _, _)| t < bt) {
+                        best = Some((t, -d.z, usize::MAX));
                     }
                 }
                 let Some((t, cos, i)) = best else { continue };
@@ -490,7 +496,7 @@ mod tests {
             Vector3::new(3.0, -2.0, 1.73),
             Vector3::new(0.02, -0.01, 0.7),
         );
-        let scan = cast_scan(&[], &pose, &small(), 1);
+        let scan = cast_scan(&[], &Ground::flat(), &pose, &small(), 1);
         assert!(!scan.cloud.is_empty());
         for p in scan.cloud.iter() {
             let w = pose * Point3::new(p.x as f64, p.y as f64, p.z as f64);
@@ -536,7 +542,7 @@ mod tests {
             reflectance: 0.5,
         };
         let pose = Isometry3::translation(0.0, 0.0, 1.73);
-        let scan = cast_scan(&[wall, person, car], &pose, &small(), 2);
+        let scan = cast_scan(&[wall, person, car], &Ground::flat(), &pose, &small(), 2);
         let mut seen = [0usize; 3];
         for (p, s) in scan.cloud.iter().zip(&scan.surfaces) {
             let (x, y, z) = (p.x as f64, p.y as f64, p.z as f64 + 1.73);
@@ -568,13 +574,13 @@ mod tests {
             columns: 500,
             ..LidarConfig::default()
         };
-        let a = cast_scan(&[], &pose, &cfg, 9);
+        let a = cast_scan(&[], &Ground::flat(), &pose, &cfg, 9);
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(1)
             .build()
             .unwrap();
-        let b = pool.install(|| cast_scan(&[], &pose, &cfg, 9));
+        let b = pool.install(|| cast_scan(&[], &Ground::flat(), &pose, &cfg, 9));
         assert_eq!(a, b);
-        assert_ne!(a, cast_scan(&[], &pose, &cfg, 10));
+        assert_ne!(a, cast_scan(&[], &Ground::flat(), &pose, &cfg, 10));
     }
 }

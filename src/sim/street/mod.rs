@@ -6,347 +6,66 @@
 //! layout with its cars and pedestrians as `label_02` labels; [`generate`] keeps it in memory
 //! with per-point labels.
 //!
-//! The pieces: [`ego`] (the vehicle's motion), [`world`] (the scene), [`lidar`] (the ray
-//! caster), [`truth`] (what is written as ground truth), [`writer`] (the raw layout's files),
+//! The pieces: [`ego`] (the vehicle's planar motion), [`body`] (its roll, pitch and heave),
+//! [`world`] (the scene), [`ground`] (the road surface's relief), [`lidar`] (the ray caster),
+//! [`truth`] (what is written as ground truth), [`writer`] (the raw layout's files),
 //! [`tracking_writer`] (the tracking layout's).
 //!
-//! **Poses.** The OXTS unit is simulated level (roll = pitch = 0) at constant height; the
-//! Velodyne pose follows from the IMU→Velodyne calibration exactly as the reader derives it
-//! (W_velo = W_imu·T_velo_imu⁻¹, with the calibration as the reader parses it), and the
-//! mounting height is that of the Velodyne origin. Latitude and longitude are the world x/y
-//! (east/north) through the inverse of the devkit's Mercator projection whose scale is fixed by
-//! the first packet, so the poses read back equal the simulated ones to rounding.
+//! **Poses.** The OXTS unit rolls, pitches and heaves a little with the body around its
+//! nominal height; the Velodyne pose follows from the IMU→Velodyne calibration exactly as the
+//! reader derives it (W_velo = W_imu·T_velo_imu⁻¹, with the calibration as the reader parses
+//! it), and the nominal mounting height is that of the Velodyne origin. Latitude and longitude
+//! are the world x/y (east/north) through the inverse of the devkit's Mercator projection whose
+//! scale is fixed by the first packet, so the poses read back equal the simulated ones to
+//! rounding.
 //!
-//! **Randomness.** The scene comes from `rng::stream(seed, SCENE_KEY)`, scan k from its own
-//! streams (see [`lidar`]): a drive is a pure function of the configuration, the frame count
-//! and the seed, at any thread count. The scene depends on the frame count (objects are placed
-//! near the ego's path during the drive).
+//! **Randomness.** The scene comes from `rng::stream(seed, SCENE_KEY)`, the body motion from
+//! `rng::stream(seed, BODY_KEY)`, the ground relief from a hash keyed by the seed and scan k
+//! from its own streams (see [`lidar`]): a drive is a pure function of the configuration, the
+//! frame count and the seed, at any thread count. The scene depends on the frame count (objects
+//! are placed near the ego's path during the drive). With `ground.relief = []` and zero `body`
+//! amplitudes the scans are those of the flat, level street this simulator first wrote.
 //!
 //! Not for: reading drives back (see [`crate::kitti`]) or scoring trackers against the truth.
 
+pub mod body;
 pub mod calib_files;
+pub mod config;
 pub mod ego;
+pub mod ground;
 pub mod lidar;
 pub mod tracking_writer;
 pub mod truth;
 pub mod world;
 pub mod writer;
 
+pub use body::{BodyMotion, BodyMotionConfig};
+pub use config::{Recording, StreetConfig, StreetLayout, TrafficConfig};
 pub use ego::{EgoState, EgoTrajectory, LegSpec};
+pub use ground::{Ground, GroundConfig, ReliefOctave};
 pub use lidar::{LidarConfig, LidarScan, Surface};
 pub use tracking_writer::{write_tracking_sequence, WrittenSequence};
 pub use truth::{FrameTruth, ObjectState, ObjectTruth, PoseTruth, StreetTruth, WallTruth};
 pub use world::{ObjectKind, Street};
 pub use writer::{write_drive, WrittenDrive, TRUTH_FILE};
 
-use crate::error::{ensure_non_negative, ensure_positive, Error, Result};
+use crate::error::{Error, Result};
 use crate::geometry::wrap_angle;
 use crate::kitti::calib::{rigid_calib_from, CalibFile};
 use crate::kitti::poses::{oxts_rotation, velodyne_pose_from_imu, Mercator};
 use crate::kitti::{OxtsPacket, Timestamp};
 use crate::rng::{mix64, stream};
 use nalgebra::{Isometry3, Point3, Translation3};
-use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 /// Key of the scene's random stream.
 const SCENE_KEY: u64 = 0x5743_4E45;
+/// Key of the ground relief's hash.
+const GROUND_KEY: u64 = 0x4752_4E44;
+/// Key of the body motion's random stream.
+const BODY_KEY: u64 = 0x424F_4459;
 /// Standard gravity, m/s² (OXTS accelerations include it, as the real unit's do).
 const GRAVITY: f64 = 9.80665;
-
-/// Street cross-section and building walls. Lengths in metres.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct StreetLayout {
-    /// Distance from the centreline to the kerb.
-    pub road_half_width: f64,
-    /// Sidewalk width between kerb and walls.
-    pub sidewalk_width: f64,
-    /// Lane width.
-    pub lane_width: f64,
-    /// Lateral offset of the ego's path from the centreline (negative = right).
-    pub ego_lane_offset: f64,
-    /// Range of wall piece lengths.
-    pub wall_length: [f64; 2],
-    /// Range of gaps between wall pieces.
-    pub wall_gap: [f64; 2],
-    /// Range of wall heights.
-    pub wall_height: [f64; 2],
-    /// Shorter pieces left at segment ends are dropped.
-    pub min_wall_piece: f64,
-    /// The street starts this far behind the ego's start.
-    pub behind_start: f64,
-    /// The last street segment reaches this far beyond the ego's last position.
-    pub beyond_end: f64,
-}
-
-impl Default for StreetLayout {
-    fn default() -> Self {
-        StreetLayout {
-            road_half_width: 9.0,
-            sidewalk_width: 3.0,
-            lane_width: 3.5,
-            ego_lane_offset: -1.75,
-            wall_length: [20.0, 45.0],
-            wall_gap: [3.0, 10.0],
-            wall_height: [6.0, 15.0],
-            min_wall_piece: 5.0,
-            behind_start: 60.0,
-            beyond_end: 80.0,
-        }
-    }
-}
-
-/// Cars and pedestrians.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct TrafficConfig {
-    /// Number of parked cars.
-    pub parked_cars: usize,
-    /// Number of moving cars.
-    pub moving_cars: usize,
-    /// Number of pedestrians.
-    pub pedestrians: usize,
-    /// Car length, width, height, metres.
-    pub car_size: [f64; 3],
-    /// Range of moving car speeds, m/s.
-    pub car_speed: [f64; 2],
-    /// Pedestrian radius, metres.
-    pub pedestrian_radius: f64,
-    /// Pedestrian height, metres.
-    pub pedestrian_height: f64,
-    /// Range of walking speeds, m/s.
-    pub pedestrian_speed: [f64; 2],
-    /// Objects keep this far from street corners (moving ones vanish there), metres.
-    pub corner_clearance: f64,
-    /// Objects start within this distance of the ego's path, metres.
-    pub spawn_radius: f64,
-}
-
-impl Default for TrafficConfig {
-    fn default() -> Self {
-        TrafficConfig {
-            parked_cars: 8,
-            moving_cars: 5,
-            pedestrians: 8,
-            car_size: [4.5, 1.8, 1.5],
-            car_speed: [5.0, 12.0],
-            pedestrian_radius: 0.3,
-            pedestrian_height: 1.75,
-            pedestrian_speed: [1.2, 1.4],
-            corner_clearance: 20.0,
-            spawn_radius: 60.0,
-        }
-    }
-}
-
-/// Where and when the drive is recorded.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct Recording {
-    /// Latitude of the start, degrees (also the Mercator reference).
-    pub latitude: f64,
-    /// Longitude of the start, degrees.
-    pub longitude: f64,
-    /// Ground altitude, metres.
-    pub altitude: f64,
-    /// Date folder name, `YYYY_MM_DD`.
-    pub date: String,
-    /// Time of frame 0, `hh:mm:ss[.fraction]`.
-    pub start_time: String,
-    /// Drive number (`DATE_drive_NNNN_sync`).
-    pub drive_number: u32,
-}
-
-impl Default for Recording {
-    fn default() -> Self {
-        Recording {
-            latitude: 49.0,
-            longitude: 8.43,
-            altitude: 115.0,
-            date: "2020_01_01".to_string(),
-            start_time: "12:00:00.000000000".to_string(),
-            drive_number: 1,
-        }
-    }
-}
-
-/// A whole simulated street drive as data (TOML/JSON); every field has a default.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct StreetConfig {
-    /// Ego speed, m/s.
-    pub speed: f64,
-    /// Time between frames, seconds.
-    pub frame_period: f64,
-    /// Initial heading, degrees counter-clockwise from east.
-    pub start_heading_deg: f64,
-    /// The route: straight stretches and turns; straight on after the last.
-    pub route: Vec<LegSpec>,
-    /// Street geometry.
-    pub street: StreetLayout,
-    /// Cars and pedestrians.
-    pub traffic: TrafficConfig,
-    /// The lidar.
-    pub lidar: LidarConfig,
-    /// Place and time.
-    pub recording: Recording,
-}
-
-impl Default for StreetConfig {
-    fn default() -> Self {
-        StreetConfig {
-            speed: 10.0,
-            frame_period: 0.1,
-            start_heading_deg: 30.0,
-            route: vec![
-                LegSpec {
-                    straight: 25.0,
-                    turn_deg: 45.0,
-                    turn_seconds: 3.0,
-                },
-                LegSpec {
-                    straight: 50.0,
-                    turn_deg: -60.0,
-                    turn_seconds: 4.0,
-                },
-                LegSpec {
-                    straight: 60.0,
-                    turn_deg: 30.0,
-                    turn_seconds: 2.5,
-                },
-            ],
-            street: StreetLayout::default(),
-            traffic: TrafficConfig::default(),
-            lidar: LidarConfig::default(),
-            recording: Recording::default(),
-        }
-    }
-}
-
-fn ensure_range(what: &str, r: [f64; 2]) -> Result<()> {
-    ensure_non_negative(what, r[0])?;
-    ensure_non_negative(what, r[1])?;
-    if r[1] < r[0] {
-        return Err(Error::invalid(
-            what,
-            format!("[{}, {}] is decreasing", r[0], r[1]),
-        ));
-    }
-    Ok(())
-}
-
-impl StreetConfig {
-    /// Checks every field; errors name the field.
-    pub fn validate(&self) -> Result<()> {
-        ensure_positive("speed", self.speed)?;
-        ensure_positive("frame_period", self.frame_period)?;
-        crate::error::ensure_finite("start_heading_deg", &[self.start_heading_deg])?;
-        for (i, leg) in self.route.iter().enumerate() {
-            ensure_non_negative(&format!("route[{i}].straight"), leg.straight)?;
-            ensure_positive(&format!("route[{i}].turn_seconds"), leg.turn_seconds)?;
-            if !(leg.turn_deg.abs() >= 10.0 && leg.turn_deg.abs() <= 120.0) {
-                return Err(Error::invalid(
-                    format!("route[{i}].turn_deg"),
-                    format!("{} (turns must be 10° to 120° either way)", leg.turn_deg),
-                ));
-            }
-        }
-        let s = &self.street;
-        ensure_positive("street.road_half_width", s.road_half_width)?;
-        ensure_positive("street.sidewalk_width", s.sidewalk_width)?;
-        ensure_positive("street.lane_width", s.lane_width)?;
-        if s.ego_lane_offset.is_nan() || s.ego_lane_offset.abs() >= s.road_half_width {
-            return Err(Error::invalid(
-                "street.ego_lane_offset",
-                format!("{} is not inside the road", s.ego_lane_offset),
-            ));
-        }
-        ensure_range("street.wall_length", s.wall_length)?;
-        ensure_positive("street.wall_length", s.wall_length[0])?;
-        ensure_range("street.wall_gap", s.wall_gap)?;
-        ensure_range("street.wall_height", s.wall_height)?;
-        ensure_positive("street.wall_height", s.wall_height[0])?;
-        ensure_non_negative("street.min_wall_piece", s.min_wall_piece)?;
-        ensure_non_negative("street.behind_start", s.behind_start)?;
-        ensure_positive("street.beyond_end", s.beyond_end)?;
-        let t = &self.traffic;
-        for (i, v) in t.car_size.iter().enumerate() {
-            ensure_positive(&format!("traffic.car_size[{i}]"), *v)?;
-        }
-        ensure_range("traffic.car_speed", t.car_speed)?;
-        ensure_positive("traffic.pedestrian_radius", t.pedestrian_radius)?;
-        ensure_positive("traffic.pedestrian_height", t.pedestrian_height)?;
-        ensure_range("traffic.pedestrian_speed", t.pedestrian_speed)?;
-        ensure_non_negative("traffic.corner_clearance", t.corner_clearance)?;
-        ensure_positive("traffic.spawn_radius", t.spawn_radius)?;
-        let l = &self.lidar;
-        if l.beams < 2 || !l.beams.is_multiple_of(2) || l.beams > 256 {
-            return Err(Error::invalid(
-                "lidar.beams",
-                format!("{} (must be even, 2 to 256)", l.beams),
-            ));
-        }
-        if !(l.elevation_top_deg < 90.0
-            && l.elevation_top_deg > l.elevation_split_deg
-            && l.elevation_split_deg > l.elevation_bottom_deg
-            && l.elevation_bottom_deg > -90.0)
-        {
-            return Err(Error::invalid(
-                "lidar elevations",
-                "need 90 > top > split > bottom > -90 degrees",
-            ));
-        }
-        if l.columns == 0 || l.columns > 100_000 {
-            return Err(Error::invalid(
-                "lidar.columns",
-                format!("{} (must be 1 to 100000)", l.columns),
-            ));
-        }
-        ensure_positive("lidar.max_range", l.max_range)?;
-        ensure_non_negative("lidar.min_range", l.min_range)?;
-        ensure_non_negative("lidar.range_noise", l.range_noise)?;
-        ensure_positive("lidar.mount_height", l.mount_height)?;
-        if !(0.0..1.0).contains(&l.dropout) {
-            return Err(Error::invalid(
-                "lidar.dropout",
-                format!("{} (must be in [0, 1))", l.dropout),
-            ));
-        }
-        let r = &self.recording;
-        if !(r.latitude.abs() < 80.0 && r.longitude.abs() <= 180.0 && r.altitude.is_finite()) {
-            return Err(Error::invalid(
-                "recording latitude/longitude/altitude",
-                format!("{} / {} / {}", r.latitude, r.longitude, r.altitude),
-            ));
-        }
-        self.start_stamp()?;
-        Ok(())
-    }
-
-    /// The time stamp of frame 0 from `recording.date` and `recording.start_time`.
-    pub fn start_stamp(&self) -> Result<Timestamp> {
-        let r = &self.recording;
-        let ok = r.date.len() == 10 && r.date.bytes().all(|b| b.is_ascii_digit() || b == b'_');
-        let text = format!("{} {}", r.date.replace('_', "-"), r.start_time);
-        match Timestamp::parse(&text) {
-            Ok(t) if ok => Ok(t),
-            Ok(_) => Err(Error::invalid(
-                "recording.date",
-                format!("`{}` is not YYYY_MM_DD", r.date),
-            )),
-            Err(e) => Err(Error::invalid("recording date/start_time", e)),
-        }
-    }
-
-    /// Drive folder name, `DATE_drive_NNNN_sync`.
-    pub fn drive_name(&self) -> String {
-        format!(
-            "{}_drive_{:04}_sync",
-            self.recording.date, self.recording.drive_number
-        )
-    }
-}
 
 /// A drive being simulated: the scene, the motion and the rig, frame by frame.
 #[derive(Clone, Debug)]
@@ -356,6 +75,8 @@ pub struct StreetSimulator {
     seed: u64,
     trajectory: EgoTrajectory,
     street: Street,
+    ground: Ground,
+    body: BodyMotion,
     t_velo_imu: Isometry3<f64>,
     imu_height: f64,
     mercator: Mercator,
@@ -384,7 +105,7 @@ impl StreetSimulator {
         let calib = CalibFile::parse(Path::new("calib_imu_to_velo.txt"), calib_files::IMU_TO_VELO)
             .and_then(|f| rigid_calib_from(&f))?;
         let t_velo_imu = calib.isometry;
-        // The Velodyne origin in IMU coordinates; the IMU is level, so its height follows.
+        // The Velodyne origin in IMU coordinates; with the body level its height follows.
         let velo_in_imu = t_velo_imu.inverse() * Point3::origin();
         let imu_height = config.lidar.mount_height - velo_in_imu.z;
         let trajectory = EgoTrajectory::new(
@@ -407,6 +128,8 @@ impl StreetSimulator {
         let mut rng = stream(seed, SCENE_KEY);
         let street =
             world::build_street(config, &trajectory.straight_lines(), &ego, &times, &mut rng)?;
+        let ground = Ground::new(&config.ground, mix64(seed ^ mix64(GROUND_KEY)));
+        let body = BodyMotion::new(&config.body, &mut stream(seed, BODY_KEY));
         let r = &config.recording;
         let mercator = Mercator::from_reference_latitude(r.latitude)?;
         let origin_xy = mercator.project(r.latitude, r.longitude);
@@ -416,6 +139,8 @@ impl StreetSimulator {
             seed,
             trajectory,
             street,
+            ground,
+            body,
             t_velo_imu,
             imu_height,
             mercator,
@@ -439,6 +164,11 @@ impl StreetSimulator {
         &self.street
     }
 
+    /// The ground surface.
+    pub fn ground(&self) -> &Ground {
+        &self.ground
+    }
+
     /// Time of frame k since frame 0, seconds.
     pub fn time(&self, k: usize) -> f64 {
         k as f64 * self.config.frame_period
@@ -460,12 +190,15 @@ impl StreetSimulator {
         self.t_velo_imu
     }
 
-    /// The IMU pose in the world at frame k (level, heading wrapped as in the OXTS packet).
+    /// The IMU pose in the world at frame k (roll, pitch and heave of the body, heading
+    /// wrapped as in the OXTS packet).
     pub fn imu_pose(&self, k: usize) -> Isometry3<f64> {
         let s = self.ego(k);
+        let t = self.time(k);
+        let (roll, pitch) = self.body.attitude(t);
         Isometry3::from_parts(
-            Translation3::new(s.x, s.y, self.imu_height),
-            oxts_rotation(0.0, 0.0, wrap_angle(s.yaw)),
+            Translation3::new(s.x, s.y, self.imu_height + self.body.heave(t)),
+            oxts_rotation(roll, pitch, wrap_angle(s.yaw)),
         )
     }
 
@@ -487,29 +220,33 @@ impl StreetSimulator {
             .unproject(self.origin_xy.0 + s.x, self.origin_xy.1 + s.y);
         let (ve, vn) = s.velocity();
         let lateral = s.speed * s.yaw_rate;
+        let t = self.time(k);
+        let (roll, pitch) = self.body.attitude(t);
+        let (roll_rate, pitch_rate) = self.body.attitude_rate(t);
+        let (sy, cy) = s.yaw.sin_cos();
         OxtsPacket {
             lat,
             lon,
-            alt: self.config.recording.altitude + self.imu_height,
-            roll: 0.0,
-            pitch: 0.0,
+            alt: self.config.recording.altitude + self.imu_height + self.body.heave(t),
+            roll,
+            pitch,
             yaw: wrap_angle(s.yaw),
             vn,
             ve,
             vf: s.speed,
             vl: 0.0,
-            vu: 0.0,
+            vu: self.body.heave_rate(t),
             ax: 0.0,
             ay: lateral,
             az: GRAVITY,
             af: 0.0,
             al: lateral,
             au: GRAVITY,
-            wx: 0.0,
-            wy: 0.0,
+            wx: cy * roll_rate - sy * pitch_rate,
+            wy: sy * roll_rate + cy * pitch_rate,
             wz: s.yaw_rate,
-            wf: 0.0,
-            wl: 0.0,
+            wf: roll_rate,
+            wl: pitch_rate,
             wu: s.yaw_rate,
             pos_accuracy: 0.02,
             vel_accuracy: 0.01,
@@ -525,7 +262,13 @@ impl StreetSimulator {
     pub fn scan(&self, k: usize) -> LidarScan {
         let shapes = self.street.shapes_at(self.time(k));
         let seed = mix64(self.seed ^ mix64(0x5CA4_0000 + k as u64));
-        lidar::cast_scan(&shapes, &self.velodyne_pose(k), &self.config.lidar, seed)
+        lidar::cast_scan(
+            &shapes,
+            &self.ground,
+            &self.velodyne_pose(k),
+            &self.config.lidar,
+            seed,
+        )
     }
 
     /// The truth without point counts (all zero); add them with [`record_scan`](Self::record_scan).

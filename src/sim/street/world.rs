@@ -1,6 +1,6 @@
-//! The simulated street scene in the world frame (x east, y north, z up, ground z = 0): the
-//! street segments that follow the ego route, building walls along both sides, and the
-//! parked cars, moving cars and pedestrians with their motion.
+//! The simulated street scene in the world frame (x east, y north, z up, ground near z = 0,
+//! see [`super::ground`]): the street segments that follow the ego route, building walls along
+//! both sides, and the parked cars, moving cars and pedestrians with their motion.
 //!
 //! **Layout.** Each straight stretch of the ego route is one street segment; its centreline is
 //! the ego's straight line shifted by the ego lane offset. Consecutive segments meet at a

@@ -1,0 +1,314 @@
+//! A simulated street as data: the street's layout, traffic, ground, body motion, lidar and
+//! recording, each with defaults, and their validation.
+//!
+//! Not for: simulating (see [`super::StreetSimulator`]).
+
+use super::body::BodyMotionConfig;
+use super::ego::LegSpec;
+use super::ground::GroundConfig;
+use super::lidar::LidarConfig;
+use crate::error::{ensure_non_negative, ensure_positive, Error, Result};
+use crate::kitti::Timestamp;
+use serde::{Deserialize, Serialize};
+
+/// Street cross-section and building walls. Lengths in metres.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct StreetLayout {
+    /// Distance from the centreline to the kerb.
+    pub road_half_width: f64,
+    /// Sidewalk width between kerb and walls.
+    pub sidewalk_width: f64,
+    /// Lane width.
+    pub lane_width: f64,
+    /// Lateral offset of the ego's path from the centreline (negative = right).
+    pub ego_lane_offset: f64,
+    /// Range of wall piece lengths.
+    pub wall_length: [f64; 2],
+    /// Range of gaps between wall pieces.
+    pub wall_gap: [f64; 2],
+    /// Range of wall heights.
+    pub wall_height: [f64; 2],
+    /// Shorter pieces left at segment ends are dropped.
+    pub min_wall_piece: f64,
+    /// The street starts this far behind the ego's start.
+    pub behind_start: f64,
+    /// The last street segment reaches this far beyond the ego's last position.
+    pub beyond_end: f64,
+}
+
+impl Default for StreetLayout {
+    fn default() -> Self {
+        StreetLayout {
+            road_half_width: 9.0,
+            sidewalk_width: 3.0,
+            lane_width: 3.5,
+            ego_lane_offset: -1.75,
+            wall_length: [20.0, 45.0],
+            wall_gap: [3.0, 10.0],
+            wall_height: [6.0, 15.0],
+            min_wall_piece: 5.0,
+            behind_start: 60.0,
+            beyond_end: 80.0,
+        }
+    }
+}
+
+/// Cars and pedestrians.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TrafficConfig {
+    /// Number of parked cars.
+    pub parked_cars: usize,
+    /// Number of moving cars.
+    pub moving_cars: usize,
+    /// Number of pedestrians.
+    pub pedestrians: usize,
+    /// Car length, width, height, metres.
+    pub car_size: [f64; 3],
+    /// Range of moving car speeds, m/s.
+    pub car_speed: [f64; 2],
+    /// Pedestrian radius, metres.
+    pub pedestrian_radius: f64,
+    /// Pedestrian height, metres.
+    pub pedestrian_height: f64,
+    /// Range of walking speeds, m/s.
+    pub pedestrian_speed: [f64; 2],
+    /// Objects keep this far from street corners (moving ones vanish there), metres.
+    pub corner_clearance: f64,
+    /// Objects start within this distance of the ego's path, metres.
+    pub spawn_radius: f64,
+}
+
+impl Default for TrafficConfig {
+    fn default() -> Self {
+        TrafficConfig {
+            parked_cars: 8,
+            moving_cars: 5,
+            pedestrians: 8,
+            car_size: [4.5, 1.8, 1.5],
+            car_speed: [5.0, 12.0],
+            pedestrian_radius: 0.3,
+            pedestrian_height: 1.75,
+            pedestrian_speed: [1.2, 1.4],
+            corner_clearance: 20.0,
+            spawn_radius: 60.0,
+        }
+    }
+}
+
+/// Where and when the drive is recorded.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Recording {
+    /// Latitude of the start, degrees (also the Mercator reference).
+    pub latitude: f64,
+    /// Longitude of the start, degrees.
+    pub longitude: f64,
+    /// Ground altitude, metres.
+    pub altitude: f64,
+    /// Date folder name, `YYYY_MM_DD`.
+    pub date: String,
+    /// Time of frame 0, `hh:mm:ss[.fraction]`.
+    pub start_time: String,
+    /// Drive number (`DATE_drive_NNNN_sync`).
+    pub drive_number: u32,
+}
+
+impl Default for Recording {
+    fn default() -> Self {
+        Recording {
+            latitude: 49.0,
+            longitude: 8.43,
+            altitude: 115.0,
+            date: "2020_01_01".to_string(),
+            start_time: "12:00:00.000000000".to_string(),
+            drive_number: 1,
+        }
+    }
+}
+
+/// A whole simulated street drive as data (TOML/JSON); every field has a default.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct StreetConfig {
+    /// Ego speed, m/s.
+    pub speed: f64,
+    /// Time between frames, seconds.
+    pub frame_period: f64,
+    /// Initial heading, degrees counter-clockwise from east.
+    pub start_heading_deg: f64,
+    /// The route: straight stretches and turns; straight on after the last.
+    pub route: Vec<LegSpec>,
+    /// Street geometry.
+    pub street: StreetLayout,
+    /// The ground's relief.
+    pub ground: GroundConfig,
+    /// The vehicle body's roll, pitch and heave.
+    pub body: BodyMotionConfig,
+    /// Cars and pedestrians.
+    pub traffic: TrafficConfig,
+    /// The lidar.
+    pub lidar: LidarConfig,
+    /// Place and time.
+    pub recording: Recording,
+}
+
+impl Default for StreetConfig {
+    fn default() -> Self {
+        StreetConfig {
+            speed: 10.0,
+            frame_period: 0.1,
+            start_heading_deg: 30.0,
+            route: vec![
+                LegSpec {
+                    straight: 25.0,
+                    turn_deg: 45.0,
+                    turn_seconds: 3.0,
+                },
+                LegSpec {
+                    straight: 50.0,
+                    turn_deg: -60.0,
+                    turn_seconds: 4.0,
+                },
+                LegSpec {
+                    straight: 60.0,
+                    turn_deg: 30.0,
+                    turn_seconds: 2.5,
+                },
+            ],
+            street: StreetLayout::default(),
+            ground: GroundConfig::default(),
+            body: BodyMotionConfig::default(),
+            traffic: TrafficConfig::default(),
+            lidar: LidarConfig::default(),
+            recording: Recording::default(),
+        }
+    }
+}
+
+fn ensure_range(what: &str, r: [f64; 2]) -> Result<()> {
+    ensure_non_negative(what, r[0])?;
+    ensure_non_negative(what, r[1])?;
+    if r[1] < r[0] {
+        return Err(Error::invalid(
+            what,
+            format!("[{}, {}] is decreasing", r[0], r[1]),
+        ));
+    }
+    Ok(())
+}
+
+impl StreetConfig {
+    /// Checks every field; errors name the field.
+    pub fn validate(&self) -> Result<()> {
+        ensure_positive("speed", self.speed)?;
+        ensure_positive("frame_period", self.frame_period)?;
+        crate::error::ensure_finite("start_heading_deg", &[self.start_heading_deg])?;
+        for (i, leg) in self.route.iter().enumerate() {
+            ensure_non_negative(&format!("route[{i}].straight"), leg.straight)?;
+            ensure_positive(&format!("route[{i}].turn_seconds"), leg.turn_seconds)?;
+            if !(leg.turn_deg.abs() >= 10.0 && leg.turn_deg.abs() <= 120.0) {
+                return Err(Error::invalid(
+                    format!("route[{i}].turn_deg"),
+                    format!("{} (turns must be 10° to 120° either way)", leg.turn_deg),
+                ));
+            }
+        }
+        let s = &self.street;
+        ensure_positive("street.road_half_width", s.road_half_width)?;
+        ensure_positive("street.sidewalk_width", s.sidewalk_width)?;
+        ensure_positive("street.lane_width", s.lane_width)?;
+        if s.ego_lane_offset.is_nan() || s.ego_lane_offset.abs() >= s.road_half_width {
+            return Err(Error::invalid(
+                "street.ego_lane_offset",
+                format!("{} is not inside the road", s.ego_lane_offset),
+            ));
+        }
+        ensure_range("street.wall_length", s.wall_length)?;
+        ensure_positive("street.wall_length", s.wall_length[0])?;
+        ensure_range("street.wall_gap", s.wall_gap)?;
+        ensure_range("street.wall_height", s.wall_height)?;
+        ensure_positive("street.wall_height", s.wall_height[0])?;
+        ensure_non_negative("street.min_wall_piece", s.min_wall_piece)?;
+        ensure_non_negative("street.behind_start", s.behind_start)?;
+        ensure_positive("street.beyond_end", s.beyond_end)?;
+        self.ground.validate()?;
+        self.body.validate()?;
+        let t = &self.traffic;
+        for (i, v) in t.car_size.iter().enumerate() {
+            ensure_positive(&format!("traffic.car_size[{i}]"), *v)?;
+        }
+        ensure_range("traffic.car_speed", t.car_speed)?;
+        ensure_positive("traffic.pedestrian_radius", t.pedestrian_radius)?;
+        ensure_positive("traffic.pedestrian_height", t.pedestrian_height)?;
+        ensure_range("traffic.pedestrian_speed", t.pedestrian_speed)?;
+        ensure_non_negative("traffic.corner_clearance", t.corner_clearance)?;
+        ensure_positive("traffic.spawn_radius", t.spawn_radius)?;
+        let l = &self.lidar;
+        if l.beams < 2 || !l.beams.is_multiple_of(2) || l.beams > 256 {
+            return Err(Error::invalid(
+                "lidar.beams",
+                format!("{} (must be even, 2 to 256)", l.beams),
+            ));
+        }
+        if !(l.elevation_top_deg < 90.0
+            && l.elevation_top_deg > l.elevation_split_deg
+            && l.elevation_split_deg > l.elevation_bottom_deg
+            && l.elevation_bottom_deg > -90.0)
+        {
+            return Err(Error::invalid(
+                "lidar elevations",
+                "need 90 > top > split > bottom > -90 degrees",
+            ));
+        }
+        if l.columns == 0 || l.columns > 100_000 {
+            return Err(Error::invalid(
+                "lidar.columns",
+                format!("{} (must be 1 to 100000)", l.columns),
+            ));
+        }
+        ensure_positive("lidar.max_range", l.max_range)?;
+        ensure_non_negative("lidar.min_range", l.min_range)?;
+        ensure_non_negative("lidar.range_noise", l.range_noise)?;
+        ensure_positive("lidar.mount_height", l.mount_height)?;
+        if !(0.0..1.0).contains(&l.dropout) {
+            return Err(Error::invalid(
+                "lidar.dropout",
+                format!("{} (must be in [0, 1))", l.dropout),
+            ));
+        }
+        let r = &self.recording;
+        if !(r.latitude.abs() < 80.0 && r.longitude.abs() <= 180.0 && r.altitude.is_finite()) {
+            return Err(Error::invalid(
+                "recording latitude/longitude/altitude",
+                format!("{} / {} / {}", r.latitude, r.longitude, r.altitude),
+            ));
+        }
+        self.start_stamp()?;
+        Ok(())
+    }
+
+    /// The time stamp of frame 0 from `recording.date` and `recording.start_time`.
+    pub fn start_stamp(&self) -> Result<Timestamp> {
+        let r = &self.recording;
+        let ok = r.date.len() == 10 && r.date.bytes().all(|b| b.is_ascii_digit() || b == b'_');
+        let text = format!("{} {}", r.date.replace('_', "-"), r.start_time);
+        match Timestamp::parse(&text) {
+            Ok(t) if ok => Ok(t),
+            Ok(_) => Err(Error::invalid(
+                "recording.date",
+                format!("`{}` is not YYYY_MM_DD", r.date),
+            )),
+            Err(e) => Err(Error::invalid("recording date/start_time", e)),
+        }
+    }
+
+    /// Drive folder name, `DATE_drive_NNNN_sync`.
+    pub fn drive_name(&self) -> String {
+        format!(
+            "{}_drive_{:04}_sync",
+            self.recording.date, self.recording.drive_number
+        )
+    }
+}
