@@ -49,13 +49,25 @@ fn bar(quiet: bool, len: usize, what: &str) -> ProgressBar {
     bar
 }
 
+/// FNV-1a hash of `text`: the same on every run and machine.
+fn fingerprint(text: &str) -> u64 {
+    text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+        (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
     anyhow::ensure!(args.frames >= 2, "--frames must be at least 2");
     let config = StreetConfig::default();
-    let root = args
-        .dir
-        .join(format!("seed{}-frames{}", args.seed, args.frames));
+    // The folder is keyed by the street's configuration too, so that a drive simulated by an
+    // older street model is not reused for a newer one.
+    let root = args.dir.join(format!(
+        "seed{}-frames{}-{:016x}",
+        args.seed,
+        args.frames,
+        fingerprint(&serde_json::to_string(&config)?)
+    ));
     let dir = root.join(&config.recording.date).join(config.drive_name());
     if !dir.join(TRUTH_FILE).is_file() {
         let b = bar(args.quiet, args.frames, "frames simulated");
