@@ -11,7 +11,7 @@
 //! Not for: running recordings on several machines (each `batch` is one process; split the
 //! list to spread it).
 
-use crate::config_file::read_config;
+use crate::config_file::tracking_config;
 use crate::recording::{read_list, Recording};
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -62,13 +62,7 @@ enum Outcome {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    let mut config: TrackingConfig = match &args.config {
-        Some(p) => read_config(p)?,
-        None => TrackingConfig::default(),
-    };
-    if let Some(n) = args.particles {
-        config.filter.particles = n;
-    }
+    let config = tracking_config(args.config.as_deref(), args.particles)?;
     config
         .validate()
         .context("the tracking configuration is not valid")?;

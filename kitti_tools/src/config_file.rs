@@ -7,6 +7,22 @@ use anyhow::{bail, Context, Result};
 use serde::de::DeserializeOwned;
 use std::path::Path;
 
+/// The tracking configuration of `track` and `batch`: the file's (default: the library's),
+/// with `--particles` overriding its particles per track.
+pub fn tracking_config(
+    path: Option<&Path>,
+    particles: Option<usize>,
+) -> Result<smc_lmb::pipeline::drive_tracking::TrackingConfig> {
+    let mut config: smc_lmb::pipeline::drive_tracking::TrackingConfig = match path {
+        Some(p) => read_config(p)?,
+        None => Default::default(),
+    };
+    if let Some(n) = particles {
+        config.filter.particles = n;
+    }
+    Ok(config)
+}
+
 /// Reads `path` as TOML (`.toml`) or JSON (`.json`) into `T`.
 pub fn read_config<T: DeserializeOwned>(path: &Path) -> Result<T> {
     let text =

@@ -2,7 +2,7 @@
 //! sequence in which building walls and point clusters are labelled objects; writes the per-frame tracks as JSON and, on request,
 //! labelled LAS/PLY clouds of chosen frames and a bird's-eye plot; prints a summary.
 
-use crate::config_file::read_config;
+use crate::config_file::tracking_config;
 use crate::recording::Recording;
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -12,7 +12,6 @@ use smc_lmb::kitti::TrackingSequence;
 use smc_lmb::pipeline::drive_tracking::kitti_out::{lmb_results, BaselineBoxes};
 use smc_lmb::pipeline::drive_tracking::{
     drive_plot, frame_plot, point_labels, DriveTracks, EgoModel, FrameView, PoseSource,
-    TrackingConfig,
 };
 use smc_lmb::pipeline::kitti_results::{results_path, write_tracking_results, ResultObject};
 use smc_lmb::trackers::ab3dmot::Ab3dmotConfig;
@@ -140,13 +139,7 @@ fn parse_range(text: &str) -> Result<Range<usize>> {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    let mut config: TrackingConfig = match &args.config {
-        Some(p) => read_config(p)?,
-        None => TrackingConfig::default(),
-    };
-    if let Some(n) = args.particles {
-        config.filter.particles = n;
-    }
+    let mut config = tracking_config(args.config.as_deref(), args.particles)?;
     if args.ect {
         config.ego = EgoModel::Ect {
             sigma_accel: 0.5,

@@ -28,7 +28,15 @@ fn demo_runs_the_whole_pipeline_and_eval_scores_its_tracks() {
     assert!(ok, "{err}");
     assert!(out.contains("reusing the simulated street"), "{out}");
 
-    let root = tmp.path().join("seed1-frames8");
+    // The drive's folder is named by the seed, the frames and the street configuration.
+    let roots: Vec<_> = std::fs::read_dir(tmp.path())
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(roots.len(), 1, "{roots:?}");
+    let root = roots[0].clone();
+    let name = root.file_name().unwrap().to_string_lossy().into_owned();
+    assert!(name.starts_with("seed1-frames8-"), "{name}");
     let drive = root.join("2020_01_01/2020_01_01_drive_0001_sync");
     let tracks = root.join("tracks.json");
     assert!(root.join("tracks.svg").is_file());
