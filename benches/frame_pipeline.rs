@@ -15,9 +15,11 @@
 //! * `frame/filter_update`: one step of the drive tracker (walls and clusters as labelled
 //!   objects of one LMB filter, 1000 particles per track) on this frame's detections, after a
 //!   warm-up on the same detections that confirms them (a static sensor);
-//! * `frame/whole`: read, detect (planes and clusters as the drive tracker selects them: every
-//!   object-sized cluster of the range image within range) and the filter update in a row;
-//! * `frame/whole_euclidean`: the same with the exact Euclidean clustering selected.
+//! * `frame/whole`: read, detect (planes and clusters as the drive tracker selects them by
+//!   default: every object-sized cluster of the exact Euclidean clustering within range) and
+//!   the filter update in a row;
+//! * `frame/filter_update_range_image`, `frame/whole_range_image`: the same with the range
+//!   image's clustering selected.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use nalgebra::Isometry3;
@@ -109,8 +111,8 @@ fn filter_update(
     }
 }
 
-/// `filter_update` and `whole` with one cluster configuration (`whole_euclidean` for the
-/// exact clustering).
+/// `filter_update` and `whole` with one cluster configuration (suffixed `_range_image` for the
+/// range image's clustering).
 fn tracker_group(
     g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
     path: &Path,
@@ -119,8 +121,8 @@ fn tracker_group(
 ) {
     let config = config.clone();
     let suffix = match config.clusters.method {
-        ClusterMethod::RangeImage => "",
-        ClusterMethod::Euclidean => "_euclidean",
+        ClusterMethod::Euclidean => "",
+        ClusterMethod::RangeImage => "_range_image",
     };
     let det = detect_objects(cloud, &config, &mut seeded(1)).expect("detections");
     println!(
