@@ -1,83 +1,25 @@
-//! The recordings `track` and `batch` run on: a KITTI raw drive, a tracking sequence or an
-//! odometry sequence, each opened and tracked the same way; and the list file of `batch` that
-//! names many of them.
+//! The recordings `track` and `batch` run on (the library's `RecordingSource`), tracked with
+//! errors that say which; and the list file of `batch` that names many of them.
 //!
 //! Not for: what a run writes (see `track_cmd` and `batch_cmd`).
 
 use anyhow::{bail, Context, Result};
-use smc_lmb::kitti::{OdometrySequence, RawDrive, TrackingSequence};
-use smc_lmb::pipeline::drive_tracking::{
-    track_drive, track_odometry_sequence, track_tracking_sequence, DriveTracks, FrameView,
-    TrackingConfig,
-};
+pub use smc_lmb::pipeline::drive_tracking::RecordingSource as Recording;
+use smc_lmb::pipeline::drive_tracking::{DriveTracks, FrameView, TrackingConfig};
 use std::ops::Range;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-/// One recording to track.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum Recording {
-    /// A raw drive folder (`.../2011_09_26/2011_09_26_drive_0001_sync`).
-    Raw(PathBuf),
-    /// A tracking split folder (`.../training`) and a sequence number.
-    Tracking(PathBuf, u32),
-    /// An odometry root (holding `sequences/` and `poses/`) and a sequence number.
-    Odometry(PathBuf, u32),
-}
-
-impl Recording {
-    /// A short name, unique among the recordings of one list: the drive folder's name, or
-    /// `tracking_NNNN` / `odometry_NN`.
-    pub fn name(&self) -> String {
-        match self {
-            Recording::Raw(dir) => dir
-                .file_name()
-                .map(|n| n.to_string_lossy().into_owned())
-                .unwrap_or_else(|| dir.display().to_string()),
-            Recording::Tracking(_, n) => format!("tracking_{n:04}"),
-            Recording::Odometry(_, n) => format!("odometry_{n:02}"),
-        }
-    }
-
-    /// What the recording is, for messages.
-    pub fn describe(&self) -> String {
-        match self {
-            Recording::Raw(dir) => format!("drive {}", dir.display()),
-            Recording::Tracking(root, n) => {
-                format!("tracking sequence {n:04} of {}", root.display())
-            }
-            Recording::Odometry(root, n) => {
-                format!("odometry sequence {n:02} of {}", root.display())
-            }
-        }
-    }
-
-    /// Opens the recording and runs one tracking pass over `frames` (all when `None`).
-    pub fn track(
-        &self,
-        frames: Option<Range<usize>>,
-        config: &TrackingConfig,
-        seed: u64,
-        on_frame: impl FnMut(&FrameView<'_>) -> smc_lmb::Result<()>,
-    ) -> Result<DriveTracks> {
-        let what = self.describe();
-        match self {
-            Recording::Raw(dir) => {
-                let drive = RawDrive::open(dir).with_context(|| format!("opening {what}"))?;
-                track_drive(&drive, frames, config, seed, on_frame)
-            }
-            Recording::Tracking(root, n) => {
-                let seq =
-                    TrackingSequence::open(root, *n).with_context(|| format!("opening {what}"))?;
-                track_tracking_sequence(&seq, frames, config, seed, on_frame)
-            }
-            Recording::Odometry(root, n) => {
-                let seq =
-                    OdometrySequence::open(root, *n).with_context(|| format!("opening {what}"))?;
-                track_odometry_sequence(&seq, frames, config, seed, on_frame)
-            }
-        }
-        .with_context(|| format!("tracking {what}"))
-    }
+/// Opens `rec` and runs one tracking pass over `frames` (all when `None`); errors say which
+/// recording.
+pub fn track(
+    rec: &Recording,
+    frames: Option<Range<usize>>,
+    config: &TrackingConfig,
+    seed: u64,
+    on_frame: impl FnMut(&FrameView<'_>) -> smc_lmb::Result<()>,
+) -> Result<DriveTracks> {
+    rec.track(frames, config, seed, on_frame)
+        .with_context(|| format!("tracking {}", rec.describe()))
 }
 
 /// The recordings `path` names: every raw drive in it when it is a folder (its subfolders
@@ -161,6 +103,7 @@ fn parse_line(line: &str, base: &Path) -> Result<Recording> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::path::PathBuf;
 
     #[test]
     fn list_lines_and_their_errors() {

@@ -3,7 +3,7 @@
 //! labelled LAS/PLY clouds of chosen frames and a bird's-eye plot; prints a summary.
 
 use crate::config_file::tracking_config;
-use crate::recording::Recording;
+use crate::recording::{track, Recording};
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use smc_lmb::cloud::{write_las_labelled, write_ply_labelled};
@@ -207,7 +207,7 @@ pub fn run(args: Args) -> Result<()> {
         }
         Ok(())
     };
-    let tracks = recording.track(frames.clone(), &config, args.seed, on_frame)?;
+    let tracks = track(&recording, frames.clone(), &config, args.seed, on_frame)?;
     bar.finish_and_clear();
     tracks.write_json(&args.out)?;
     if let Some(p) = &args.plot {

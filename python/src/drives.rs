@@ -10,10 +10,7 @@ use crate::convert::{lib, read_config_as};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use smc_lmb::kitti::{OdometrySequence, RawDrive, TrackingSequence};
-use smc_lmb::pipeline::drive_tracking::{
-    track_drive, track_odometry_sequence, track_tracking_sequence, DriveTracks, TrackingConfig,
-};
+use smc_lmb::pipeline::drive_tracking::{DriveTracks, RecordingSource, TrackingConfig};
 use smc_lmb::sim::street::{write_drive, StreetConfig};
 use std::path::PathBuf;
 
@@ -67,32 +64,17 @@ fn track<'py>(
             PyValueError::new_err(format!("layout \"{layout}\" needs a sequence number"))
         })
     };
-    let none = |_: &smc_lmb::pipeline::drive_tracking::FrameView<'_>| Ok(());
-    let tracks = match layout {
-        "raw" => py.detach(|| {
-            let drive = RawDrive::open(&path)?;
-            track_drive(&drive, None, &cfg, seed, none)
-        }),
-        "tracking" => {
-            let n = need_sequence()?;
-            py.detach(|| {
-                let seq = TrackingSequence::open(&path, n)?;
-                track_tracking_sequence(&seq, None, &cfg, seed, none)
-            })
-        }
-        "odometry" => {
-            let n = need_sequence()?;
-            py.detach(|| {
-                let seq = OdometrySequence::open(&path, n)?;
-                track_odometry_sequence(&seq, None, &cfg, seed, none)
-            })
-        }
+    let source = match layout {
+        "raw" => RecordingSource::Raw(path),
+        "tracking" => RecordingSource::Tracking(path, need_sequence()?),
+        "odometry" => RecordingSource::Odometry(path, need_sequence()?),
         other => {
             return Err(PyValueError::new_err(format!(
                 "layout \"{other}\": expected \"raw\", \"tracking\" or \"odometry\""
             )))
         }
     };
+    let tracks = py.detach(|| source.track(None, &cfg, seed, |_| Ok(())));
     let tracks = lib(tracks)?;
     if let Some(out) = &out {
         lib(py.detach(|| tracks.write_json(out)))?;

@@ -25,6 +25,7 @@ pub mod mixed;
 pub mod output;
 pub mod repeatability;
 pub mod road_users;
+pub mod source;
 pub mod tracker;
 
 pub use detect::{detect_objects, ClusterDetection, FrameDetections, WallDetection};
@@ -35,6 +36,7 @@ pub use output::{
     DriveTracks, StageTimes, TrackedCluster, TrackedFrame, TrackedPlane, TrackingSummary,
 };
 pub use repeatability::tracked_wall_pairs;
+pub use source::RecordingSource;
 pub use tracker::DriveTracker;
 
 use crate::cloud::odometry::{LidarOdometry, OdometryConfig};
