@@ -12,7 +12,7 @@
 //! list to spread it).
 
 use crate::config_file::tracking_config;
-use crate::recording::{read_list, Recording};
+use crate::recording::{read_list, track, Recording};
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use smc_lmb::pipeline::drive_tracking::{drive_plot, DriveTracks, FrameView, TrackingConfig};
@@ -136,7 +136,7 @@ fn track_one(
         bar.set_message(format!("{name}: frame {done}/{total}"));
         Ok(())
     };
-    let tracks = rec.track(None, config, args.seed, on_frame)?;
+    let tracks = track(rec, None, config, args.seed, on_frame)?;
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     if args.plot {
         drive_plot(&tracks).write(&dir.join("tracks.png"), 1000)?;
@@ -153,17 +153,11 @@ fn summary_table(rows: &[(String, Outcome)]) -> String {
     for (name, outcome) in rows {
         let line = match outcome {
             Outcome::Tracked(t) | Outcome::Skipped(t) => {
+                let (status, note) = match outcome {
+                    Outcome::Skipped(_) => ("skipped", "output already there"),
+                    _ => ("tracked", ""),
+                };
                 let s = &t.summary;
-                let status = if matches!(outcome, Outcome::Tracked(_)) {
-                    "tracked"
-                } else {
-                    "skipped"
-                };
-                let note = if status == "skipped" {
-                    "output already there"
-                } else {
-                    ""
-                };
                 format!(
                     "{name}\t{status}\t{}\t{}\t{:.2}\t{:.2}\t{:.1}\t{:.1}\t{note}",
                     s.frames,

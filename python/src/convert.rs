@@ -51,24 +51,28 @@ impl Table {
     }
 }
 
-/// `obj` as a float64 array of `ndim` dimensions through `numpy.asarray`.
-fn as_f64_array<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyAny>> {
+/// `obj` as a float64 array (of any number of dimensions) through `numpy.asarray`.
+fn as_f64_array<'py>(
+    obj: &Bound<'py, PyAny>,
+    what: &str,
+) -> PyResult<Bound<'py, numpy::PyArrayDyn<f64>>> {
     let py = obj.py();
     let np = py.import("numpy")?;
     np.getattr("asarray")?
         .call((obj, "float64"), None)
-        .map_err(|e| PyValueError::new_err(format!("{what}: not a numeric array ({e})")))
+        .map_err(|e| PyValueError::new_err(format!("{what}: not a numeric array ({e})")))?
+        .cast_into::<numpy::PyArrayDyn<f64>>()
+        .map_err(|_| {
+            PyValueError::new_err(format!(
+                "{what}: numpy.asarray did not give a float64 array"
+            ))
+        })
 }
 
 /// A 2-D table (`M × d`) from any array-like; an empty 1-D array or list is 0 rows of
 /// `empty_cols` columns.
 pub fn table(obj: &Bound<'_, PyAny>, what: &str, empty_cols: usize) -> PyResult<Table> {
     let arr = as_f64_array(obj, what)?;
-    let arr = arr.cast_into::<numpy::PyArrayDyn<f64>>().map_err(|_| {
-        PyValueError::new_err(format!(
-            "{what}: numpy.asarray did not give a float64 array"
-        ))
-    })?;
     let ro = arr.readonly();
     let view = ro.as_array();
     match view.ndim() {
@@ -95,11 +99,6 @@ pub fn table(obj: &Bound<'_, PyAny>, what: &str, empty_cols: usize) -> PyResult<
 /// A 1-D float vector from any array-like.
 pub fn vector(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
     let arr = as_f64_array(obj, what)?;
-    let arr = arr.cast_into::<numpy::PyArrayDyn<f64>>().map_err(|_| {
-        PyValueError::new_err(format!(
-            "{what}: numpy.asarray did not give a float64 array"
-        ))
-    })?;
     let ro = arr.readonly();
     let view = ro.as_array();
     if view.ndim() != 1 {
