@@ -148,10 +148,12 @@ pub(super) fn one_round(
     fitted.map(|p| (p, inliers))
 }
 
-/// The subsample's voxel grid: sample indices sorted by cell (ascending within a cell), so
-/// that the members of the cell of any sample point are one contiguous slice.
+/// The subsample's voxel grid: sample indices grouped by cell (ascending within a cell), so
+/// that the members of the cell of any sample point are one contiguous slice. Built in
+/// linear time: cells are numbered by a hash table in order of first appearance, then the
+/// indices are placed by a counting sort on that number.
 struct SampleCells {
-    /// Sample indices ordered by (cell, index).
+    /// Sample indices grouped by cell, ascending within a cell.
     order: Vec<u32>,
     /// Per sample index: the range of its cell in `order`.
     range_of: Vec<(u32, u32)>,
@@ -160,31 +162,54 @@ struct SampleCells {
 impl SampleCells {
     fn new(sample: &[[f32; 3]], cell: f32) -> Self {
         let inv = 1.0 / cell;
-        // (cell x, cell y, cell z, index) packed into one u128 whose order is the order of
-        // the tuple: flipping the sign bit maps i32 order onto u32 order.
-        let ordered = |v: f32| (floor_i32(v * inv) as u32 ^ 0x8000_0000) as u128;
-        let mut keyed: Vec<u128> = sample
-            .iter()
-            .enumerate()
-            .map(|(i, p)| {
-                (ordered(p[0]) << 96) | (ordered(p[1]) << 64) | (ordered(p[2]) << 32) | i as u128
-            })
-            .collect();
-        keyed.sort_unstable();
-        let order: Vec<u32> = keyed.iter().map(|&k| k as u32).collect();
-        let mut range_of = vec![(0u32, 0u32); sample.len()];
-        let mut start = 0usize;
-        while start < keyed.len() {
-            let cell_of = |k: u128| k >> 32;
-            let key = cell_of(keyed[start]);
-            let mut end = start + 1;
-            while end < keyed.len() && cell_of(keyed[end]) == key {
-                end += 1;
-            }
-            for &i in &order[start..end] {
-                range_of[i as usize] = (start as u32, end as u32);
-            }
-            start = end;
+        let m = sample.len();
+        // Open addressing with linear probing, at most half full; a slot holds a cell number
+        // and the cell's coordinates are kept once per cell.
+        let slots = (2 * m).next_power_of_two().max(2);
+        let mask = slots - 1;
+        let mut table: Vec<u32> = vec![u32::MAX; slots];
+        let mut cell_key: Vec<[i32; 3]> = Vec::new();
+        let mut count: Vec<u32> = Vec::new();
+        let mut cell_of: Vec<u32> = Vec::with_capacity(m);
+        for p in sample {
+            let key = [
+                floor_i32(p[0] * inv),
+                floor_i32(p[1] * inv),
+                floor_i32(p[2] * inv),
+            ];
+            let mut slot = cell_hash(key) as usize & mask;
+            let id = loop {
+                let id = table[slot];
+                if id == u32::MAX {
+                    let id = cell_key.len() as u32;
+                    table[slot] = id;
+                    cell_key.push(key);
+                    count.push(0);
+                    break id;
+                }
+                if cell_key[id as usize] == key {
+                    break id;
+                }
+                slot = (slot + 1) & mask;
+            };
+            count[id as usize] += 1;
+            cell_of.push(id);
+        }
+        // Start of every cell's run, then the indices in ascending order into their runs.
+        let mut start: Vec<u32> = Vec::with_capacity(count.len());
+        let mut acc = 0u32;
+        for &c in &count {
+            start.push(acc);
+            acc += c;
+        }
+        let mut next = start.clone();
+        let mut order = vec![0u32; m];
+        let mut range_of = vec![(0u32, 0u32); m];
+        for (i, &id) in cell_of.iter().enumerate() {
+            let id = id as usize;
+            order[next[id] as usize] = i as u32;
+            next[id] += 1;
+            range_of[i] = (start[id], start[id] + count[id]);
         }
         SampleCells { order, range_of }
     }
@@ -194,6 +219,14 @@ impl SampleCells {
         let (a, b) = self.range_of[i];
         &self.order[a as usize..b as usize]
     }
+}
+
+/// A 64-bit mix of a cell's three coordinates (for the hash table of [`SampleCells`]).
+#[inline]
+fn cell_hash(key: [i32; 3]) -> u64 {
+    let packed =
+        (key[0] as u32 as u64) ^ ((key[1] as u32 as u64) << 21) ^ ((key[2] as u32 as u64) << 42);
+    crate::rng::mix64(packed)
 }
 
 /// `v.floor() as i32` (saturating) without a libm call.
@@ -265,7 +298,12 @@ fn msse_threshold(residuals: &[f32], config: &PlaneConfig) -> f32 {
             high.push(r.to_bits());
         }
     }
-    high.sort_unstable();
+    // An LSD radix sort: the band holds tens of thousands of residuals for the ground.
+    if high.len() > RADIX_MIN {
+        radsort::sort(&mut high);
+    } else {
+        high.sort_unstable();
+    }
     let high: Vec<f64> = high.iter().map(|&b| f32::from_bits(b) as f64).collect();
     if low >= MSSE_START {
         return msse_grow(low, low_sq, &high, config);
@@ -278,6 +316,9 @@ fn msse_threshold(residuals: &[f32], config: &PlaneConfig) -> f32 {
     }
     msse_grow(low + take, low_sq + sq, &high[take..], config)
 }
+
+/// Below this many residuals a comparison sort beats the radix sort's passes.
+const RADIX_MIN: usize = 512;
 
 /// Parameters of the fitted model (a plane) in the MSSE scale `σ_k² = Σ r² / (k − P)`.
 const MSSE_P: usize = 3;
@@ -370,6 +411,36 @@ mod tests {
     use super::*;
     use crate::rng::seeded;
     use rand_distr::{Distribution, Normal};
+
+    #[test]
+    fn sample_cells_hold_exactly_the_points_of_each_cell_in_ascending_order() {
+        let mut rng = seeded(11);
+        for (m, spread) in [
+            (1usize, 1.0f32),
+            (7, 0.5),
+            (500, 3.0),
+            (3000, 40.0),
+            (3000, -8.0),
+        ] {
+            let sample: Vec<[f32; 3]> = (0..m)
+                .map(|_| {
+                    let mut p = [0.0f32; 3];
+                    for v in &mut p {
+                        *v = rng.random_range(-1.0f32..1.0) * spread;
+                    }
+                    p
+                })
+                .collect();
+            let cells = SampleCells::new(&sample, 2.0);
+            let cell = |p: &[f32; 3]| p.map(|v| (v / 2.0).floor() as i64);
+            for (i, p) in sample.iter().enumerate() {
+                let want: Vec<u32> = (0..m as u32)
+                    .filter(|&j| cell(&sample[j as usize]) == cell(p))
+                    .collect();
+                assert_eq!(cells.members_with(i), want.as_slice(), "m {m}, point {i}");
+            }
+        }
+    }
 
     #[test]
     fn msse_threshold_tracks_noise_scale() {
