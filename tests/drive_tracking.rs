@@ -185,6 +185,8 @@ fn synthetic_street_walls_keep_labels_and_the_box_is_tracked() {
     let json = tmp.path().join("tracks.json");
     tracks.write_json(&json).unwrap();
     let back = DriveTracks::read_json(&json).unwrap();
+    // Every number to the last bit (serde_json's `float_roundtrip` parsing).
+    assert_eq!(back, tracks);
     assert_eq!(back.frames.len(), tracks.frames.len());
     assert_eq!(back.summary.plane_labels, tracks.summary.plane_labels);
     for (a, b) in back.frames.iter().zip(&tracks.frames) {
