@@ -50,6 +50,10 @@ struct Args {
     /// Print one JSON object instead of tables.
     #[arg(long)]
     json: bool,
+    /// Also print where the OSPA comes from: its localisation and cardinality parts, missed
+    /// and false objects, the r ≥ 0.5 estimator's OSPA, and how late objects are found.
+    #[arg(long)]
+    breakdown: bool,
 }
 
 struct RunResult {
@@ -57,6 +61,28 @@ struct RunResult {
     gospa: Vec<f64>,
     card: Vec<f64>,
     ms: Vec<f64>,
+    /// Where the OSPA comes from (`--breakdown`).
+    parts: Breakdown,
+}
+
+/// The MAP estimate's OSPA split into its localisation and cardinality parts, GOSPA's missed
+/// and false objects, the OSPA of the other common estimator (every track with r ≥ 0.5), and
+/// how late objects are first found; summed over steps and objects.
+#[derive(Default)]
+struct Breakdown {
+    ospa_localisation: f64,
+    ospa_cardinality: f64,
+    missed: f64,
+    false_tracks: f64,
+    ospa_threshold_estimator: f64,
+    steps: usize,
+    /// Per truth object: steps from its first appearance until an estimate lies within c/2.
+    first_found_delay: Vec<f64>,
+    /// Objects never found.
+    never_found: usize,
+    /// OSPA summed over the steps in which some object is in its first 5 steps.
+    ospa_young: f64,
+    young_steps: usize,
 }
 
 fn run_once(
@@ -74,7 +100,10 @@ fn run_once(
         gospa: vec![],
         card: vec![],
         ms: vec![],
+        parts: Breakdown::default(),
     };
+    let mut first_seen: std::collections::BTreeMap<u64, (usize, Option<usize>)> =
+        Default::default();
     for (k, z) in sim.measurements.iter().enumerate() {
         let frame = Frame::new(k as f64 * scenario.period, Measurements::from_rows(2, z)?);
         let t0 = Instant::now();
@@ -82,10 +111,51 @@ fn run_once(
         out.ms.push(t0.elapsed().as_secs_f64() * 1e3);
         let x: Vec<Vec<f64>> = est.iter().map(|e| vec![e.state[0], e.state[2]]).collect();
         let truth: Vec<Vec<f64>> = sim.truth[k].iter().map(|(_, s)| vec![s[0], s[2]]).collect();
-        out.ospa.push(ospa(&truth, &x, c, p)?.distance);
-        out.gospa.push(gospa(&truth, &x, c, p)?.distance);
+        let o = ospa(&truth, &x, c, p)?;
+        let g = gospa(&truth, &x, c, p)?;
+        out.ospa.push(o.distance);
+        out.gospa.push(g.distance);
+        let b = &mut out.parts;
+        b.ospa_localisation += o.localisation;
+        b.ospa_cardinality += o.cardinality;
+        b.missed += g.n_missed as f64;
+        b.false_tracks += g.n_false as f64;
+        b.steps += 1;
+        let confident: Vec<Vec<f64>> = filter
+            .tracks()
+            .iter()
+            .filter(|t| t.existence >= 0.5)
+            .map(|t| {
+                let m = t.particles.mean();
+                vec![m[0], m[2]]
+            })
+            .collect();
+        b.ospa_threshold_estimator += ospa(&truth, &confident, c, p)?.distance;
+        let mut young = false;
+        for (id, state) in &sim.truth[k] {
+            let entry = first_seen.entry(*id).or_insert((k, None));
+            if k < entry.0 + 5 {
+                young = true;
+            }
+            let near = x
+                .iter()
+                .any(|e| (e[0] - state[0]).hypot(e[1] - state[2]) < c / 2.0);
+            if near && entry.1.is_none() {
+                entry.1 = Some(k);
+            }
+        }
+        if young {
+            b.ospa_young += o.distance;
+            b.young_steps += 1;
+        }
         out.card
             .push(cardinality_error([(truth.len(), x.len())]).mean);
+    }
+    for (born, found) in first_seen.values() {
+        match found {
+            Some(f) => out.parts.first_found_delay.push((f - born) as f64),
+            None => out.parts.never_found += 1,
+        }
     }
     Ok(out)
 }
@@ -103,6 +173,49 @@ fn parse_jitter(s: &str) -> Result<Jitter> {
         "regularised" => Jitter::Regularised { scale: num()? },
         _ => anyhow::bail!("--jitter {s}: expected none, roughening:K or regularised:SCALE"),
     })
+}
+
+fn print_breakdown(runs: &[RunResult], cutoff: f64) {
+    let sum = |f: fn(&Breakdown) -> f64| runs.iter().map(|r| f(&r.parts)).sum::<f64>();
+    let steps = sum(|b| b.steps as f64);
+    let delays: Vec<f64> = runs
+        .iter()
+        .flat_map(|r| r.parts.first_found_delay.iter().copied())
+        .collect();
+    let never: usize = runs.iter().map(|r| r.parts.never_found).sum();
+    let young_steps = sum(|b| b.young_steps as f64);
+    println!("where the OSPA comes from (MAP estimate, means over steps):");
+    println!(
+        "  localisation part {:.2} m, cardinality part {:.2} m",
+        sum(|b| b.ospa_localisation) / steps,
+        sum(|b| b.ospa_cardinality) / steps
+    );
+    println!(
+        "  missed objects {:.3}, false tracks {:.3} per step",
+        sum(|b| b.missed) / steps,
+        sum(|b| b.false_tracks) / steps
+    );
+    println!(
+        "  estimator r ≥ 0.5 instead of MAP: OSPA {:.2} m",
+        sum(|b| b.ospa_threshold_estimator) / steps
+    );
+    println!(
+        "  steps with an object in its first 5 steps: {:.0} % of steps, OSPA {:.2} m there, {:.2} m elsewhere",
+        100.0 * young_steps / steps,
+        sum(|b| b.ospa_young) / young_steps.max(1.0),
+        (sum(|b| runs_ospa_total(b)) - sum(|b| b.ospa_young)) / (steps - young_steps).max(1.0)
+    );
+    println!(
+        "  objects first found within c/2 = {:.0} m after {:.2} steps on average (median {:.1}); never found: {never}",
+        cutoff / 2.0,
+        mean(&delays),
+        median(&delays)
+    );
+}
+
+/// Sum of the step OSPAs of a run (the parts add up to it for p = 1).
+fn runs_ospa_total(b: &Breakdown) -> f64 {
+    b.ospa_localisation + b.ospa_cardinality
 }
 
 fn mean(v: &[f64]) -> f64 {
@@ -195,6 +308,9 @@ fn main() -> Result<()> {
     if args.json {
         println!("{summary}");
         return Ok(());
+    }
+    if args.breakdown {
+        print_breakdown(&runs, scenario.ospa_cutoff);
     }
     println!("step  OSPA(m)  GOSPA(m)  |card err|");
     for k in 0..steps {
