@@ -13,10 +13,10 @@
 //!    width, linearity, circularity, radius, boundary length and regularity, mean curvature,
 //!    mean angular difference), then the range of the centroid and the occlusion of each end
 //!    (neighbour end range minus own end range, clipped to ±2 m; +2 m with no neighbour),
-//!    and the motion: the scan is aligned onto the previous scan by ICP ([`super::icp`]:
-//!    the scanner's own motion, no odometry needed) and the motion is the mean distance
-//!    from the segment's aligned returns to the nearest return of the previous scan, capped
-//!    at 1 m (−1 on the first scan or when the alignment fails). Walls and furniture stay
+//!    and the motion: the scan is aligned onto the previous scan by ICP ([`super::icp`]
+//!    with [`LEG_ICP`]: the scanner's own motion, no odometry needed) and the motion is the
+//!    mean distance from the segment's aligned returns to the nearest return of the previous
+//!    scan, capped at 1 m (−1 on the first scan or when the alignment fails). Walls and furniture stay
 //!    put; a walking person's legs do not.
 //! 3. **Legs**: a segment whose boosted score exceeds [`LegDetectorConfig::leg_score`].
 //! 4. **People** ([`pair_legs`]): legs closer than `pair_distance` are paired, closest pairs
