@@ -48,6 +48,10 @@ struct Args {
     /// recordings with `laser2d --leg-model`).
     #[arg(long)]
     fold_models: Option<PathBuf>,
+    /// Train without these features (comma-separated names; their column is set to 0, so
+    /// no stump splits on it): for measuring what a feature is worth.
+    #[arg(long, value_delimiter = ',')]
+    drop_features: Vec<String>,
 }
 
 const POSITIVE: [&str; 4] = [
@@ -146,14 +150,16 @@ fn load(args: &Args, cfg: &LegDetectorConfig) -> Result<(Vec<Recording>, Vec<Rec
     Ok((pos, neg))
 }
 
-fn train(recs: &[&Recording], rounds: usize) -> Result<Boosted> {
-    let mut xs = Vec::new();
+fn train(recs: &[&Recording], rounds: usize, drop: &[usize]) -> Result<Boosted> {
+    let mut xs: Vec<Vec<f64>> = Vec::new();
     let mut ys = Vec::new();
     for r in recs {
         for s in &r.scans {
             for (c, label) in s {
                 if let Some(l) = label {
-                    xs.push(c.features.to_vec());
+                    let mut x = c.features.to_vec();
+                    drop.iter().for_each(|&f| x[f] = 0.0);
+                    xs.push(x);
                     ys.push(*l);
                 }
             }
@@ -256,6 +262,16 @@ fn leg_model(model: &Boosted, cfg: &LegDetectorConfig, trained_on: &str) -> LegM
 fn main() -> Result<()> {
     let args = Args::parse();
     let cfg = LegDetectorConfig::default();
+    let drop = args
+        .drop_features
+        .iter()
+        .map(|n| {
+            LEG_FEATURE_NAMES
+                .iter()
+                .position(|f| f == n)
+                .with_context(|| format!("no feature {n}"))
+        })
+        .collect::<Result<Vec<usize>>>()?;
     let (pos, neg) = load(&args, &cfg)?;
     header("Leave-one-bag-out (each row scored by a model that never saw it)");
     let (mut pooled_pos, mut pooled_neg) = (DetectionScore::default(), DetectionScore::default());
@@ -276,7 +292,7 @@ fn main() -> Result<()> {
                     .map(|(_, r)| r),
             )
             .collect();
-        let model = train(&train_set, args.rounds)?;
+        let model = train(&train_set, args.rounds, &drop)?;
         if let Some(dir) = &args.fold_models {
             std::fs::create_dir_all(dir)?;
             let path = dir.join(format!("fold_{}.json", i + 1));
@@ -316,7 +332,7 @@ fn main() -> Result<()> {
     }
 
     let all: Vec<&Recording> = pos.iter().chain(&neg).collect();
-    let model = train(&all, args.rounds)?;
+    let model = train(&all, args.rounds, &drop)?;
     header("Trained on everything, scored on its own training recordings");
     let mut pooled = DetectionScore::default();
     for r in &pos {

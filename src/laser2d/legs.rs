@@ -13,10 +13,10 @@
 //!    width, linearity, circularity, radius, boundary length and regularity, mean curvature,
 //!    mean angular difference), then the range of the centroid and the occlusion of each end
 //!    (neighbour end range minus own end range, clipped to ±2 m; +2 m with no neighbour),
-//!    and the motion: the scan is aligned onto the previous scan by ICP ([`super::icp`]:
-//!    the scanner's own motion, no odometry needed) and the motion is the mean distance
-//!    from the segment's aligned returns to the nearest return of the previous scan, capped
-//!    at 1 m (−1 on the first scan or when the alignment fails). Walls and furniture stay
+//!    and the motion: the scan is aligned onto the previous scan by ICP ([`super::icp`]
+//!    with [`LEG_ICP`]: the scanner's own motion, no odometry needed) and the motion is the
+//!    mean distance from the segment's aligned returns to the nearest return of the previous
+//!    scan, capped at 1 m (−1 on the first scan or when the alignment fails). Walls and furniture stay
 //!    put; a walking person's legs do not.
 //! 3. **Legs**: a segment whose boosted score exceeds [`LegDetectorConfig::leg_score`].
 //! 4. **People** ([`pair_legs`]): legs closer than `pair_distance` are paired, closest pairs
@@ -281,11 +281,35 @@ pub struct LegDetector {
     icp: Icp,
     previous: Vec<[f64; 2]>,
     current: Vec<[f64; 2]>,
+    source: Vec<[f64; 2]>,
     pose: Pose2,
+    /// The last alignment's motion, the next alignment's first guess.
+    step: Pose2,
 }
 
 /// Motion feature when it cannot be measured.
 pub const UNKNOWN_MOTION: f64 = -1.0;
+
+/// The scan-to-scan alignment of the detector. A motion cue needs centimetres, not the
+/// default's hundredth of a millimetre: it aligns every [`ICP_STRIDE`]th return, stops
+/// after 12 iterations or once a step moves less than 0.1 mm and turns less than 0.1 mrad,
+/// and starts from the previous scan's motion (a scanner moves on much as it moved). On
+/// `negative_2.bag` (`/right_scan`, a moving scanner) the alignments run 6.6 times as fast as
+/// with the default settings from the identity (3,600 against 550 per second; 11.6 against
+/// 31.1 iterations) and differ from them by about 1 mm and 0.5 mrad.
+pub const LEG_ICP: IcpConfig = IcpConfig {
+    max_iterations: 12,
+    max_pair_distance: 1.0,
+    residual_factor: 3.0,
+    min_gate: 0.1,
+    tolerance_translation: 1e-4,
+    tolerance_rotation: 1e-4,
+    min_pairs: 10,
+};
+
+/// The alignment uses every this many'th return of a scan as its source (all returns as
+/// its target).
+pub const ICP_STRIDE: usize = 3;
 
 impl LegDetector {
     /// A detector running `model` with its own settings.
@@ -294,10 +318,12 @@ impl LegDetector {
         Ok(LegDetector {
             model,
             config,
-            icp: Icp::new(IcpConfig::default())?,
+            icp: Icp::new(LEG_ICP)?,
             previous: Vec::new(),
             current: Vec::new(),
+            source: Vec::new(),
             pose: identity(),
+            step: identity(),
         })
     }
 
@@ -311,12 +337,18 @@ impl LegDetector {
     pub fn candidates(&mut self, scan: &Scan) -> Result<Vec<LegCandidate>> {
         self.current.clear();
         self.current.extend(scan.points().map(|(_, p)| p));
-        let fit = if self.previous.len() >= 10 && self.current.len() >= 10 {
+        self.source.clear();
+        self.source
+            .extend(self.current.iter().step_by(ICP_STRIDE).copied());
+        let fit = if self.previous.len() >= 10 && self.source.len() >= 10 {
             self.icp.set_target(&self.previous)?;
-            self.icp.align(&self.current, identity()).ok()
+            self.icp.align(&self.source, self.step).ok()
         } else {
             None
         };
+        if let Some(f) = fit {
+            self.step = f.transform;
+        }
         let icp = &self.icp;
         let motion = |pts: &[[f64; 2]]| match fit {
             Some(f) => {
@@ -457,6 +489,39 @@ mod tests {
         assert!(
             again.iter().all(|c| (0.0..0.01).contains(&c.features[16])),
             "{again:?}"
+        );
+    }
+
+    /// A scan from (`x`, 0) facing +x in a room with walls at x = 4 m and y = ±2.5 m.
+    fn room_from(x: f64) -> Scan {
+        let (a0, inc) = (-1.2f64, 0.006f64);
+        let ranges = (0..401)
+            .map(|i| {
+                let b = a0 + inc * i as f64;
+                let (dx, dy) = (b.cos(), b.sin());
+                let mut r = (4.0 - x) / dx;
+                if dy.abs() > 1e-9 {
+                    r = r.min(2.5 / dy.abs());
+                }
+                r as f32
+            })
+            .collect();
+        Scan::new(0.0, a0, inc, ranges, 0.0, 30.0).unwrap()
+    }
+
+    #[test]
+    fn the_chained_alignments_follow_a_scanner_driving_through_a_room() {
+        // 5 cm forward per scan: after 12 scans the scanner stands 0.55 m from where it
+        // started, with the walls the only thing to align on. Point-to-point alignment of
+        // sampled walls falls short by about a millimetre per scan (1.2 cm here).
+        let mut d = LegDetector::shipped().unwrap();
+        for k in 0..12 {
+            d.candidates(&room_from(0.05 * k as f64)).unwrap();
+        }
+        let p = d.pose();
+        assert!(
+            (p.x - 0.55).abs() < 0.02 && p.y.abs() < 0.005 && p.theta.abs() < 0.002,
+            "{p:?}"
         );
     }
 
