@@ -36,6 +36,19 @@ pub struct OdometryConfig {
     pub max_iterations: usize,
     /// Stop once the norm of the 6-vector update is below this (default 1e-4).
     pub convergence: f64,
+    // --- point-to-plane refinement (not in KISS-ICP; see `refine`) ---
+    /// At most this many point-to-plane Gauss–Newton steps after the point-to-point
+    /// alignment, on the map sampling of the scan against the planes of the map's voxels
+    /// (default 10; 0 switches the refinement off, leaving KISS-ICP's recipe).
+    pub refine_iterations: usize,
+    /// Geman–McClure scale of the point-to-plane distances, metres (default 0.1 m).
+    pub refine_scale: f64,
+    /// A map voxel carries a plane when its points' RMS distance to it is below this, metres
+    /// (default 0.05 m).
+    pub refine_thickness: f64,
+    /// A map voxel's plane is fitted to the map points within this distance of its centre,
+    /// metres (default 1 m; at most `voxel_size`).
+    pub refine_radius: f64,
 }
 
 impl Default for OdometryConfig {
@@ -51,6 +64,10 @@ impl Default for OdometryConfig {
             fixed_threshold: None,
             max_iterations: 500,
             convergence: 1e-4,
+            refine_iterations: 10,
+            refine_scale: 0.1,
+            refine_thickness: 0.05,
+            refine_radius: 1.0,
         }
     }
 }
@@ -88,6 +105,9 @@ impl OdometryConfig {
             ));
         }
         ensure_non_negative("odometry convergence", self.convergence)?;
+        ensure_positive("odometry refine_scale", self.refine_scale)?;
+        ensure_positive("odometry refine_thickness", self.refine_thickness)?;
+        ensure_positive("odometry refine_radius", self.refine_radius)?;
         Ok(())
     }
 }

@@ -3,6 +3,7 @@
 
 use super::config::OdometryConfig;
 use super::downsample::{crop_range, voxel_downsample};
+use super::refine::{refine_point_to_plane, RefineParams};
 use super::registration::{align_points_to_map, IcpParams};
 use super::se3::renormalized;
 use super::threshold::AdaptiveThreshold;
@@ -98,7 +99,18 @@ impl LidarOdometry {
             convergence: c.convergence,
         };
         let aligned = align_points_to_map(&source, &self.map, &initial, &params);
-        let pose = aligned.pose;
+        let pose = if c.refine_iterations > 0 {
+            let fine = RefineParams {
+                scale: c.refine_scale,
+                thickness: c.refine_thickness,
+                radius: c.refine_radius.min(c.voxel_size),
+                max_iterations: c.refine_iterations,
+                convergence: 1e-6,
+            };
+            refine_point_to_plane(&frame_down, &self.map, &aligned.pose, &fine).pose
+        } else {
+            aligned.pose
+        };
         // Update: threshold from the model deviation, map, velocity, pose.
         self.threshold.update(&(initial.inverse() * pose));
         self.map.update(&frame_down, &pose);
