@@ -37,10 +37,13 @@ pub struct OdometryConfig {
     /// Stop once the norm of the 6-vector update is below this (default 1e-4).
     pub convergence: f64,
     // --- point-to-plane refinement (not in KISS-ICP; see `refine`) ---
-    /// At most this many point-to-plane Gauss–Newton steps after the point-to-point
-    /// alignment, on the map sampling of the scan against the planes of the map's voxels
-    /// (default 10; 0 switches the refinement off, leaving KISS-ICP's recipe).
+    /// At most this many point-to-plane Gauss–Newton steps per refinement pass after the
+    /// point-to-point alignment, on the map sampling of the scan against the planes of the
+    /// map's voxels (default 10; 0 switches the refinement off, leaving KISS-ICP's recipe).
     pub refine_iterations: usize,
+    /// Refinement passes, each fitting the planes anew at the pose the last one reached
+    /// (default 2).
+    pub refine_passes: usize,
     /// Geman–McClure scale of the point-to-plane distances, metres (default 0.1 m).
     pub refine_scale: f64,
     /// A map voxel carries a plane when its points' RMS distance to it is below this, metres
@@ -65,6 +68,7 @@ impl Default for OdometryConfig {
             max_iterations: 500,
             convergence: 1e-4,
             refine_iterations: 10,
+            refine_passes: 2,
             refine_scale: 0.1,
             refine_thickness: 0.05,
             refine_radius: 1.0,

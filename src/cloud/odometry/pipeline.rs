@@ -99,11 +99,12 @@ impl LidarOdometry {
             convergence: c.convergence,
         };
         let aligned = align_points_to_map(&source, &self.map, &initial, &params);
-        let pose = if c.refine_iterations > 0 {
+        let pose = if c.refine_iterations > 0 && c.refine_passes > 0 {
             let fine = RefineParams {
                 scale: c.refine_scale,
                 thickness: c.refine_thickness,
                 radius: c.refine_radius.min(c.voxel_size),
+                passes: c.refine_passes,
                 max_iterations: c.refine_iterations,
                 convergence: 1e-6,
             };
