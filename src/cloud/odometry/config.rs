@@ -52,6 +52,11 @@ pub struct OdometryConfig {
     /// A map voxel's plane is fitted to the map points within this distance of its centre,
     /// metres (default 1 m; at most `voxel_size`).
     pub refine_radius: f64,
+    /// With the refinement on, the point-to-point alignment stops once the update's norm is
+    /// below this (or `convergence`, whichever is larger; default 1e-3): the refinement
+    /// takes the last millimetres, and the point-to-point iterations between 1e-3 and 1e-4
+    /// changed nothing measurable on the street or drive 0005 but took a quarter of the time.
+    pub refine_coarse_convergence: f64,
 }
 
 impl Default for OdometryConfig {
@@ -72,6 +77,7 @@ impl Default for OdometryConfig {
             refine_scale: 0.1,
             refine_thickness: 0.05,
             refine_radius: 1.0,
+            refine_coarse_convergence: 1e-3,
         }
     }
 }
@@ -112,6 +118,10 @@ impl OdometryConfig {
         ensure_positive("odometry refine_scale", self.refine_scale)?;
         ensure_positive("odometry refine_thickness", self.refine_thickness)?;
         ensure_positive("odometry refine_radius", self.refine_radius)?;
+        ensure_non_negative(
+            "odometry refine_coarse_convergence",
+            self.refine_coarse_convergence,
+        )?;
         Ok(())
     }
 }

@@ -92,14 +92,19 @@ impl LidarOdometry {
             .unwrap_or_else(|| self.threshold.threshold());
         // Constant-velocity prediction (Sec. III-A) and alignment (Sec. III-D).
         let initial = renormalized(&(self.last_pose * self.last_delta));
+        let refine = c.refine_iterations > 0 && c.refine_passes > 0;
         let params = IcpParams {
             max_correspondence: 3.0 * sigma,
             kernel: sigma / 3.0,
             max_iterations: c.max_iterations,
-            convergence: c.convergence,
+            convergence: if refine {
+                c.convergence.max(c.refine_coarse_convergence)
+            } else {
+                c.convergence
+            },
         };
         let aligned = align_points_to_map(&source, &self.map, &initial, &params);
-        let pose = if c.refine_iterations > 0 && c.refine_passes > 0 {
+        let pose = if refine {
             let fine = RefineParams {
                 scale: c.refine_scale,
                 thickness: c.refine_thickness,
