@@ -8,7 +8,9 @@ use crate::error::{ensure_non_negative, ensure_positive, Error, Result};
 ///
 /// The defaults are KISS-ICP's: a sensor range of 100 m, voxels of `max_range / 100` = 1 m,
 /// 20 points per map voxel, an initial threshold of 2 m, a minimum motion of 0.1 m, at most 500
-/// ICP iterations and a convergence criterion of 1e-4 on the update's norm.
+/// ICP iterations and a convergence criterion of 1e-4 on the update's norm. The `refine_*`
+/// fields set the point-to-plane refinement that follows (not KISS-ICP's; see
+/// [`refine`](super::refine)).
 #[derive(Clone, Debug, PartialEq)]
 pub struct OdometryConfig {
     // --- preprocessing ---
@@ -151,5 +153,14 @@ mod tests {
             ..OdometryConfig::default()
         };
         assert!(c.validate().unwrap_err().to_string().contains("min_range"));
+        let c = OdometryConfig {
+            refine_scale: 0.0,
+            ..OdometryConfig::default()
+        };
+        assert!(c
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("refine_scale"));
     }
 }

@@ -1,5 +1,6 @@
 //! [`LidarOdometry`]: the per-frame pipeline of KISS-ICP — preprocess, voxelize, threshold,
-//! align, update — and [`odometry_of_files`], which runs it over a list of `.bin` scans.
+//! align, update — with a point-to-plane refinement after the alignment, and
+//! [`odometry_of_files`], which runs it over a list of `.bin` scans.
 
 use super::config::OdometryConfig;
 use super::downsample::{crop_range, voxel_downsample};
@@ -28,7 +29,8 @@ pub struct Registered {
     pub correspondences: usize,
 }
 
-/// Lidar odometry by scan-to-map registration (KISS-ICP, Vizzo et al., RA-L 2023).
+/// Lidar odometry by scan-to-map registration (KISS-ICP, Vizzo et al., RA-L 2023), refined
+/// point-to-plane against the local map's planes (see [`super::refine`]).
 ///
 /// Feed the scans in order to [`register`](Self::register); the first scan gets the identity
 /// pose and defines the map frame. Scans are not deskewed: KITTI `.bin` files carry no
