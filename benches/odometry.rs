@@ -8,7 +8,10 @@
 //! Groups:
 //! * `odometry/voxelize`: range crop and the two voxel downsamplings of one scan;
 //! * `odometry/align`: ICP of the second scan's registration points to a map of the first;
+//! * `odometry/refine`: the point-to-plane refinement of the second scan's map sampling against
+//!   the map, from the pose `align` found (two passes, as in the pipeline);
 //! * `odometry/pair`: the whole pipeline on both scans (a fresh map each time);
+//!   `odometry/pair_no_refine` without the refinement (KISS-ICP's recipe);
 //! * `odometry/nearest_voxel_hash` and `odometry/nearest_kiddo`: the closest map point of
 //!   every registration point, by the 27-voxel lookup the pipeline uses and by a k-d tree
 //!   (kiddo, built once) — the choice KISS-ICP made, measured; `odometry/kiddo_build` is the
@@ -18,8 +21,8 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use nalgebra::{Isometry3, Vector3};
 use smc_lmb::cloud::odometry::{
-    align_points_to_map, crop_range, voxel_downsample, IcpParams, LidarOdometry, OdometryConfig,
-    VoxelHashMap,
+    align_points_to_map, crop_range, refine_point_to_plane, voxel_downsample, IcpParams,
+    LidarOdometry, OdometryConfig, RefineParams, VoxelHashMap,
 };
 use smc_lmb::cloud::{read_kitti_bin, PointCloud};
 use std::path::{Path, PathBuf};
@@ -61,7 +64,7 @@ fn odometry(c: &mut Criterion) {
         (down, source)
     };
     let (map_points, _) = voxelize(&a);
-    let (_, source) = voxelize(&b);
+    let (down, source) = voxelize(&b);
     let mut map = VoxelHashMap::new(v, config.max_range, config.max_points_per_voxel);
     map.update(&map_points, &Isometry3::identity());
     println!(
@@ -87,9 +90,33 @@ fn odometry(c: &mut Criterion) {
     g.bench_function("align", |bench| {
         bench.iter(|| align_points_to_map(&source, &map, &Isometry3::identity(), &params))
     });
+    let coarse = align_points_to_map(&source, &map, &Isometry3::identity(), &params).pose;
+    let fine = RefineParams {
+        scale: config.refine_scale,
+        thickness: config.refine_thickness,
+        radius: config.refine_radius,
+        passes: config.refine_passes,
+        max_iterations: config.refine_iterations,
+        convergence: 1e-6,
+    };
+    println!("{} refinement points", down.len());
+    g.bench_function("refine", |bench| {
+        bench.iter(|| refine_point_to_plane(&down, &map, &coarse, &fine))
+    });
     g.bench_function("pair", |bench| {
         bench.iter(|| {
             let mut odometry = LidarOdometry::new(config.clone()).unwrap();
+            odometry.register(&a).unwrap();
+            odometry.register(&b).unwrap().pose
+        })
+    });
+    let p2p = OdometryConfig {
+        refine_iterations: 0,
+        ..config.clone()
+    };
+    g.bench_function("pair_no_refine", |bench| {
+        bench.iter(|| {
+            let mut odometry = LidarOdometry::new(p2p.clone()).unwrap();
             odometry.register(&a).unwrap();
             odometry.register(&b).unwrap().pose
         })

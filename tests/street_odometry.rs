@@ -15,8 +15,12 @@ const FRAMES: usize = 30;
 const SEED: u64 = 5;
 
 /// Path length of the truth, the end-point distance between estimate and truth, and the worst
-/// per-frame translation error (m).
-fn run(config: &StreetConfig) -> (f64, f64, f64) {
+/// and the mean per-frame translation error (m), with the default odometry.
+fn run(config: &StreetConfig) -> (f64, f64, f64, f64) {
+    run_with(config, &OdometryConfig::default())
+}
+
+fn run_with(config: &StreetConfig, odometry: &OdometryConfig) -> (f64, f64, f64, f64) {
     let street = generate(config, FRAMES, SEED).unwrap();
     let truth: Vec<Isometry3<f64>> = street
         .truth
@@ -24,7 +28,7 @@ fn run(config: &StreetConfig) -> (f64, f64, f64) {
         .iter()
         .map(|f| f.drive_pose.to_isometry())
         .collect();
-    let mut odometry = LidarOdometry::new(OdometryConfig::default()).unwrap();
+    let mut odometry = LidarOdometry::new(odometry.clone()).unwrap();
     let estimate: Vec<Isometry3<f64>> = street
         .scans
         .iter()
@@ -36,19 +40,21 @@ fn run(config: &StreetConfig) -> (f64, f64, f64) {
         .map(|w| (position(&w[1]) - position(&w[0])).norm())
         .sum();
     let drift = (position(&estimate[FRAMES - 1]) - position(&truth[FRAMES - 1])).norm();
-    let worst_step = (1..FRAMES)
+    let steps: Vec<f64> = (1..FRAMES)
         .map(|k| {
             let true_step = position(&truth[k]) - position(&truth[k - 1]);
             let est_step = position(&estimate[k]) - position(&estimate[k - 1]);
             (true_step - est_step).norm()
         })
-        .fold(0.0, f64::max);
-    (path, drift, worst_step)
+        .collect();
+    let worst_step = steps.iter().copied().fold(0.0, f64::max);
+    let mean_step = steps.iter().sum::<f64>() / steps.len() as f64;
+    (path, drift, worst_step, mean_step)
 }
 
 #[test]
 fn lidar_odometry_recovers_the_simulated_path() {
-    let (path, drift, worst) = run(&StreetConfig::default());
+    let (path, drift, worst, _) = run(&StreetConfig::default());
     eprintln!(
         "street: path {path:.2} m, end-point drift {drift:.3} m ({:.2} %), worst frame {worst:.3} m",
         100.0 * drift / path
@@ -57,4 +63,27 @@ fn lidar_odometry_recovers_the_simulated_path() {
     assert!((path - 29.0).abs() < 0.5, "{path}");
     assert!(drift < 0.05 * path, "drift {drift} m over {path} m");
     assert!(worst < 0.3, "a frame off by {worst} m");
+}
+
+/// The point-to-plane refinement makes each frame's motion millimetre-precise on the street.
+/// When this test was written, KISS-ICP's recipe alone (`refine_iterations: 0`) erred by 1.8 cm
+/// a frame on average on these 30 frames (worst 4.8 cm, end-point drift 8.2 cm) and fails every
+/// bound; the default by 2.0 mm (worst 4.8 mm, drift 0.9 cm).
+#[test]
+fn each_frame_is_millimetre_precise_with_the_refinement() {
+    let street = StreetConfig::default();
+    let (_, drift, worst, mean) = run(&street);
+    let kiss = OdometryConfig {
+        refine_iterations: 0,
+        ..OdometryConfig::default()
+    };
+    let (_, kiss_drift, kiss_worst, kiss_mean) = run_with(&street, &kiss);
+    eprintln!(
+        "per-frame translation error: refined mean {mean:.4} m, worst {worst:.4} m, drift \
+         {drift:.3} m; point-to-point only mean {kiss_mean:.4} m, worst {kiss_worst:.4} m, drift \
+         {kiss_drift:.3} m"
+    );
+    assert!(mean < 0.004, "mean per-frame error {mean} m");
+    assert!(worst < 0.012, "worst per-frame error {worst} m");
+    assert!(drift < 0.05, "end-point drift {drift} m");
 }

@@ -50,6 +50,10 @@ pub struct Args {
     /// Maximum range in metres.
     #[arg(long, default_value_t = 100.0)]
     max_range: f64,
+    /// KISS-ICP's recipe alone: no point-to-plane refinement after the point-to-point
+    /// alignment.
+    #[arg(long)]
+    no_refine: bool,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -176,6 +180,11 @@ fn estimate(args: &Args, scans: &[PathBuf]) -> Result<Vec<Isometry3<f64>>> {
     let config = OdometryConfig {
         max_range: args.max_range,
         voxel_size: args.voxel_size.unwrap_or(args.max_range / 100.0),
+        refine_iterations: if args.no_refine {
+            0
+        } else {
+            OdometryConfig::default().refine_iterations
+        },
         ..OdometryConfig::default()
     };
     let bar = if args.quiet {

@@ -54,7 +54,23 @@ fn a_standing_sensor_stays_at_the_origin() {
     assert!(stdout.contains("translation mean 0.00"), "{stdout}");
     let poses = smc_lmb::kitti::odometry::read_odometry_poses(&out).unwrap();
     assert_eq!(poses.len(), 2);
-    assert!(poses[1].translation.vector.norm() < 1e-3, "{:?}", poses[1]);
+    // The point-to-plane refinement measures the copy against planes fitted to the first scan's
+    // sparse map (a model of the surface, not its points): it settles 1.0 mm from the origin
+    // here when this was written; KISS-ICP's recipe alone (`--no-refine`, below) 0.5 mm.
+    assert!(poses[1].translation.vector.norm() < 2e-3, "{:?}", poses[1]);
+    let exact = dir.path().join("poses_p2p.txt");
+    let (good, stdout, stderr) = run(&[
+        "odometry",
+        "--scans",
+        scans.to_str().unwrap(),
+        "--out",
+        exact.to_str().unwrap(),
+        "--no-refine",
+        "--quiet",
+    ]);
+    assert!(good, "{stdout}\n{stderr}");
+    let p2p = smc_lmb::kitti::odometry::read_odometry_poses(&exact).unwrap();
+    assert!(p2p[1].translation.vector.norm() < 1e-3, "{:?}", p2p[1]);
     // Scoring the written file gives the same report without running again.
     let scored = ok(&common::output(&[
         "odometry",

@@ -8,7 +8,9 @@ use crate::error::{ensure_non_negative, ensure_positive, Error, Result};
 ///
 /// The defaults are KISS-ICP's: a sensor range of 100 m, voxels of `max_range / 100` = 1 m,
 /// 20 points per map voxel, an initial threshold of 2 m, a minimum motion of 0.1 m, at most 500
-/// ICP iterations and a convergence criterion of 1e-4 on the update's norm.
+/// ICP iterations and a convergence criterion of 1e-4 on the update's norm. The `refine_*`
+/// fields set the point-to-plane refinement that follows (not KISS-ICP's; see
+/// [`refine`](super::refine)).
 #[derive(Clone, Debug, PartialEq)]
 pub struct OdometryConfig {
     // --- preprocessing ---
@@ -36,6 +38,27 @@ pub struct OdometryConfig {
     pub max_iterations: usize,
     /// Stop once the norm of the 6-vector update is below this (default 1e-4).
     pub convergence: f64,
+    // --- point-to-plane refinement (not in KISS-ICP; see `refine`) ---
+    /// At most this many point-to-plane Gauss–Newton steps per refinement pass after the
+    /// point-to-point alignment, on the map sampling of the scan against the planes of the
+    /// map's voxels (default 10; 0 switches the refinement off, leaving KISS-ICP's recipe).
+    pub refine_iterations: usize,
+    /// Refinement passes, each fitting the planes anew at the pose the last one reached
+    /// (default 2).
+    pub refine_passes: usize,
+    /// Geman–McClure scale of the point-to-plane distances, metres (default 0.1 m).
+    pub refine_scale: f64,
+    /// A map voxel carries a plane when its points' RMS distance to it is below this, metres
+    /// (default 0.05 m).
+    pub refine_thickness: f64,
+    /// A map voxel's plane is fitted to the map points within this distance of its centre,
+    /// metres (default 1 m; at most `voxel_size`).
+    pub refine_radius: f64,
+    /// With the refinement on, the point-to-point alignment stops once the update's norm is
+    /// below this (or `convergence`, whichever is larger; default 1e-3): the refinement
+    /// takes the last millimetres, and the point-to-point iterations between 1e-3 and 1e-4
+    /// changed nothing measurable on the street or drive 0005 but took a quarter of the time.
+    pub refine_coarse_convergence: f64,
 }
 
 impl Default for OdometryConfig {
@@ -51,6 +74,12 @@ impl Default for OdometryConfig {
             fixed_threshold: None,
             max_iterations: 500,
             convergence: 1e-4,
+            refine_iterations: 10,
+            refine_passes: 2,
+            refine_scale: 0.1,
+            refine_thickness: 0.05,
+            refine_radius: 1.0,
+            refine_coarse_convergence: 1e-3,
         }
     }
 }
@@ -88,6 +117,13 @@ impl OdometryConfig {
             ));
         }
         ensure_non_negative("odometry convergence", self.convergence)?;
+        ensure_positive("odometry refine_scale", self.refine_scale)?;
+        ensure_positive("odometry refine_thickness", self.refine_thickness)?;
+        ensure_positive("odometry refine_radius", self.refine_radius)?;
+        ensure_non_negative(
+            "odometry refine_coarse_convergence",
+            self.refine_coarse_convergence,
+        )?;
         Ok(())
     }
 }
@@ -117,5 +153,14 @@ mod tests {
             ..OdometryConfig::default()
         };
         assert!(c.validate().unwrap_err().to_string().contains("min_range"));
+        let c = OdometryConfig {
+            refine_scale: 0.0,
+            ..OdometryConfig::default()
+        };
+        assert!(c
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("refine_scale"));
     }
 }

@@ -1,5 +1,7 @@
 //! Lidar odometry: the ego motion of a scanner from its own scans, by KISS-ICP's recipe
-//! (Vizzo et al., "KISS-ICP: In Defense of Point-to-Point ICP", RA-L 2023).
+//! (Vizzo et al., "KISS-ICP: In Defense of Point-to-Point ICP", RA-L 2023) followed by a
+//! point-to-plane refinement against the local map's planes ([`refine`]; on by default,
+//! `refine_iterations: 0` leaves KISS-ICP's recipe alone).
 //!
 //! One file per concept:
 //!
@@ -11,7 +13,8 @@
 //! | [`threshold`] | [`AdaptiveThreshold`], σ from the recent model deviations |
 //! | [`se3`] | the SE(3) exponential for the Gauss–Newton updates |
 //! | [`registration`] | point-to-point ICP with a Geman–McClure kernel |
-//! | [`pipeline`] | [`LidarOdometry`]: preprocess → voxelize → threshold → align → update |
+//! | [`refine`] | point-to-plane refinement against a plane per map voxel |
+//! | [`pipeline`] | [`LidarOdometry`]: preprocess → voxelize → threshold → align → refine → update |
 //!
 //! ```no_run
 //! use smc_lmb::cloud::odometry::{LidarOdometry, OdometryConfig};
@@ -24,7 +27,7 @@
 //! # Ok::<(), smc_lmb::Error>(())
 //! ```
 //!
-//! Results do not depend on the number of rayon threads (see [`registration`]).
+//! Results do not depend on the number of rayon threads (see [`registration`] and [`refine`]).
 //! Deskewing (motion compensation within a sweep) is left out: KITTI `.bin` scans carry no
 //! per-point time.
 //!
@@ -33,6 +36,7 @@
 pub mod config;
 pub mod downsample;
 pub mod pipeline;
+pub mod refine;
 pub mod registration;
 pub mod se3;
 pub mod threshold;
@@ -44,6 +48,7 @@ mod test_scene;
 pub use config::OdometryConfig;
 pub use downsample::{crop_range, voxel_downsample};
 pub use pipeline::{odometry_of_files, odometry_of_frames, LidarOdometry, Registered};
+pub use refine::{fit_plane, refine_point_to_plane, Plane, RefineParams};
 pub use registration::{align_points_to_map, Alignment, IcpParams};
 pub use threshold::AdaptiveThreshold;
 pub use voxel_map::{Voxel, VoxelHashMap};

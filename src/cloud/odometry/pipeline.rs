@@ -1,8 +1,10 @@
 //! [`LidarOdometry`]: the per-frame pipeline of KISS-ICP — preprocess, voxelize, threshold,
-//! align, update — and [`odometry_of_files`], which runs it over a list of `.bin` scans.
+//! align, update — with a point-to-plane refinement after the alignment, and
+//! [`odometry_of_files`], which runs it over a list of `.bin` scans.
 
 use super::config::OdometryConfig;
 use super::downsample::{crop_range, voxel_downsample};
+use super::refine::{refine_point_to_plane, RefineParams};
 use super::registration::{align_points_to_map, IcpParams};
 use super::se3::renormalized;
 use super::threshold::AdaptiveThreshold;
@@ -27,7 +29,8 @@ pub struct Registered {
     pub correspondences: usize,
 }
 
-/// Lidar odometry by scan-to-map registration (KISS-ICP, Vizzo et al., RA-L 2023).
+/// Lidar odometry by scan-to-map registration (KISS-ICP, Vizzo et al., RA-L 2023), refined
+/// point-to-plane against the local map's planes (see [`super::refine`]).
 ///
 /// Feed the scans in order to [`register`](Self::register); the first scan gets the identity
 /// pose and defines the map frame. Scans are not deskewed: KITTI `.bin` files carry no
@@ -91,14 +94,31 @@ impl LidarOdometry {
             .unwrap_or_else(|| self.threshold.threshold());
         // Constant-velocity prediction (Sec. III-A) and alignment (Sec. III-D).
         let initial = renormalized(&(self.last_pose * self.last_delta));
+        let refine = c.refine_iterations > 0 && c.refine_passes > 0;
         let params = IcpParams {
             max_correspondence: 3.0 * sigma,
             kernel: sigma / 3.0,
             max_iterations: c.max_iterations,
-            convergence: c.convergence,
+            convergence: if refine {
+                c.convergence.max(c.refine_coarse_convergence)
+            } else {
+                c.convergence
+            },
         };
         let aligned = align_points_to_map(&source, &self.map, &initial, &params);
-        let pose = aligned.pose;
+        let pose = if refine {
+            let fine = RefineParams {
+                scale: c.refine_scale,
+                thickness: c.refine_thickness,
+                radius: c.refine_radius.min(c.voxel_size),
+                passes: c.refine_passes,
+                max_iterations: c.refine_iterations,
+                convergence: 1e-6,
+            };
+            refine_point_to_plane(&frame_down, &self.map, &aligned.pose, &fine).pose
+        } else {
+            aligned.pose
+        };
         // Update: threshold from the model deviation, map, velocity, pose.
         self.threshold.update(&(initial.inverse() * pose));
         self.map.update(&frame_down, &pose);

@@ -109,6 +109,11 @@ impl VoxelHashMap {
         v
     }
 
+    /// The points of one voxel, or `None` when it is empty.
+    pub fn cell(&self, voxel: &Voxel) -> Option<&[Vector3<f64>]> {
+        self.map.get(voxel).map(Vec::as_slice)
+    }
+
     /// Every point of the map, ordered by voxel coordinates, then by insertion.
     pub fn points(&self) -> Vec<Vector3<f64>> {
         self.voxels()
