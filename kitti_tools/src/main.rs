@@ -66,7 +66,21 @@ enum Command {
     Eval(eval_cmd::Args),
 }
 
+/// Writing to a closed pipe (`kitti-tools planes --all … | head`) ends the process quietly, as
+/// it does for other Unix tools, instead of a panic in `println!`: Rust ignores SIGPIPE and
+/// turns the failed write into an error that `println!` cannot return. Outputs are written to
+/// a temporary file and renamed, so an interrupted command leaves no half-written file.
+fn restore_default_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: called first thing in `main`, before any thread exists; SIG_DFL is a valid
+    // disposition for SIGPIPE.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() -> Result<()> {
+    restore_default_sigpipe();
     match Cli::parse().command {
         Command::Demo(args) => demo_cmd::run(args),
         Command::Detections(args) => detections_cmd::run(args),

@@ -249,3 +249,23 @@ fn info_on_oxts_only_drive() {
     assert!(v["path_length_m"].as_f64().unwrap() >= 0.0);
     assert!(v["issues"].is_array());
 }
+
+/// Output into a pipe whose reader has gone (`kitti-tools info … | head -0`) ends the process
+/// quietly, by SIGPIPE as for other Unix tools, not with a panic from `println!`.
+#[cfg(unix)]
+#[test]
+fn a_closed_output_pipe_ends_the_command_without_a_panic() {
+    use std::os::unix::process::ExitStatusExt;
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let drive = data("2011_09_26_drive_UNKNOWN_sync");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_kitti-tools"))
+        .args(["info", "--drive", drive.to_str().unwrap()])
+        .stdout(writer)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    // SIGPIPE is signal 13 on Linux, macOS and the BSDs.
+    assert_eq!(out.status.signal(), Some(13), "{:?}", out.status);
+}
