@@ -28,6 +28,7 @@ use super::points::PointCloud;
 use crate::error::{Error, Result};
 use crate::geometry::plane::convex_hull;
 use crate::geometry::Box3;
+use crate::numerics::floor::floor_i64;
 use nalgebra::{Point2, Point3};
 use std::f64::consts::{FRAC_PI_2, PI};
 
@@ -280,13 +281,7 @@ fn one_point_per_cell(xy: &mut Vec<f64>, n2: usize, cell: f64) {
     let mut keys: Vec<(i64, i64, usize)> = xy[..n2]
         .chunks_exact(2)
         .enumerate()
-        .map(|(i, p)| {
-            (
-                (p[0] / cell).floor() as i64,
-                (p[1] / cell).floor() as i64,
-                i,
-            )
-        })
+        .map(|(i, p)| (floor_i64(p[0] / cell), floor_i64(p[1] / cell), i))
         .collect();
     keys.sort_unstable();
     keys.dedup_by(|a, b| a.0 == b.0 && a.1 == b.1);

@@ -7,6 +7,7 @@
 //! Not for: occupancy or free-space reasoning, loop closure, or storing moving objects (the
 //! caller inserts only points it believes static).
 
+use crate::numerics::floor::floor_i64;
 use std::collections::BTreeMap;
 
 /// Cells of running point means; see the module documentation. Iteration order (and so the
@@ -44,10 +45,7 @@ impl LocalMap {
         if !(p[0].is_finite() && p[1].is_finite()) {
             return;
         }
-        let key = (
-            (p[0] / self.cell).floor() as i64,
-            (p[1] / self.cell).floor() as i64,
-        );
+        let key = (floor_i64(p[0] / self.cell), floor_i64(p[1] / self.cell));
         let e = self.cells.entry(key).or_insert((0.0, 0.0, 0));
         e.0 += p[0];
         e.1 += p[1];

@@ -1,9 +1,11 @@
-//! Numerical kernels the per-particle loops share: a slice exponential on vector lanes
-//! ([`exp`]) and a full-precision `atan2` for whole slices ([`atan`]). Both are exact
-//! replacements of the standard library's functions (within their documented error), written
-//! so that the compiler vectorises them.
+//! Numerical kernels the per-particle and per-point loops share: a slice exponential on vector
+//! lanes ([`exp`]), a full-precision `atan2` for whole slices ([`atan`]) and an integer floor
+//! without a libm call ([`floor`]). All are exact replacements of the standard library's
+//! functions (within their documented error), written so that the compiler inlines or
+//! vectorises them.
 //!
 //! Not for: models or statistics; anything here is a plain function of numbers.
 
 pub(crate) mod atan;
 pub(crate) mod exp;
+pub(crate) mod floor;

@@ -4,6 +4,7 @@
 //!
 //! Points are in the map frame (the Velodyne frame of the first scan), f64.
 
+use crate::numerics::floor::floor_i32;
 use nalgebra::{Isometry3, Point3, Vector3};
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hash, Hasher};
@@ -21,15 +22,6 @@ impl Voxel {
             floor_i32(p.z / size),
         ])
     }
-}
-
-/// `v.floor() as i32`, bit for bit (saturating, NaN to 0), without the libm call that
-/// `floor` costs on the baseline x86-64 target (no SSE4.1 rounding instruction): truncate
-/// towards zero, then step down when that rounded a negative value up.
-#[inline]
-pub fn floor_i32(v: f64) -> i32 {
-    let t = v as i32;
-    t.saturating_sub((v < t as f64) as i32)
 }
 
 impl Hash for Voxel {
@@ -207,32 +199,6 @@ mod tests {
     }
 
     #[test]
-    fn fast_floor_matches_floor_on_the_edge_cases() {
-        for v in [
-            0.0,
-            -0.0,
-            0.5,
-            -0.5,
-            -1.0,
-            1.0,
-            -1e-300,
-            2_147_483_647.9,
-            2_147_483_648.0,
-            -2_147_483_648.0,
-            -2_147_483_648.5,
-            -3e10,
-            3e10,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::NAN,
-            f64::MAX,
-            f64::MIN,
-        ] {
-            assert_eq!(floor_i32(v), v.floor() as i32, "{v}");
-        }
-    }
-
-    #[test]
     fn negative_coordinates_floor_into_their_own_voxel() {
         assert_eq!(
             Voxel::of(&Vector3::new(-0.1, 0.1, -1.0), 1.0),
@@ -249,17 +215,6 @@ mod tests {
     }
 
     proptest! {
-        #[test]
-        fn fast_floor_matches_floor(v in prop::num::f64::ANY) {
-            prop_assert_eq!(floor_i32(v), v.floor() as i32);
-        }
-
-        #[test]
-        fn fast_floor_matches_floor_near_integers(k in -3_000_000_000i64..3_000_000_000, d in -1e-6f64..1e-6) {
-            let v = k as f64 + d;
-            prop_assert_eq!(floor_i32(v), v.floor() as i32);
-        }
-
         #[test]
         fn voxels_respect_capacity_membership_and_spacing(
             raw in prop::collection::vec((-5.0f64..5.0, -5.0f64..5.0, -2.0f64..2.0), 1..400),

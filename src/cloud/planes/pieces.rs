@@ -4,6 +4,7 @@
 //! Not for: finding planes (see the `ransac` module) or deciding what a piece is.
 
 use crate::geometry::Plane;
+use crate::numerics::floor::floor_i64;
 use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -178,10 +179,7 @@ fn plane_cells(plane: &Plane, idx: &[u32], pts: &[[f32; 3]], cell: f64) -> Vec<(
         .map(|&i| {
             let p = pts[i as usize];
             let q = Vector3::new(p[0] as f64, p[1] as f64, p[2] as f64);
-            (
-                (q.dot(&u) * inv).floor() as i64,
-                (q.dot(&v) * inv).floor() as i64,
-            )
+            (floor_i64(q.dot(&u) * inv), floor_i64(q.dot(&v) * inv))
         })
         .collect()
 }
