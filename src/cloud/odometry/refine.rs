@@ -357,19 +357,7 @@ mod tests {
             convergence: 1e-4,
         };
         let coarse = align_points_to_map(&scan, &map, &Isometry3::identity(), &icp);
-        let fine = refine_point_to_plane(
-            &scan,
-            &map,
-            &coarse.pose,
-            &RefineParams {
-                scale: 0.1,
-                thickness: 0.05,
-                radius: 1.0,
-                passes: 2,
-                max_iterations: 10,
-                convergence: 1e-6,
-            },
-        );
+        let fine = refine_point_to_plane(&scan, &map, &coarse.pose, &params());
         let err = |pose: &Isometry3<f64>| {
             let e = truth.inverse() * pose;
             (e.translation.vector.norm(), e.rotation.angle().to_degrees())
@@ -381,19 +369,23 @@ mod tests {
         assert!(ft < 0.5 * ct, "refined {ft} m, point-to-point {ct} m");
     }
 
-    #[test]
-    fn an_empty_map_returns_the_initial_guess() {
-        let map = VoxelHashMap::new(1.0, 100.0, 20);
-        let init = Isometry3::translation(1.0, 0.0, 0.0);
-        let params = RefineParams {
+    /// The refinement's settings in these tests.
+    fn params() -> RefineParams {
+        RefineParams {
             scale: 0.1,
             thickness: 0.05,
             radius: 1.0,
             passes: 2,
             max_iterations: 10,
             convergence: 1e-6,
-        };
-        let a = refine_point_to_plane(&[Vector3::zeros()], &map, &init, &params);
+        }
+    }
+
+    #[test]
+    fn an_empty_map_returns_the_initial_guess() {
+        let map = VoxelHashMap::new(1.0, 100.0, 20);
+        let init = Isometry3::translation(1.0, 0.0, 0.0);
+        let a = refine_point_to_plane(&[Vector3::zeros()], &map, &init, &params());
         assert_eq!(a.pose, init);
         assert_eq!(a.iterations, 0);
     }
