@@ -5,12 +5,13 @@
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use nalgebra::Isometry3;
-use smc_lmb::cloud::odometry::{odometry_of_files, OdometryConfig};
+use smc_lmb::cloud::odometry::{odometry_of_files, Fallback, OdometryConfig};
 use smc_lmb::kitti::odometry::{read_odometry_poses, write_odometry_poses};
 use smc_lmb::kitti::{OdometrySequence, RawDrive};
 use smc_lmb::metrics::{
     path_length, relative_pose_errors, segment_errors, Spread, KITTI_SEGMENT_LENGTHS,
 };
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -197,7 +198,17 @@ fn estimate(args: &Args, scans: &[PathBuf]) -> Result<Vec<Isometry3<f64>>> {
             .expect("valid template"),
     );
     let start = Instant::now();
-    let poses = odometry_of_files(scans, &config, |_, _| bar.inc(1))?;
+    let mut fallbacks: BTreeMap<Fallback, Vec<usize>> = BTreeMap::new();
+    let mut least_information = f64::INFINITY;
+    let poses = odometry_of_files(scans, &config, |k, r| {
+        bar.inc(1);
+        if let Some(f) = r.fallback {
+            fallbacks.entry(f).or_default().push(k);
+        }
+        if let Some(i) = r.information_ratio {
+            least_information = least_information.min(i);
+        }
+    })?;
     let elapsed = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
     let out = args
@@ -212,6 +223,22 @@ fn estimate(args: &Args, scans: &[PathBuf]) -> Result<Vec<Isometry3<f64>>> {
         1000.0 * elapsed / poses.len() as f64,
         out.display()
     );
+    if least_information.is_finite() {
+        println!(
+            "least translational information ratio {least_information:.2e} (fallback below {:.0e})",
+            config.min_information_ratio
+        );
+    }
+    for (f, frames) in &fallbacks {
+        let shown: Vec<String> = frames.iter().take(10).map(|k| k.to_string()).collect();
+        let more = if frames.len() > 10 { ", …" } else { "" };
+        eprintln!(
+            "warning: {} scan(s) kept the constant-velocity pose ({}): {}{more}",
+            frames.len(),
+            f.name(),
+            shown.join(", ")
+        );
+    }
     Ok(poses)
 }
 

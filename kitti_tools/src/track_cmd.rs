@@ -277,6 +277,13 @@ pub fn print_summary(tracks: &DriveTracks) {
             String::new()
         }
     );
+    if s.ego_fallbacks > 0 {
+        eprintln!(
+            "warning: lidar odometry kept the constant-velocity pose in {} frame(s) (too few \
+             points, a degenerate scene or a jump; see `kitti-tools odometry` for which)",
+            s.ego_fallbacks
+        );
+    }
     let pairs = smc_lmb::pipeline::drive_tracking::tracked_wall_pairs(tracks);
     if !pairs.is_empty() {
         let w = smc_lmb::metrics::PlanePredictionSummary::from_pairs(&pairs, &[]);

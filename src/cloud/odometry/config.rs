@@ -59,6 +59,20 @@ pub struct OdometryConfig {
     /// takes the last millimetres, and the point-to-point iterations between 1e-3 and 1e-4
     /// changed nothing measurable on the street or drive 0005 but took a quarter of the time.
     pub refine_coarse_convergence: f64,
+    /// Fewer correspondences than this in the final alignment: the scan cannot be trusted and
+    /// the constant-velocity prediction is kept ([`super::Fallback::TooFewPoints`]).
+    pub min_correspondences: usize,
+    /// A registration that moves the scan farther than this (m) from the constant-velocity
+    /// prediction is a jump, not a motion (200 m/s² at 10 Hz): the prediction is kept
+    /// ([`super::Fallback::Jump`]).
+    pub max_correction: f64,
+    /// As `max_correction`, for the rotation (rad).
+    pub max_correction_angle: f64,
+    /// The refinement's translational information Σ w n nᵀ (n the planes' normals) with its
+    /// smallest eigenvalue below this fraction of its largest leaves a direction unconstrained
+    /// (a featureless corridor): the prediction is kept ([`super::Fallback::Degenerate`]).
+    /// Only with the refinement on.
+    pub min_information_ratio: f64,
 }
 
 impl Default for OdometryConfig {
@@ -80,6 +94,10 @@ impl Default for OdometryConfig {
             refine_thickness: 0.05,
             refine_radius: 1.0,
             refine_coarse_convergence: 1e-3,
+            min_correspondences: 50,
+            max_correction: 2.0,
+            max_correction_angle: 10f64.to_radians(),
+            min_information_ratio: 1e-3,
         }
     }
 }
@@ -124,6 +142,9 @@ impl OdometryConfig {
             "odometry refine_coarse_convergence",
             self.refine_coarse_convergence,
         )?;
+        ensure_positive("odometry max_correction", self.max_correction)?;
+        ensure_positive("odometry max_correction_angle", self.max_correction_angle)?;
+        ensure_non_negative("odometry min_information_ratio", self.min_information_ratio)?;
         Ok(())
     }
 }

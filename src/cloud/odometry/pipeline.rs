@@ -11,7 +11,8 @@ use super::threshold::AdaptiveThreshold;
 use super::voxel_map::VoxelHashMap;
 use crate::cloud::{is_pcd, read_scan_with, NonFinite, PointCloud};
 use crate::error::{Error, Result};
-use nalgebra::Isometry3;
+use nalgebra::{Isometry3, Matrix3};
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// What registering one scan produced.
@@ -27,6 +28,37 @@ pub struct Registered {
     pub iterations: usize,
     /// Correspondences in the last iteration.
     pub correspondences: usize,
+    /// Why the constant-velocity prediction was kept instead of the registration, if it was.
+    pub fallback: Option<Fallback>,
+    /// Smallest over largest eigenvalue of the refinement's translational information (1 for
+    /// a scene that constrains every direction alike, 0 for a corridor); `None` without the
+    /// refinement.
+    pub information_ratio: Option<f64>,
+}
+
+/// Why a scan's registration was not trusted. The scan's pose is then the constant-velocity
+/// prediction (the last motion repeated), the map is updated at that pose, and the motion
+/// model keeps its velocity.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Fallback {
+    /// Fewer correspondences than [`OdometryConfig::min_correspondences`].
+    TooFewPoints,
+    /// A direction no plane constrains ([`OdometryConfig::min_information_ratio`]).
+    Degenerate,
+    /// The registration moved the scan farther from the prediction than
+    /// [`OdometryConfig::max_correction`] / [`OdometryConfig::max_correction_angle`].
+    Jump,
+}
+
+impl Fallback {
+    /// A short name for reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Fallback::TooFewPoints => "too few points",
+            Fallback::Degenerate => "degenerate geometry",
+            Fallback::Jump => "jump",
+        }
+    }
 }
 
 /// Lidar odometry by scan-to-map registration (KISS-ICP, Vizzo et al., RA-L 2023), refined
@@ -43,6 +75,7 @@ pub struct LidarOdometry {
     last_pose: Isometry3<f64>,
     last_delta: Isometry3<f64>,
     poses: Vec<Isometry3<f64>>,
+    fallbacks: BTreeMap<Fallback, usize>,
 }
 
 impl LidarOdometry {
@@ -64,6 +97,7 @@ impl LidarOdometry {
             last_pose: Isometry3::identity(),
             last_delta: Isometry3::identity(),
             poses: Vec::new(),
+            fallbacks: BTreeMap::new(),
         })
     }
 
@@ -106,7 +140,7 @@ impl LidarOdometry {
             },
         };
         let aligned = align_points_to_map(&source, &self.map, &initial, &params);
-        let pose = if refine {
+        let (registered, correspondences, information) = if refine {
             let fine = RefineParams {
                 scale: c.refine_scale,
                 thickness: c.refine_thickness,
@@ -115,9 +149,28 @@ impl LidarOdometry {
                 max_iterations: c.refine_iterations,
                 convergence: 1e-6,
             };
-            refine_point_to_plane(&frame_down, &self.map, &aligned.pose, &fine).pose
+            let r = refine_point_to_plane(&frame_down, &self.map, &aligned.pose, &fine);
+            // Without planes (an empty map, the first scan) the coarse alignment stands.
+            let n = if r.iterations > 0 {
+                r.correspondences
+            } else {
+                aligned.correspondences
+            };
+            (r.pose, n, r.translation_information)
         } else {
-            aligned.pose
+            (aligned.pose, aligned.correspondences, None)
+        };
+        let information_ratio = information.map(|m| eigen_ratio(&m));
+        // The first scan has no map to register against: it is the origin, never a fallback.
+        let fallback = if self.map.is_empty() {
+            None
+        } else {
+            self.fallback(&initial, &registered, correspondences, information_ratio)
+        };
+        let pose = if fallback.is_some() {
+            initial
+        } else {
+            registered
         };
         // Update: threshold from the model deviation, map, velocity, pose.
         self.threshold.update(&(initial.inverse() * pose));
@@ -125,13 +178,48 @@ impl LidarOdometry {
         self.last_delta = renormalized(&(self.last_pose.inverse() * pose));
         self.last_pose = pose;
         self.poses.push(pose);
+        if let Some(f) = fallback {
+            *self.fallbacks.entry(f).or_insert(0) += 1;
+        }
         Ok(Registered {
             pose,
             threshold: sigma,
             source_points: source.len(),
             iterations: aligned.iterations,
             correspondences: aligned.correspondences,
+            fallback,
+            information_ratio,
         })
+    }
+
+    /// Whether the registration `registered` of a scan predicted at `initial` is untrusted,
+    /// and why (checked in the order too few points, degenerate, jump).
+    fn fallback(
+        &self,
+        initial: &Isometry3<f64>,
+        registered: &Isometry3<f64>,
+        correspondences: usize,
+        information_ratio: Option<f64>,
+    ) -> Option<Fallback> {
+        let c = &self.config;
+        if correspondences < c.min_correspondences {
+            return Some(Fallback::TooFewPoints);
+        }
+        if information_ratio.is_some_and(|r| r < c.min_information_ratio) {
+            return Some(Fallback::Degenerate);
+        }
+        let correction = initial.inverse() * registered;
+        if correction.translation.vector.norm() > c.max_correction
+            || correction.rotation.angle() > c.max_correction_angle
+        {
+            return Some(Fallback::Jump);
+        }
+        None
+    }
+
+    /// How many scans fell back to the constant-velocity prediction, by reason.
+    pub fn fallbacks(&self) -> &BTreeMap<Fallback, usize> {
+        &self.fallbacks
     }
 
     /// The poses of all scans registered so far (scan → first scan).
@@ -212,6 +300,20 @@ fn named(path: &Path, e: Error) -> Error {
     }
 }
 
+/// Smallest over largest eigenvalue of a symmetric positive semi-definite matrix (0 when it
+/// is zero).
+fn eigen_ratio(m: &Matrix3<f64>) -> f64 {
+    let e = m.symmetric_eigenvalues();
+    let (lo, hi) = e.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &v| {
+        (lo.min(v), hi.max(v))
+    });
+    if hi > 0.0 {
+        (lo / hi).max(0.0)
+    } else {
+        0.0
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -245,7 +347,9 @@ mod tests {
         for (k, t) in truth.iter().enumerate() {
             // Every frame sees its own sampling of the yard.
             let world = yard(0.1, k as u64);
-            let pose = odo.register(&seen_from(&world, t)).unwrap().pose;
+            let r = odo.register(&seen_from(&world, t)).unwrap();
+            assert_eq!(r.fallback, None, "frame {k}: {r:?}");
+            let pose = r.pose;
             // Each frame-to-frame motion to < 1 cm / 0.05°, the drift after 7 frames below
             // 3 cm / 0.15°.
             let step_err =
@@ -291,6 +395,118 @@ mod tests {
             })
         };
         assert_eq!(run(1), run(3));
+    }
+
+    /// An endless corridor along x (walls y = ±2 m, floor −1.5 m, ceiling 2.5 m; no end
+    /// walls), about one point per `spacing`² of surface, sampled by `seed`.
+    fn corridor(spacing: f64, seed: u64) -> Vec<Vector3<f64>> {
+        use rand::RngExt;
+        let mut rng = crate::rng::seeded(seed);
+        let n = (120.0 * 4.0 / (spacing * spacing)) as usize;
+        let mut out = Vec::with_capacity(4 * n);
+        for face in 0..4 {
+            for _ in 0..n {
+                let x = rng.random_range(-60.0..60.0);
+                let t: f64 = rng.random_range(0.0..4.0);
+                out.push(match face {
+                    0 => Vector3::new(x, -2.0, -1.5 + t),
+                    1 => Vector3::new(x, 2.0, -1.5 + t),
+                    2 => Vector3::new(x, -2.0 + t, -1.5),
+                    _ => Vector3::new(x, -2.0 + t, 2.5),
+                });
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn a_featureless_corridor_keeps_the_constant_velocity_pose() {
+        // The sensor moves 0.5 m a frame along the corridor, which no scan can show: every
+        // scan after the first is degenerate along x and keeps the prediction (here the
+        // origin, as nothing has moved yet), instead of whatever ICP slid to.
+        let config = OdometryConfig {
+            voxel_size: 0.5,
+            ..OdometryConfig::default()
+        };
+        let mut odo = LidarOdometry::new(config).unwrap();
+        for k in 0..5u64 {
+            let truth = Isometry3::translation(0.5 * k as f64, 0.0, 0.0);
+            let r = odo.register(&seen_from(&corridor(0.2, k), &truth)).unwrap();
+            if k == 0 {
+                assert_eq!(r.fallback, None);
+                continue;
+            }
+            assert_eq!(r.fallback, Some(Fallback::Degenerate), "scan {k}: {r:?}");
+            assert!(r.information_ratio.unwrap() < 1e-3, "scan {k}: {r:?}");
+            assert_eq!(r.pose, Isometry3::identity(), "scan {k}");
+        }
+        assert_eq!(odo.fallbacks().get(&Fallback::Degenerate), Some(&4));
+        assert_eq!(odo.fallbacks().len(), 1);
+    }
+
+    #[test]
+    fn a_scan_with_too_few_points_keeps_the_prediction() {
+        let mut odo = LidarOdometry::new(OdometryConfig {
+            voxel_size: 0.5,
+            ..OdometryConfig::default()
+        })
+        .unwrap();
+        let step = Isometry3::translation(0.4, 0.0, 0.0);
+        odo.register(&seen_from(&yard(0.1, 0), &Isometry3::identity()))
+            .unwrap();
+        let second = odo.register(&seen_from(&yard(0.1, 1), &step)).unwrap();
+        assert_eq!(second.fallback, None);
+        // Twenty points of one wall: far below 50 correspondences.
+        let few: Vec<Vector3<f64>> = yard(0.1, 2)
+            .into_iter()
+            .filter(|p| (p.x - 20.0).abs() < 1e-9)
+            .take(20)
+            .collect();
+        assert_eq!(few.len(), 20);
+        let third = odo.register(&seen_from(&few, &(step * step))).unwrap();
+        assert_eq!(third.fallback, Some(Fallback::TooFewPoints), "{third:?}");
+        // The prediction: the second pose moved on by the same motion once more.
+        let predicted = renormalized(&(second.pose * second.pose));
+        assert_eq!(third.pose, predicted);
+        assert_eq!(odo.fallbacks().get(&Fallback::TooFewPoints), Some(&1));
+    }
+
+    #[test]
+    fn a_correction_beyond_the_bound_is_a_jump_that_keeps_the_prediction() {
+        // A 0.4 m motion from standstill is a correction of 0.4 m to the prediction; with
+        // the bound at 5 cm it is refused.
+        let mut odo = LidarOdometry::new(OdometryConfig {
+            voxel_size: 0.5,
+            max_correction: 0.05,
+            ..OdometryConfig::default()
+        })
+        .unwrap();
+        odo.register(&seen_from(&yard(0.1, 0), &Isometry3::identity()))
+            .unwrap();
+        let r = odo
+            .register(&seen_from(
+                &yard(0.1, 1),
+                &Isometry3::translation(0.4, 0.0, 0.0),
+            ))
+            .unwrap();
+        assert_eq!(r.fallback, Some(Fallback::Jump), "{r:?}");
+        assert_eq!(r.pose, Isometry3::identity());
+        // With the default bound the same motion is taken.
+        let mut odo = LidarOdometry::new(OdometryConfig {
+            voxel_size: 0.5,
+            ..OdometryConfig::default()
+        })
+        .unwrap();
+        odo.register(&seen_from(&yard(0.1, 0), &Isometry3::identity()))
+            .unwrap();
+        let r = odo
+            .register(&seen_from(
+                &yard(0.1, 1),
+                &Isometry3::translation(0.4, 0.0, 0.0),
+            ))
+            .unwrap();
+        assert_eq!(r.fallback, None);
+        assert!((r.pose.translation.vector.x - 0.4).abs() < 0.01, "{r:?}");
     }
 
     #[test]

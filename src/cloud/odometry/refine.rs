@@ -114,6 +114,7 @@ pub fn refine_point_to_plane(
         pose: *initial,
         iterations: 0,
         correspondences: 0,
+        translation_information: None,
     };
     if map.is_empty() || source.is_empty() {
         return out;
@@ -127,6 +128,7 @@ pub fn refine_point_to_plane(
         let step = refine_pass(source, map, &pose, params, size, &mut planes);
         out.iterations += step.iterations;
         out.correspondences = step.correspondences;
+        out.translation_information = step.translation_information.or(out.translation_information);
         match step.pose {
             Some(p) => pose = p,
             None => break,
@@ -142,6 +144,8 @@ struct Pass {
     pose: Option<Isometry3<f64>>,
     iterations: usize,
     correspondences: usize,
+    /// The top-left block of the last iteration's normal matrix: Σ w n nᵀ.
+    translation_information: Option<Matrix3<f64>>,
 }
 
 fn refine_pass(
@@ -156,6 +160,7 @@ fn refine_pass(
         pose: None,
         iterations: 0,
         correspondences: 0,
+        translation_information: None,
     };
     let moved: Vec<Vector3<f64>> = source
         .iter()
@@ -225,6 +230,7 @@ fn refine_pass(
         );
         out.iterations += 1;
         out.correspondences = n;
+        out.translation_information = Some(jtj.fixed_view::<3, 3>(0, 0).into_owned());
         let Some(chol) = jtj.cholesky() else {
             return out;
         };

@@ -28,6 +28,9 @@ pub struct Alignment {
     pub iterations: usize,
     /// Correspondences found in the last iteration.
     pub correspondences: usize,
+    /// Point-to-plane alignments only: the translational information Σ w n nᵀ of the last
+    /// iteration (n the planes' normals, w the kernel's weights).
+    pub translation_information: Option<Matrix3<f64>>,
 }
 
 /// Stopping rules of the Gauss–Newton loop.
@@ -56,6 +59,7 @@ pub fn align_points_to_map(
         pose: *initial,
         iterations: 0,
         correspondences: 0,
+        translation_information: None,
     };
     if map.is_empty() || source.is_empty() {
         return out;

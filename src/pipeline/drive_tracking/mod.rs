@@ -665,7 +665,10 @@ fn track_recording(
         })?;
         out.push(tracked);
     }
-    let summary = TrackingSummary::of(&out);
+    let mut summary = TrackingSummary::of(&out);
+    summary.ego_fallbacks = odometry
+        .as_ref()
+        .map_or(0, |o| o.fallbacks().values().sum());
     Ok(DriveTracks {
         drive: rec.name.clone(),
         seed,

@@ -158,6 +158,10 @@ pub struct TrackingSummary {
     pub cluster_labels: usize,
     /// Mean stage times per frame.
     pub mean_times: StageTimes,
+    /// Frames whose lidar odometry was not trusted and kept the constant-velocity pose
+    /// ([`crate::cloud::odometry::Fallback`]); 0 with recorded poses.
+    #[serde(default)]
+    pub ego_fallbacks: usize,
 }
 
 impl TrackingSummary {
@@ -187,6 +191,7 @@ impl TrackingSummary {
             plane_labels: planes.len(),
             cluster_labels: clusters.len(),
             mean_times: t,
+            ego_fallbacks: 0,
         }
     }
 }
