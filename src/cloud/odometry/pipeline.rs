@@ -473,38 +473,28 @@ mod tests {
 
     #[test]
     fn a_correction_beyond_the_bound_is_a_jump_that_keeps_the_prediction() {
-        // A 0.4 m motion from standstill is a correction of 0.4 m to the prediction; with
-        // the bound at 5 cm it is refused.
-        let mut odo = LidarOdometry::new(OdometryConfig {
-            voxel_size: 0.5,
-            max_correction: 0.05,
-            ..OdometryConfig::default()
-        })
-        .unwrap();
-        odo.register(&seen_from(&yard(0.1, 0), &Isometry3::identity()))
+        // A 0.4 m motion from standstill is a correction of 0.4 m to the prediction.
+        let second = |max_correction: f64| {
+            let mut odo = LidarOdometry::new(OdometryConfig {
+                voxel_size: 0.5,
+                max_correction,
+                ..OdometryConfig::default()
+            })
             .unwrap();
-        let r = odo
-            .register(&seen_from(
+            odo.register(&seen_from(&yard(0.1, 0), &Isometry3::identity()))
+                .unwrap();
+            odo.register(&seen_from(
                 &yard(0.1, 1),
                 &Isometry3::translation(0.4, 0.0, 0.0),
             ))
-            .unwrap();
+            .unwrap()
+        };
+        // With the bound at 5 cm it is refused and the prediction kept …
+        let r = second(0.05);
         assert_eq!(r.fallback, Some(Fallback::Jump), "{r:?}");
         assert_eq!(r.pose, Isometry3::identity());
-        // With the default bound the same motion is taken.
-        let mut odo = LidarOdometry::new(OdometryConfig {
-            voxel_size: 0.5,
-            ..OdometryConfig::default()
-        })
-        .unwrap();
-        odo.register(&seen_from(&yard(0.1, 0), &Isometry3::identity()))
-            .unwrap();
-        let r = odo
-            .register(&seen_from(
-                &yard(0.1, 1),
-                &Isometry3::translation(0.4, 0.0, 0.0),
-            ))
-            .unwrap();
+        // … with the default bound it is taken.
+        let r = second(OdometryConfig::default().max_correction);
         assert_eq!(r.fallback, None);
         assert!((r.pose.translation.vector.x - 0.4).abs() < 0.01, "{r:?}");
     }
