@@ -1,6 +1,7 @@
-//! `floor` to an integer without the libm call that `f64::floor` costs on the baseline x86-64
+//! `floor` to an integer without the libm call that `floor` costs on the baseline x86-64
 //! target (no SSE4.1 rounding instruction), for the grid and voxel keys of point loops. The
-//! results are those of `v.floor() as i32` / `as i64`, bit for bit: saturating, NaN to 0.
+//! results are those of `v.floor() as i32` / `as i64` (f64 and f32), bit for bit: saturating,
+//! NaN to 0.
 //!
 //! Not for: floors that stay floating point.
 
@@ -10,6 +11,13 @@
 pub(crate) fn floor_i32(v: f64) -> i32 {
     let t = v as i32;
     t.saturating_sub((v < t as f64) as i32)
+}
+
+/// `v.floor() as i32` for an `f32` (see [`floor_i32`]).
+#[inline]
+pub(crate) fn floor_f32_i32(v: f32) -> i32 {
+    let t = v as i32;
+    t.saturating_sub((v < t as f32) as i32)
 }
 
 /// `v.floor() as i64` (see [`floor_i32`]). Beyond 2⁵³ every f64 is an integer, so the
@@ -56,6 +64,8 @@ mod tests {
         {
             assert_eq!(floor_i32(v), v.floor() as i32, "{v}");
             assert_eq!(floor_i64(v), v.floor() as i64, "{v}");
+            let w = v as f32;
+            assert_eq!(floor_f32_i32(w), w.floor() as i32, "{w}");
         }
     }
 
@@ -64,6 +74,11 @@ mod tests {
         fn any_value_matches_floor(v in prop::num::f64::ANY) {
             prop_assert_eq!(floor_i32(v), v.floor() as i32);
             prop_assert_eq!(floor_i64(v), v.floor() as i64);
+        }
+
+        #[test]
+        fn any_f32_matches_floor(v in prop::num::f32::ANY) {
+            prop_assert_eq!(floor_f32_i32(v), v.floor() as i32);
         }
 
         #[test]

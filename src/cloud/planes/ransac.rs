@@ -6,6 +6,7 @@
 
 use super::PlaneConfig;
 use crate::geometry::Plane;
+use crate::numerics::floor::floor_f32_i32;
 use crate::rng::FilterRng;
 use nalgebra::{Matrix3, Point3, Vector3};
 use rand::RngExt;
@@ -173,9 +174,9 @@ impl SampleCells {
         let mut cell_of: Vec<u32> = Vec::with_capacity(m);
         for p in sample {
             let key = [
-                floor_i32(p[0] * inv),
-                floor_i32(p[1] * inv),
-                floor_i32(p[2] * inv),
+                floor_f32_i32(p[0] * inv),
+                floor_f32_i32(p[1] * inv),
+                floor_f32_i32(p[2] * inv),
             ];
             let mut slot = cell_hash(key) as usize & mask;
             let id = loop {
@@ -227,13 +228,6 @@ fn cell_hash(key: [i32; 3]) -> u64 {
     let packed =
         (key[0] as u32 as u64) ^ ((key[1] as u32 as u64) << 21) ^ ((key[2] as u32 as u64) << 42);
     crate::rng::mix64(packed)
-}
-
-/// `v.floor() as i32` (saturating) without a libm call.
-#[inline]
-fn floor_i32(v: f32) -> i32 {
-    let t = v as i32;
-    t.saturating_sub((v < t as f32) as i32)
 }
 
 /// Points as three contiguous coordinate columns, for vectorised residual counts.
