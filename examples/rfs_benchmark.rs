@@ -203,7 +203,8 @@ fn print_breakdown(runs: &[RunResult], cutoff: f64) {
         "  steps with an object in its first 5 steps: {:.0} % of steps, OSPA {:.2} m there, {:.2} m elsewhere",
         100.0 * young_steps / steps,
         sum(|b| b.ospa_young) / young_steps.max(1.0),
-        (sum(runs_ospa_total) - sum(|b| b.ospa_young)) / (steps - young_steps).max(1.0)
+        (runs.iter().flat_map(|r| &r.ospa).sum::<f64>() - sum(|b| b.ospa_young))
+            / (steps - young_steps).max(1.0)
     );
     println!(
         "  objects first found within c/2 = {:.0} m after {:.2} steps on average (median {:.1}); never found: {never}",
@@ -211,11 +212,6 @@ fn print_breakdown(runs: &[RunResult], cutoff: f64) {
         mean(&delays),
         median(&delays)
     );
-}
-
-/// Sum of the step OSPAs of a run (the parts add up to it for p = 1).
-fn runs_ospa_total(b: &Breakdown) -> f64 {
-    b.ospa_localisation + b.ospa_cardinality
 }
 
 fn mean(v: &[f64]) -> f64 {
