@@ -111,12 +111,9 @@ fn normal_equations(
             let mut jtr = Vector6::zeros();
             let mut n = 0usize;
             for p in chunk {
-                let Some((q, d2)) = map.closest(p) else {
+                let Some((q, d2)) = map.closest_within(p, max2) else {
                     continue;
                 };
-                if d2 >= max2 {
-                    continue;
-                }
                 let r = p - q;
                 let w = k * k / ((k + d2) * (k + d2));
                 // J = [I, −p^]: rows are the three residual components.
