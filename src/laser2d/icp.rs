@@ -3,7 +3,7 @@
 //! step 2) to correct the odometry between two scans.
 //!
 //! Each iteration moves the source by the current estimate, pairs every moved point with its
-//! nearest target point (a kiddo k-d tree over the target), drops pairs farther apart than
+//! nearest target point (an exact grid search, [`PlanarGrid`]), drops pairs farther apart than
 //! [`IcpConfig::max_pair_distance`] and — in the second phase, which starts once the first
 //! has converged — also those farther than [`IcpConfig::residual_factor`] times the median
 //! pair distance (but never below [`IcpConfig::min_gate`]), and solves the least-squares rigid step in closed form: with the
@@ -17,10 +17,10 @@
 //! Not for: choosing which scans to match (the moving-object detector does that), global
 //! registration from a poor initial guess, or point-to-line refinement.
 
+use super::nearest::PlanarGrid;
 use crate::error::{Error, Result};
 use crate::geometry::pose2::{compose, transform_point};
 use crate::geometry::Pose2;
-use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
 /// ICP parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -104,14 +104,16 @@ pub struct IcpFit {
     pub rms: f64,
 }
 
-/// A reusable aligner: holds the target's k-d tree and scratch buffers, so that repeated
-/// alignments against one target allocate nothing but the tree.
+/// A reusable aligner: holds the target's search grid and scratch buffers, so that repeated
+/// alignments against one target allocate nothing but the grid.
 pub struct Icp {
     config: IcpConfig,
     target: Vec<[f64; 2]>,
-    tree: Option<ImmutableKdTree<f64, 2>>,
+    grid: Option<PlanarGrid>,
     pairs: Vec<(usize, usize, f64)>,
     distances: Vec<f64>,
+    /// Each source point's nearest target point in the last iteration, or `usize::MAX`.
+    hints: Vec<usize>,
 }
 
 impl std::fmt::Debug for Icp {
@@ -130,9 +132,10 @@ impl Icp {
         Ok(Icp {
             config,
             target: Vec::new(),
-            tree: None,
+            grid: None,
             pairs: Vec::new(),
             distances: Vec::new(),
+            hints: Vec::new(),
         })
     }
 
@@ -159,32 +162,24 @@ impl Icp {
         }
         self.target.clear();
         self.target.extend_from_slice(points);
-        self.tree = if points.is_empty() {
-            None
-        } else {
-            ImmutableKdTree::<f64, 2>::new_from_slice(points).ok()
-        };
+        // Cells of half the pairing distance: a pair is found within the first rings.
+        self.grid = PlanarGrid::new(points, 0.5 * self.config.max_pair_distance);
         Ok(())
     }
 
     /// Distance from `p` to the nearest target point, `None` without a target.
     pub fn nearest_target_distance(&self, p: [f64; 2]) -> Option<f64> {
-        let tree = self.tree.as_ref()?;
-        let nn = tree
-            .query(&p)
-            .nearest_one::<SquaredEuclidean<f64>>()
-            .execute();
-        Some(nn.distance.sqrt())
+        let grid = self.grid.as_ref()?;
+        grid.nearest(p, f64::INFINITY).map(|(_, d2)| d2.sqrt())
     }
 
     /// Aligns `source` to the current target starting from `initial`. Errors when the
     /// target is empty, a source point is not finite, or fewer than
     /// [`IcpConfig::min_pairs`] pairs survive the gates.
     pub fn align(&mut self, source: &[[f64; 2]], initial: Pose2) -> Result<IcpFit> {
-        let tree = self
-            .tree
-            .as_ref()
-            .ok_or_else(|| Error::invalid("ICP target", "empty"))?;
+        if self.grid.is_none() {
+            return Err(Error::invalid("ICP target", "empty"));
+        }
         if !initial.is_finite() {
             return Err(Error::invalid(
                 "ICP initial pose",
@@ -212,19 +207,23 @@ impl Icp {
             rms: f64::INFINITY,
         };
         let mut tight = false;
+        self.hints.clear();
+        self.hints.resize(source.len(), usize::MAX);
         for iteration in 1..=c.max_iterations {
             // Pair every moved source point with its nearest target point.
             self.pairs.clear();
             self.distances.clear();
             for (i, &p) in source.iter().enumerate() {
                 let q = transform_point(transform, p);
-                let nn = tree
-                    .query(&q)
-                    .nearest_one::<SquaredEuclidean<f64>>()
-                    .execute();
-                if nn.distance <= max_d2 {
-                    let d = nn.distance.sqrt();
-                    self.pairs.push((i, nn.item as usize, d));
+                // The last iteration's partner is a near bound: few cells are searched.
+                let found = match self.grid.as_mut() {
+                    Some(grid) => grid.nearest_from(q, max_d2, self.hints[i]),
+                    None => None,
+                };
+                self.hints[i] = found.map_or(usize::MAX, |(j, _)| j);
+                if let Some((j, d2)) = found {
+                    let d = d2.sqrt();
+                    self.pairs.push((i, j, d));
                     self.distances.push(d);
                 }
             }

@@ -39,6 +39,7 @@ pub mod legs;
 pub mod local_map;
 pub mod moving;
 pub mod moving_rule;
+pub mod nearest;
 pub mod person_groups;
 pub mod rosbag;
 pub mod scan;
