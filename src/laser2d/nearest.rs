@@ -150,13 +150,17 @@ impl PlanarGrid {
         let (nx, ny) = (self.nx as i64, self.ny as i64);
         // Rings beyond this one lie entirely outside the grid.
         let last = (ci.max(nx - 1 - ci).max(cj).max(ny - 1 - cj)).max(0);
-        let mut best: Option<(u32, f64)> = None;
-        let mut bound = max_d2;
+        let mut search = Search {
+            q,
+            exclude,
+            best: None,
+            bound: max_d2,
+        };
         let mut r = 0i64;
         while r <= last {
             if r >= 1 {
                 let lb = (r - 1) as f64 * s + edge;
-                if lb * lb > bound {
+                if lb * lb > search.bound {
                     break;
                 }
             }
@@ -165,20 +169,20 @@ impl PlanarGrid {
             for i in i0..=i1 {
                 let whole_column = i == ci - r || i == ci + r;
                 if whole_column {
-                    self.scan_cells(i, j0, j1, q, exclude, &mut best, &mut bound);
+                    self.scan_cells(i, j0, j1, &mut search);
                 } else {
                     // Only the ring's top and bottom cells of this column.
                     if cj - r >= 0 && cj - r < ny {
-                        self.scan_cells(i, cj - r, cj - r, q, exclude, &mut best, &mut bound);
+                        self.scan_cells(i, cj - r, cj - r, &mut search);
                     }
                     if r > 0 && cj + r >= 0 && cj + r < ny {
-                        self.scan_cells(i, cj + r, cj + r, q, exclude, &mut best, &mut bound);
+                        self.scan_cells(i, cj + r, cj + r, &mut search);
                     }
                 }
             }
             r += 1;
         }
-        best.map(|(k, d2)| (k as usize, d2))
+        search.best.map(|(k, d2)| (k as usize, d2))
     }
 
     /// [`nearest`](Self::nearest), starting from point `hint` (an index below
@@ -191,7 +195,8 @@ impl PlanarGrid {
             return self.nearest(q, max_d2);
         };
         let d2 = (h[0] - q[0]).powi(2) + (h[1] - q[1]).powi(2);
-        if !(d2 <= max_d2) || !(q[0].is_finite() && q[1].is_finite()) {
+        let usable = d2 <= max_d2 && q[0].is_finite() && q[1].is_finite();
+        if !usable {
             return self.nearest(q, max_d2);
         }
         if self.separation[hint].is_nan() {
@@ -203,8 +208,12 @@ impl PlanarGrid {
         if d2 < self.separation[hint] {
             return Some((hint, d2));
         }
-        let mut best = Some((hint as u32, d2));
-        let mut bound = d2;
+        let mut search = Search {
+            q,
+            exclude: u32::MAX,
+            best: Some((hint as u32, d2)),
+            bound: d2,
+        };
         // A hair wider than the hint's distance, so that rounding cannot drop a cell that
         // holds a tie.
         let reach = d2.sqrt() * (1.0 + 1e-9) + 1e-12;
@@ -221,44 +230,45 @@ impl PlanarGrid {
             cell(q[1] + reach, self.origin[1], self.ny).min(self.ny as i64 - 1),
         );
         for i in i0..=i1 {
-            self.scan_cells(i, j0, j1, q, u32::MAX, &mut best, &mut bound);
+            self.scan_cells(i, j0, j1, &mut search);
         }
-        best.map(|(k, d2)| (k as usize, d2))
+        search.best.map(|(k, d2)| (k as usize, d2))
     }
 
-    /// Offers the points of cells (i, j0..=j1) (one contiguous run) to `best`.
+    /// Offers the points of cells (i, j0..=j1) (one contiguous run) to the search.
     #[inline]
-    fn scan_cells(
-        &self,
-        i: i64,
-        j0: i64,
-        j1: i64,
-        q: [f64; 2],
-        exclude: u32,
-        best: &mut Option<(u32, f64)>,
-        bound: &mut f64,
-    ) {
+    fn scan_cells(&self, i: i64, j0: i64, j1: i64, search: &mut Search) {
         if j0 > j1 {
             return;
         }
         let base = i as usize * self.ny;
         let a = self.start[base + j0 as usize] as usize;
         let b = self.start[base + j1 as usize + 1] as usize;
+        let q = search.q;
         for (p, &k) in self.coords[a..b].iter().zip(&self.items[a..b]) {
             let (dx, dy) = (p[0] - q[0], p[1] - q[1]);
             let d2 = dx * dx + dy * dy;
-            if d2 <= *bound && k != exclude {
-                let better = match *best {
+            if d2 <= search.bound && k != search.exclude {
+                let better = match search.best {
                     None => true,
                     Some((bk, bd)) => d2 < bd || (d2 == bd && k < bk),
                 };
                 if better {
-                    *best = Some((k, d2));
-                    *bound = d2;
+                    search.best = Some((k, d2));
+                    search.bound = d2;
                 }
             }
         }
     }
+}
+
+/// One query's state: the best point so far and the squared distance a point must not exceed.
+struct Search {
+    q: [f64; 2],
+    /// A point index never returned (`u32::MAX`: none).
+    exclude: u32,
+    best: Option<(u32, f64)>,
+    bound: f64,
 }
 
 #[cfg(test)]

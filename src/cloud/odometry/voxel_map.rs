@@ -213,20 +213,19 @@ impl VoxelHashMap {
             scan(&mut best, cell, OWN);
         }
         let mut rank = 0;
-        for dx in 0..3 {
-            for dy in 0..3 {
-                for dz in 0..3 {
+        for (ox, gx) in (-1..=1).zip(gx) {
+            for (oy, gy) in (-1..=1).zip(gy) {
+                for (oz, gz) in (-1..=1).zip(gz) {
                     let here = rank;
                     rank += 1;
                     if here == OWN {
                         continue;
                     }
-                    let gap = gx[dx] + gy[dy] + gz[dz];
+                    let gap = gx + gy + gz;
                     if gap >= max2 || best.is_some_and(|(_, b, _)| gap > b) {
                         continue;
                     }
-                    let v = Voxel([x + dx as i32 - 1, y + dy as i32 - 1, z + dz as i32 - 1]);
-                    if let Some(cell) = self.map.get(&v) {
+                    if let Some(cell) = self.map.get(&Voxel([x + ox, y + oy, z + oz])) {
                         scan(&mut best, cell, here);
                     }
                 }
