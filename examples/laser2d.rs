@@ -607,6 +607,20 @@ mod recording {
             "visible people per scan: mean {mean_people:.2}, max {}",
             per_scan.iter().max().copied().unwrap_or(0)
         );
+        let fallbacks = run.pose_fallbacks();
+        if !fallbacks.is_empty() {
+            let parts: Vec<String> = fallbacks
+                .iter()
+                .map(|(why, n)| format!("{n} for {}", why.describe()))
+                .collect();
+            eprintln!(
+                "warning: the scan matching's pose was not used on {} of {} scans ({}); the \
+                 predicted pose stood",
+                fallbacks.values().sum::<usize>(),
+                run.scans.len(),
+                parts.join(", ")
+            );
+        }
         for (what, min) in [
             ("all", 1usize),
             ("at least 8 scans (1 s at 8 Hz)", 8),

@@ -102,6 +102,14 @@ pub struct IcpFit {
     pub inlier_fraction: f64,
     /// Root mean square distance of the kept pairs after the last step (m).
     pub rms: f64,
+    /// How well the last pairs pin the translation down in every direction: the smaller over
+    /// the larger eigenvalue of Σ n nᵀ, n the normal of each paired target point's line
+    /// ([`PlanarGrid::line_normal`]; pairs at corners and blobs add nothing). About 0 in a
+    /// corridor (every line parallel: sliding along it costs nothing), up to 1 in a room.
+    pub information_ratio: f64,
+    /// Share of the last pairs whose target point has a line normal: where it is small (a
+    /// sparse or cluttered map) `information_ratio` says little.
+    pub line_share: f64,
 }
 
 /// A reusable aligner: holds the target's search grid and scratch buffers, so that repeated
@@ -205,6 +213,8 @@ impl Icp {
             pairs: 0,
             inlier_fraction: 0.0,
             rms: f64::INFINITY,
+            information_ratio: 0.0,
+            line_share: 0.0,
         };
         let mut tight = false;
         self.hints.clear();
@@ -302,6 +312,8 @@ impl Icp {
                 pairs: self.pairs.len(),
                 inlier_fraction: self.pairs.len() as f64 / source.len() as f64,
                 rms,
+                information_ratio: 0.0,
+                line_share: 0.0,
             };
             if converged {
                 if tight {
@@ -311,7 +323,33 @@ impl Icp {
                 fit.converged = false;
             }
         }
+        (fit.information_ratio, fit.line_share) = self.information();
         Ok(fit)
+    }
+
+    /// [`IcpFit::information_ratio`] and [`IcpFit::line_share`] of the current pairs.
+    fn information(&mut self) -> (f64, f64) {
+        let Some(grid) = self.grid.as_mut() else {
+            return (0.0, 0.0);
+        };
+        let (mut a, mut b, mut c, mut lines) = (0.0, 0.0, 0.0, 0usize);
+        for &(_, j, _) in &self.pairs {
+            if let Some([nx, ny]) = grid.line_normal(j) {
+                a += nx * nx;
+                b += nx * ny;
+                c += ny * ny;
+                lines += 1;
+            }
+        }
+        let share = lines as f64 / self.pairs.len().max(1) as f64;
+        let mean = 0.5 * (a + c);
+        let root = (0.25 * (a - c) * (a - c) + b * b).sqrt();
+        let ratio = if mean + root > 0.0 {
+            ((mean - root) / (mean + root)).max(0.0)
+        } else {
+            0.0
+        };
+        (ratio, share)
     }
 }
 
@@ -407,6 +445,27 @@ mod tests {
         assert!((fit.transform.y + 0.15).abs() < 0.02, "{fit:?}");
         assert!((fit.transform.theta - 0.08).abs() < 0.005, "{fit:?}");
         assert!(fit.inlier_fraction < 0.95 && fit.inlier_fraction > 0.7);
+    }
+
+    #[test]
+    fn a_corridor_pins_down_one_direction_a_room_both() {
+        // Two parallel walls 2 m apart, 20 m long, against the L-shaped room.
+        let corridor: Vec<[f64; 2]> = (0..400)
+            .flat_map(|k| [[k as f64 * 0.05, 0.0], [k as f64 * 0.05, 2.0]])
+            .collect();
+        let source = moved(&corridor, Pose2::new(0.02, 0.01, 0.0));
+        let fit = align(&source, &corridor, identity(), &IcpConfig::default()).unwrap();
+        assert!(
+            fit.information_ratio < 1e-6 && fit.line_share > 0.99,
+            "{fit:?}"
+        );
+        let target = l_room(0.0, 0.01);
+        let source = moved(&l_room(0.003, 0.05), Pose2::new(0.02, 0.01, 0.01));
+        let fit = align(&source, &target, identity(), &IcpConfig::default()).unwrap();
+        assert!(
+            fit.information_ratio > 0.3 && fit.line_share > 0.8,
+            "{fit:?}"
+        );
     }
 
     #[test]

@@ -51,7 +51,7 @@ pub use self::carmen::{
 };
 pub use self::csv::{read_scan_csv, write_scan_csv};
 pub use self::moving::{
-    MovingCluster, MovingDetections, MovingDetectorConfig, MovingObjectDetector,
+    MovingCluster, MovingDetections, MovingDetectorConfig, MovingObjectDetector, PoseFallback,
 };
 pub use self::person_groups::{person_groups, PersonGroup, PersonGrouping};
 pub use self::rosbag::{

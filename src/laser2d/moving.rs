@@ -17,8 +17,10 @@
 //!    [`MovingDetectorConfig::min_icp_points`] returns are not matched.
 //!    The ICP result is used when it converged within the gates
 //!    [`MovingDetectorConfig::max_correction`] / [`MovingDetectorConfig::max_correction_angle`]
-//!    of the prediction with at least [`MovingDetectorConfig::min_inlier_fraction`] inliers;
-//!    otherwise the prediction stands.
+//!    of the prediction with at least [`MovingDetectorConfig::min_inlier_fraction`] inliers,
+//!    and its pairs pin the translation down in every direction (where the map is made of
+//!    lines: see [`MovingDetectorConfig::min_information_ratio`]); otherwise the prediction
+//!    stands and [`MovingDetections::fallback`] says why.
 //! 2. **Background** (Sec. II): the background map is carried along the corrected motion and
 //!    splits the beams; foreground returns are the candidates, unless they lie within
 //!    [`MovingDetectorConfig::static_map_radius`] of the local map (static surfaces seen
@@ -89,6 +91,15 @@ pub struct MovingDetectorConfig {
     /// ICP results with fewer inliers (fraction of the scan's returns) are rejected.
     /// Default 0.5.
     pub min_inlier_fraction: f64,
+    /// ICP results whose pairs leave a direction unconstrained are rejected: an
+    /// [`IcpFit::information_ratio`] below this (a corridor, where the fit can slide along
+    /// the walls) when at least [`MovingDetectorConfig::min_line_share`] of the pairs lie on
+    /// lines. Default 1e-3 (a corridor of straight walls scores below 1e-6, rooms and real
+    /// recordings' hallways 0.002–0.5).
+    pub min_information_ratio: f64,
+    /// The share of pairs on lines below which the map is too sparse or cluttered for the
+    /// information test, which is then skipped. Default 0.5.
+    pub min_line_share: f64,
     /// The background map.
     pub background: BackgroundConfig,
     /// Foreground returns closer than this to a cell of the local map (static returns seen
@@ -137,6 +148,8 @@ impl Default for MovingDetectorConfig {
             max_correction: 0.3,
             max_correction_angle: 0.05,
             min_inlier_fraction: 0.5,
+            min_information_ratio: 1e-3,
+            min_line_share: 0.5,
             background: BackgroundConfig::default(),
             static_map_radius: 0.3,
             cluster_gap: 0.6,
@@ -203,11 +216,17 @@ impl MovingDetectorConfig {
             "MovingDetectorConfig::static_map_radius",
             self.static_map_radius,
         )?;
-        if !(0.0..=1.0).contains(&self.min_inlier_fraction) {
-            return Err(Error::invalid(
-                "MovingDetectorConfig::min_inlier_fraction",
-                format!("{} (must lie in [0, 1])", self.min_inlier_fraction),
-            ));
+        for (name, v) in [
+            ("min_inlier_fraction", self.min_inlier_fraction),
+            ("min_information_ratio", self.min_information_ratio),
+            ("min_line_share", self.min_line_share),
+        ] {
+            if !(0.0..=1.0).contains(&v) {
+                return Err(Error::invalid(
+                    format!("MovingDetectorConfig::{name}"),
+                    format!("{v} (must lie in [0, 1])"),
+                ));
+            }
         }
         if self.cluster_window == 0 || self.min_cluster_points == 0 || self.forget_every == 0 {
             return Err(Error::invalid(
@@ -258,6 +277,9 @@ pub struct MovingDetections {
     pub sensor_pose: Pose2,
     /// The ICP fit, when ICP ran and its result was used.
     pub icp: Option<IcpFit>,
+    /// Why the predicted pose was kept instead of an ICP result (never on the first scan,
+    /// which defines the map).
+    pub fallback: Option<PoseFallback>,
     /// The moving targets.
     pub clusters: Vec<MovingCluster>,
     /// Clusters that passed the size and local-minimum filters (moving or not).
@@ -270,6 +292,53 @@ pub struct MovingDetections {
     pub candidates: Vec<usize>,
     /// Every cluster of candidates, in order of its first beam, with its stage.
     pub all_clusters: Vec<ClusterReport>,
+}
+
+/// Why a scan kept the predicted pose (odometry, or constant velocity without it) instead
+/// of the scan matching's.
+#[derive(
+    Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize, serde::Deserialize,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum PoseFallback {
+    /// Fewer returns than [`MovingDetectorConfig::min_icp_points`].
+    TooFewPoints,
+    /// Too few returns found a map point within reach ([`IcpConfig::min_pairs`]).
+    TooFewPairs,
+    /// ICP did not converge within its iterations.
+    NotConverged,
+    /// The result lies beyond [`MovingDetectorConfig::max_correction`] or
+    /// [`MovingDetectorConfig::max_correction_angle`] of the prediction.
+    Jump,
+    /// Fewer inliers than [`MovingDetectorConfig::min_inlier_fraction`].
+    FewInliers,
+    /// The pairs leave a direction unconstrained
+    /// ([`MovingDetectorConfig::min_information_ratio`]).
+    Degenerate,
+}
+
+impl PoseFallback {
+    /// Every reason, in order.
+    pub const ALL: [PoseFallback; 6] = [
+        PoseFallback::TooFewPoints,
+        PoseFallback::TooFewPairs,
+        PoseFallback::NotConverged,
+        PoseFallback::Jump,
+        PoseFallback::FewInliers,
+        PoseFallback::Degenerate,
+    ];
+
+    /// A short description for warnings.
+    pub fn describe(self) -> &'static str {
+        match self {
+            PoseFallback::TooFewPoints => "too few returns",
+            PoseFallback::TooFewPairs => "too few returns near the map",
+            PoseFallback::NotConverged => "no convergence",
+            PoseFallback::Jump => "a jump beyond the gates",
+            PoseFallback::FewInliers => "too few inliers",
+            PoseFallback::Degenerate => "a direction left unconstrained (corridor)",
+        }
+    }
 }
 
 /// A kept cluster before the voting decides (internal).
@@ -359,17 +428,17 @@ impl MovingObjectDetector {
             }
         }
         // 1. Pose.
-        let (sensor_pose, icp_fit, dt) = match self.previous {
-            None => (sensor_odometry, None, 0.0),
+        let (sensor_pose, icp_fit, fallback, dt) = match self.previous {
+            None => (sensor_odometry, None, None, 0.0),
             Some((prev_odometry, prev_corrected, prev_time)) => {
                 let predicted = compose(prev_corrected, between(prev_odometry, sensor_odometry));
                 let (pose, fit) = if self.points.len() >= self.config.min_icp_points {
                     self.correct(predicted)
                 } else {
-                    (predicted, None)
+                    (predicted, Err(PoseFallback::TooFewPoints))
                 };
                 self.background.propagate(between(prev_corrected, pose))?;
-                (pose, fit, scan.time - prev_time)
+                (pose, fit.ok(), fit.err(), scan.time - prev_time)
             }
         };
         // 2. Background.
@@ -492,6 +561,7 @@ impl MovingObjectDetector {
             pose: compose(sensor_pose, inverse(mount)),
             sensor_pose,
             icp: icp_fit,
+            fallback,
             clusters: moving,
             kept_clusters,
             candidate_points: candidates.len(),
@@ -502,24 +572,29 @@ impl MovingObjectDetector {
     }
 
     /// ICP of the scan's returns against the local map from the predicted pose; the
-    /// corrected pose and the fit when it passed the gates, else the prediction.
-    fn correct(&mut self, predicted: Pose2) -> (Pose2, Option<IcpFit>) {
-        let initial = predicted;
+    /// corrected pose and the fit when it passed the gates, else the prediction and why.
+    fn correct(&mut self, predicted: Pose2) -> (Pose2, std::result::Result<IcpFit, PoseFallback>) {
         let c = self.config;
-        match self.icp.align(&self.points, initial) {
-            Ok(fit) => {
-                let d = between(initial, fit.transform);
-                let ok = fit.converged
-                    && d.x.hypot(d.y) <= c.max_correction
-                    && d.theta.abs() <= c.max_correction_angle
-                    && fit.inlier_fraction >= c.min_inlier_fraction;
-                if ok {
-                    (fit.transform, Some(fit))
-                } else {
-                    (predicted, None)
-                }
-            }
-            Err(_) => (predicted, None),
+        let Ok(fit) = self.icp.align(&self.points, predicted) else {
+            return (predicted, Err(PoseFallback::TooFewPairs));
+        };
+        let d = between(predicted, fit.transform);
+        let verdict = if !fit.converged {
+            Err(PoseFallback::NotConverged)
+        } else if d.x.hypot(d.y) > c.max_correction || d.theta.abs() > c.max_correction_angle {
+            Err(PoseFallback::Jump)
+        } else if fit.inlier_fraction < c.min_inlier_fraction {
+            Err(PoseFallback::FewInliers)
+        } else if fit.line_share >= c.min_line_share
+            && fit.information_ratio < c.min_information_ratio
+        {
+            Err(PoseFallback::Degenerate)
+        } else {
+            Ok(fit)
+        };
+        match verdict {
+            Ok(fit) => (fit.transform, Ok(fit)),
+            Err(why) => (predicted, Err(why)),
         }
     }
 
@@ -750,6 +825,54 @@ mod tests {
             assert!(d.pose.theta.abs() < 3e-3, "{:?}", d.pose);
             assert!(d.clusters.is_empty());
         }
+    }
+
+    /// An endless corridor 3 m wide along x, seen from its axis: two parallel walls.
+    fn corridor_scan(t: f64) -> Scan {
+        let n = 361;
+        let inc = std::f64::consts::PI / 360.0;
+        let ranges: Vec<f32> = (0..n)
+            .map(|i| {
+                let phi = -std::f64::consts::FRAC_PI_2 + i as f64 * inc;
+                let s = phi.sin().abs();
+                (if s > 1e-9 { 1.5 / s } else { f64::INFINITY }) as f32
+            })
+            .collect();
+        Scan::new(t, -std::f64::consts::FRAC_PI_2, inc, ranges, 0.0, 30.0).unwrap()
+    }
+
+    #[test]
+    fn a_corridor_keeps_the_odometry_and_says_why() {
+        let mut det = MovingObjectDetector::new(MovingDetectorConfig::default()).unwrap();
+        // The robot drives 5 cm a scan along the corridor; every scan looks the same, so
+        // only the odometry knows how far it went.
+        for k in 0..10 {
+            let odo = Pose2::new(0.05 * k as f64, 0.0, 0.0);
+            let d = det.process(&corridor_scan(k as f64 * 0.1), odo).unwrap();
+            if k == 0 {
+                assert_eq!(d.fallback, None);
+                continue;
+            }
+            assert_eq!(d.fallback, Some(PoseFallback::Degenerate), "scan {k}");
+            assert!(d.icp.is_none());
+            assert!((d.pose.x - odo.x).abs() < 1e-12, "{:?}", d.pose);
+        }
+        // In the room, ICP is trusted: no fallback after the first scan.
+        let mut det = MovingObjectDetector::new(MovingDetectorConfig::default()).unwrap();
+        for k in 0..5 {
+            let d = det
+                .process(&room_scan(k as f64 * 0.1, None), Pose2::new(0.0, 0.0, 0.0))
+                .unwrap();
+            assert_eq!(d.fallback, None, "scan {k}");
+            assert_eq!(d.icp.is_some(), k > 0);
+        }
+        // Too few returns: the prediction, and the reason.
+        let mut sparse = room_scan(0.5, None);
+        for r in sparse.ranges.iter_mut().skip(40) {
+            *r = f32::INFINITY;
+        }
+        let d = det.process(&sparse, Pose2::new(0.0, 0.0, 0.0)).unwrap();
+        assert_eq!(d.fallback, Some(PoseFallback::TooFewPoints));
     }
 
     #[test]

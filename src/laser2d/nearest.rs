@@ -34,6 +34,9 @@ pub struct PlanarGrid {
     /// Per point, a quarter of the squared distance to its nearest other point; NaN until a
     /// hint needs it.
     separation: Vec<f64>,
+    /// Per point, the normal of the line through it and its neighbours (see
+    /// [`PlanarGrid::line_normal`]), once asked for.
+    normals: Vec<Option<Option<[f64; 2]>>>,
 }
 
 /// At most this many cells per point (plus a few): a sparse, wide point set gets larger
@@ -85,6 +88,7 @@ impl PlanarGrid {
             coords: vec![[0.0; 2]; points.len()],
             points: points.to_vec(),
             separation: vec![f64::NAN; points.len()],
+            normals: vec![None; points.len()],
         };
         let cell_of = |p: &[f64; 2]| -> usize {
             let i = (((p[0] - lo[0]) / cell) as usize).min(nx - 1);
@@ -235,6 +239,67 @@ impl PlanarGrid {
         search.best.map(|(k, d2)| (k as usize, d2))
     }
 
+    /// The unit normal of the line through point `j` and the points within one cell side of
+    /// it (the principal axis of their scatter), or `None` when fewer than three points lie
+    /// there, their spread across the line is more than a fifth of their spread along it (a
+    /// corner, a blob), or `j` is out of range. Computed once per point.
+    pub fn line_normal(&mut self, j: usize) -> Option<[f64; 2]> {
+        if let Some(n) = *self.normals.get(j)? {
+            return n;
+        }
+        let n = self.fit_line_normal(self.points[j]);
+        self.normals[j] = Some(n);
+        n
+    }
+
+    fn fit_line_normal(&self, c: [f64; 2]) -> Option<[f64; 2]> {
+        let s = self.cell;
+        let r2 = s * s;
+        let cell =
+            |v: f64, o: f64, n: usize| -> i64 { floor_i64((v - o) / s).clamp(0, n as i64 - 1) };
+        let (i0, i1) = (
+            cell(c[0] - s, self.origin[0], self.nx),
+            cell(c[0] + s, self.origin[0], self.nx),
+        );
+        let (j0, j1) = (
+            cell(c[1] - s, self.origin[1], self.ny),
+            cell(c[1] + s, self.origin[1], self.ny),
+        );
+        // Moments about c (shifted sums keep the scatter exact at any coordinate size).
+        let (mut n, mut sx, mut sy, mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+        for i in i0..=i1 {
+            let base = i as usize * self.ny;
+            let a = self.start[base + j0 as usize] as usize;
+            let b = self.start[base + j1 as usize + 1] as usize;
+            for p in &self.coords[a..b] {
+                let (x, y) = (p[0] - c[0], p[1] - c[1]);
+                if x * x + y * y <= r2 {
+                    n += 1.0;
+                    sx += x;
+                    sy += y;
+                    sxx += x * x;
+                    sxy += x * y;
+                    syy += y * y;
+                }
+            }
+        }
+        if n < 3.0 {
+            return None;
+        }
+        let (mx, my) = (sx / n, sy / n);
+        let (cxx, cxy, cyy) = (sxx / n - mx * mx, sxy / n - mx * my, syy / n - my * my);
+        // Eigenvalues of the scatter: mean ± root.
+        let mean = 0.5 * (cxx + cyy);
+        let root = (0.25 * (cxx - cyy) * (cxx - cyy) + cxy * cxy).sqrt();
+        let (small, large) = (mean - root, mean + root);
+        if large.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || small > 0.04 * large {
+            return None;
+        }
+        // The line runs along the large eigenvalue's eigenvector; the normal is across it.
+        let (sin, cos) = (0.5 * (2.0 * cxy).atan2(cxx - cyy)).sin_cos();
+        Some([-sin, cos])
+    }
+
     /// Offers the points of cells (i, j0..=j1) (one contiguous run) to the search.
     #[inline]
     fn scan_cells(&self, i: i64, j0: i64, j1: i64, search: &mut Search) {
@@ -311,6 +376,28 @@ mod tests {
             g.nearest([990.0, 999.0], f64::INFINITY).map(|x| x.0),
             Some(1)
         );
+    }
+
+    #[test]
+    fn normals_of_a_wall_a_corner_and_a_lone_point() {
+        // A wall along y = 0.5 x (every 5 cm), a lone point far off.
+        let mut pts: Vec<[f64; 2]> = (0..40)
+            .map(|k| [k as f64 * 0.05, k as f64 * 0.025])
+            .collect();
+        pts.push([10.0, -10.0]);
+        // An L corner at (20, 0): both legs within the cell.
+        for k in 0..10 {
+            pts.push([20.0 + k as f64 * 0.05, 0.0]);
+            pts.push([20.0, k as f64 * 0.05]);
+        }
+        let mut g = PlanarGrid::new(&pts, 0.5).unwrap();
+        let n = g.line_normal(20).unwrap();
+        // Across (1, 0.5): ±(−0.5, 1)/√1.25.
+        let dot = (n[0] * -0.5 + n[1]) / 1.25f64.sqrt();
+        assert!((dot.abs() - 1.0).abs() < 1e-9, "{n:?}");
+        assert_eq!(g.line_normal(40), None);
+        assert_eq!(g.line_normal(41), None);
+        assert_eq!(g.line_normal(1000), None);
     }
 
     proptest! {

@@ -506,6 +506,7 @@ mod tests {
                     person(Label::new(1, 0), 2.0, false, 1.0),
                 ],
                 detections: Vec::new(),
+                pose_fallback: None,
             });
         }
         let track = |label, scans, dynamic_fraction| PersonTrack {

@@ -20,7 +20,7 @@ use crate::filter::Label;
 use crate::geometry::platform_isometry;
 use crate::geometry::Pose2;
 use crate::laser2d::legs::LegModel;
-use crate::laser2d::Scan;
+use crate::laser2d::{PoseFallback, Scan};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -41,6 +41,10 @@ pub struct ScanPeople {
     /// was handed).
     #[serde(default)]
     pub detections: Vec<[f64; 2]>,
+    /// With the moving front end: why the scan matching's pose was not used, if it was not
+    /// (the prediction, from odometry or constant velocity, stood instead).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pose_fallback: Option<PoseFallback>,
 }
 
 /// One track over the recording, counted over the scans in which it was reported as visible
@@ -73,6 +77,16 @@ pub struct PeopleRun {
 }
 
 impl PeopleRun {
+    /// How many scans kept the predicted pose, by reason (reasons that never occurred are
+    /// left out).
+    pub fn pose_fallbacks(&self) -> BTreeMap<PoseFallback, usize> {
+        let mut out = BTreeMap::new();
+        for why in self.scans.iter().filter_map(|s| s.pose_fallback) {
+            *out.entry(why).or_insert(0) += 1;
+        }
+        out
+    }
+
     /// Tracks visible in at least `min_scans` scans.
     pub fn tracks_with(&self, min_scans: usize) -> impl Iterator<Item = &PersonTrack> {
         self.tracks.iter().filter(move |t| t.scans >= min_scans)
@@ -166,6 +180,7 @@ pub fn track_scans_with_model(
             pose: pose.map(|p: Pose2| [p.x, p.y, p.theta]),
             people,
             detections,
+            pose_fallback: out.detections.as_ref().and_then(|d| d.fallback),
         });
     }
     run.tracks = summarise(&run.scans, min_visibility);
@@ -241,6 +256,7 @@ mod tests {
                 pose: None,
                 people: vec![person(0.0, 0.9, false)],
                 detections: Vec::new(),
+                pose_fallback: None,
             },
             ScanPeople {
                 scan: 1,
@@ -248,6 +264,7 @@ mod tests {
                 pose: None,
                 people: vec![person(0.5, 0.1, true)],
                 detections: Vec::new(),
+                pose_fallback: None,
             },
             ScanPeople {
                 scan: 2,
@@ -255,6 +272,7 @@ mod tests {
                 pose: None,
                 people: vec![person(1.0, 0.8, true)],
                 detections: Vec::new(),
+                pose_fallback: None,
             },
         ];
         let t = summarise(&scans, 0.5);
