@@ -159,6 +159,18 @@ pub fn track_scans_with_model(
         fe.set_leg_model(model)?;
     }
     let mut tracker = PeopleTracker::new(config)?;
+    // The whole loop runs on one of rayon's threads: the filter's parallel steps are small
+    // (a few tracks per scan), and entered from outside the pool each would hand its work
+    // to the pool and wait for it, a thread wake-up per step.
+    rayon::scope(|_| track_all(scans, &mut fe, &mut tracker, min_visibility))
+}
+
+fn track_all(
+    scans: &[Scan],
+    fe: &mut PersonFrontEnd,
+    tracker: &mut PeopleTracker,
+    min_visibility: f64,
+) -> Result<PeopleRun> {
     let mut run = PeopleRun::default();
     for (i, scan) in scans.iter().enumerate() {
         let at = |e: Error| Error::invalid(format!("scan {i} (time {})", scan.time), e.to_string());
