@@ -117,6 +117,17 @@ pub fn detect_objects(
     config: &TrackingConfig,
     rng: &mut FilterRng,
 ) -> Result<FrameDetections> {
+    // The whole detection runs on one of rayon's threads: entered from outside the pool,
+    // each of its many small parallel parts would hand its work to the pool and wait for it
+    // (a thread wake-up each time); from inside, they start at once.
+    rayon::scope(|_| detect_here(cloud, config, rng))
+}
+
+fn detect_here(
+    cloud: &PointCloud,
+    config: &TrackingConfig,
+    rng: &mut FilterRng,
+) -> Result<FrameDetections> {
     let start = Instant::now();
     let seg = extract_planes(cloud, &config.planes, rng)?;
     let planes_ms = start.elapsed().as_secs_f64() * 1e3;

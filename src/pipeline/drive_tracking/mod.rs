@@ -633,11 +633,7 @@ fn track_recording(
         let start = Instant::now();
         let cloud = (rec.read)(k)?;
         let read_ms = start.elapsed().as_secs_f64() * 1e3;
-        // Detection and the filter step each run on one of rayon's threads: their parallel
-        // parts then start without handing work to the pool and waiting, every time.
-        let detections = rayon::scope(|_| {
-            detect_objects(&cloud, config, &mut stream(seed, KEY_SEGMENT ^ k as u64))
-        })?;
+        let detections = detect_objects(&cloud, config, &mut stream(seed, KEY_SEGMENT ^ k as u64))?;
         let previous_state = vehicle
             .as_ref()
             .map(|v| v[if k > range.start { k - 1 } else { k }]);
@@ -658,9 +654,7 @@ fn track_recording(
             }
             (None, None) => unreachable!("odometry is set up when there are no poses"),
         };
-        let mut tracked = rayon::scope(|_| {
-            tracker.step(k, times[k], pose, previous_state, &detections)
-        })?;
+        let mut tracked = tracker.step(k, times[k], pose, previous_state, &detections)?;
         tracked.times.read_ms = read_ms;
         tracked.times.ego_ms = ego_ms;
         on_frame(&FrameView {

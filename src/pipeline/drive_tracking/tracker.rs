@@ -159,6 +159,18 @@ impl DriveTracker {
         vehicle_state: Option<[f64; 6]>,
         detections: &FrameDetections,
     ) -> Result<TrackedFrame> {
+        // On one of rayon's threads (see `detect_objects`).
+        rayon::scope(|_| self.step_here(frame, time, pose, vehicle_state, detections))
+    }
+
+    fn step_here(
+        &mut self,
+        frame: usize,
+        time: f64,
+        pose: Isometry3<f64>,
+        vehicle_state: Option<[f64; 6]>,
+        detections: &FrameDetections,
+    ) -> Result<TrackedFrame> {
         let start = Instant::now();
         if let (Some(h), Some(s)) = (&self.vehicle, vehicle_state) {
             h.set(s);
