@@ -105,6 +105,12 @@ impl LidarOdometry {
     ///
     /// Errors: the scan has no finite point between `min_range` and `max_range`.
     pub fn register(&mut self, cloud: &PointCloud) -> Result<Registered> {
+        // On one of rayon's threads: each ICP iteration's parallel pass then starts without
+        // handing its work to the pool and waiting for it.
+        rayon::scope(|_| self.register_here(cloud))
+    }
+
+    fn register_here(&mut self, cloud: &PointCloud) -> Result<Registered> {
         let c = &self.config;
         // Preprocess: range crop (Sec. III-A; no deskewing, see the type's docs).
         let frame = crop_range(cloud, c.min_range, c.max_range);
