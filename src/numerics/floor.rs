@@ -8,6 +8,7 @@
 /// `v.floor() as i32`: truncate towards zero, then step down when that rounded a negative
 /// value up.
 #[inline]
+#[cfg_attr(not(feature = "kitti"), allow(dead_code))] // voxel keys of the point clouds
 pub(crate) fn floor_i32(v: f64) -> i32 {
     let t = v as i32;
     t.saturating_sub((v < t as f64) as i32)
@@ -15,6 +16,7 @@ pub(crate) fn floor_i32(v: f64) -> i32 {
 
 /// `v.floor() as i32` for an `f32` (see [`floor_i32`]).
 #[inline]
+#[cfg_attr(not(feature = "kitti"), allow(dead_code))] // the plane RANSAC's cells
 pub(crate) fn floor_f32_i32(v: f32) -> i32 {
     let t = v as i32;
     t.saturating_sub((v < t as f32) as i32)
@@ -23,6 +25,7 @@ pub(crate) fn floor_f32_i32(v: f32) -> i32 {
 /// `v.floor() as i64` (see [`floor_i32`]). Beyond 2⁵³ every f64 is an integer, so the
 /// truncation is exact wherever `t as f64` rounds.
 #[inline]
+#[cfg_attr(not(any(feature = "kitti", feature = "laser2d")), allow(dead_code))]
 pub(crate) fn floor_i64(v: f64) -> i64 {
     let t = v as i64;
     t.saturating_sub((v < t as f64) as i64)
