@@ -13,6 +13,10 @@
 //!   towards the direction of travel once the track moves.
 //! * A confirmed cluster is a road user unless its class is `Other` and it moves slower than
 //!   [`STATIC_SPEED`]; parked cars are road users.
+//! * Two road users cannot stand in one place: a road user whose footprint lies mostly
+//!   ([`CONTAINED`]) inside the footprint of a more certain one (higher existence, then the
+//!   larger footprint) is a fragment of it — a pedestrian-sized piece of a van, say — and is
+//!   not reported ([`contained_in_others`]).
 //!
 //! Not for: clustering (see [`super::detect`]) or the filter (see [`super::tracker`]).
 
@@ -23,11 +27,45 @@ use crate::cloud::classes::{
 };
 use crate::cloud::PointCloud;
 use crate::error::Result;
+use crate::geometry::box3::bev_intersection_area;
 use crate::geometry::{wrap_angle, Box3};
 use std::f64::consts::PI;
 
 /// Slower than this (m/s) a track of class `Other` is static clutter, not a road user.
 pub const STATIC_SPEED: f64 = 1.0;
+
+/// A footprint whose area lies at least this much inside another's is contained in it.
+pub const CONTAINED: f64 = 0.5;
+
+/// For each box (with its track's existence), whether it is contained in the footprint of a
+/// box that ranks before it and is itself not contained: ranks go by existence, then by
+/// footprint area, then by position, largest first. Greedy, like a non-maximum suppression
+/// whose overlap is the intersection over the smaller footprint.
+pub fn contained_in_others(boxes: &[(Box3, f64)]) -> Vec<bool> {
+    let mut order: Vec<usize> = (0..boxes.len()).collect();
+    order.sort_by(|&a, &b| {
+        let (ba, ea) = &boxes[a];
+        let (bb, eb) = &boxes[b];
+        eb.total_cmp(ea)
+            .then(bb.bev_area().total_cmp(&ba.bev_area()))
+            .then(a.cmp(&b))
+    });
+    let mut contained = vec![false; boxes.len()];
+    let mut kept: Vec<usize> = Vec::new();
+    for i in order {
+        let b = &boxes[i].0;
+        let inside = kept.iter().any(|&k| {
+            let smaller = b.bev_area().min(boxes[k].0.bev_area());
+            smaller > 0.0 && bev_intersection_area(b, &boxes[k].0) >= CONTAINED * smaller
+        });
+        if inside {
+            contained[i] = true;
+        } else {
+            kept.push(i);
+        }
+    }
+    contained
+}
 
 /// Weight of a new detection's box size in a track's running size.
 const SIZE_GAIN: f64 = 0.3;
@@ -178,6 +216,34 @@ impl RoadUserState {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_fragment_inside_a_van_is_dropped_and_neighbours_are_kept() {
+        use super::contained_in_others;
+        let b = |x: f64, y: f64, l: f64, w: f64, yaw: f64| {
+            Box3::new(Point3::new(x, y, 0.9), [l, w, 1.8], yaw)
+        };
+        let boxes = [
+            // A van, a pedestrian-sized piece inside it (equally certain: the van is larger).
+            (b(10.0, 0.0, 4.4, 1.8, 0.0), 1.0),
+            (b(10.8, 0.3, 0.9, 0.6, 0.4), 1.0),
+            // A car parked 0.4 m behind the van, bumper to bumper: kept.
+            (b(14.6, 0.0, 3.9, 1.6, 0.0), 0.9),
+            // A less certain box half over that car (0.5 of the smaller area exactly).
+            (b(16.55, 0.0, 2.0, 1.6, 0.0), 0.5),
+            // A pedestrian beside the van's side: kept.
+            (b(10.0, 1.4, 0.8, 0.6, 0.0), 0.95),
+        ];
+        assert_eq!(
+            contained_in_others(&boxes),
+            vec![false, true, false, true, false]
+        );
+        // A more certain small box keeps its place; the large one is not "inside" it, but
+        // the small one's area is: the more certain one wins.
+        let swapped = [(boxes[0].0.clone(), 0.6), (boxes[1].0.clone(), 0.99)];
+        assert_eq!(contained_in_others(&swapped), vec![true, false]);
+        assert!(contained_in_others(&[]).is_empty());
+    }
+
     use super::*;
     use nalgebra::Point3;
 

@@ -13,7 +13,7 @@
 
 use super::detect::FrameDetections;
 use super::output::{OrientedBox, StageTimes, TrackedCluster, TrackedFrame, TrackedPlane};
-use super::road_users::RoadUserState;
+use super::road_users::{contained_in_others, RoadUserState};
 use super::{EgoModel, TrackingConfig};
 use crate::cloud::classes::ClassModel;
 use crate::error::Result;
@@ -362,6 +362,25 @@ impl DriveTracker {
                 box_sensor,
                 road_user,
             });
+        }
+        // A road user inside a more certain one's footprint is a fragment of it.
+        let users: Vec<usize> = (0..out_clusters.len())
+            .filter(|&i| out_clusters[i].road_user && out_clusters[i].box_world.is_some())
+            .collect();
+        let boxes: Vec<_> = users
+            .iter()
+            .filter_map(|&i| {
+                let c = &out_clusters[i];
+                c.box_world.as_ref().map(|b| (b.to_box3(), c.existence))
+            })
+            .collect();
+        for (&i, contained) in users.iter().zip(contained_in_others(&boxes)) {
+            if contained {
+                out_clusters[i].road_user = false;
+            }
+        }
+        if !self.all_clusters {
+            out_clusters.retain(|c| c.road_user);
         }
         Ok((out_planes, out_clusters))
     }
