@@ -239,7 +239,7 @@ mod tests {
         );
         // A more certain small box keeps its place; the large one is not "inside" it, but
         // the small one's area is: the more certain one wins.
-        let swapped = [(boxes[0].0.clone(), 0.6), (boxes[1].0.clone(), 0.99)];
+        let swapped = [(boxes[0].0, 0.6), (boxes[1].0, 0.99)];
         assert_eq!(contained_in_others(&swapped), vec![true, false]);
         assert!(contained_in_others(&[]).is_empty());
     }
