@@ -34,7 +34,7 @@
 //! [`CHUNK`](super::registration::CHUNK) points combined in chunk order: the result does not
 //! depend on the number of rayon threads.
 
-use super::registration::{Alignment, CHUNK};
+use super::registration::{gauss_newton_step, move_points, sum_in_order, Alignment, CHUNK};
 use super::se3;
 use super::voxel_map::{Voxel, VoxelHashMap, VoxelTable};
 use nalgebra::{Isometry3, Matrix3, Matrix6, SymmetricEigen, Vector3, Vector6};
@@ -110,12 +110,7 @@ pub fn refine_point_to_plane(
     initial: &Isometry3<f64>,
     params: &RefineParams,
 ) -> Alignment {
-    let mut out = Alignment {
-        pose: *initial,
-        iterations: 0,
-        correspondences: 0,
-        translation_information: None,
-    };
+    let mut out = Alignment::unmoved(initial);
     if map.is_empty() || source.is_empty() {
         return out;
     }
@@ -224,26 +219,15 @@ fn refine_pass(
                 (jtj, jtr, n)
             })
             .collect();
-        let (jtj, jtr, n) = partial.into_iter().fold(
-            (Matrix6::zeros(), Vector6::zeros(), 0),
-            |(a, b, n), (x, y, m)| (a + x, b + y, n + m),
-        );
+        let (jtj, jtr, n) = sum_in_order(partial);
         out.iterations += 1;
         out.correspondences = n;
         out.translation_information = Some(jtj.fixed_view::<3, 3>(0, 0).into_owned());
-        let Some(chol) = jtj.cholesky() else {
+        let Some(dx) = gauss_newton_step(&jtj, &jtr) else {
             return out;
         };
-        let dx = -chol.solve(&jtr);
-        if !dx.iter().all(|v| v.is_finite()) {
-            return out;
-        }
         let step = se3::exp(&dx);
-        moved.par_chunks_mut(CHUNK).for_each(|c| {
-            for p in c {
-                *p = step.rotation * *p + step.translation.vector;
-            }
-        });
+        move_points(&mut moved, &step);
         t = se3::renormalized(&(step * t));
         if dx.norm() < params.convergence {
             break;

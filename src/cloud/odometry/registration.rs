@@ -55,12 +55,7 @@ pub fn align_points_to_map(
     initial: &Isometry3<f64>,
     params: &IcpParams,
 ) -> Alignment {
-    let mut out = Alignment {
-        pose: *initial,
-        iterations: 0,
-        correspondences: 0,
-        translation_information: None,
-    };
+    let mut out = Alignment::unmoved(initial);
     if map.is_empty() || source.is_empty() {
         return out;
     }
@@ -70,19 +65,11 @@ pub fn align_points_to_map(
         let (jtj, jtr, n) = normal_equations(&moved, map, params);
         out.iterations += 1;
         out.correspondences = n;
-        let Some(chol) = jtj.cholesky() else {
+        let Some(dx) = gauss_newton_step(&jtj, &jtr) else {
             break;
         };
-        let dx = -chol.solve(&jtr);
-        if !dx.iter().all(|v| v.is_finite()) {
-            break;
-        }
         let step = se3::exp(&dx);
-        moved.par_chunks_mut(CHUNK).for_each(|c| {
-            for p in c {
-                *p = transform(&step, p);
-            }
-        });
+        move_points(&mut moved, &step);
         t_icp = se3::renormalized(&(step * t_icp));
         if dx.norm() < params.convergence {
             break;
@@ -92,8 +79,47 @@ pub fn align_points_to_map(
     out
 }
 
+impl Alignment {
+    /// No iteration run yet: `initial`, no correspondences.
+    pub(super) fn unmoved(initial: &Isometry3<f64>) -> Self {
+        Alignment {
+            pose: *initial,
+            iterations: 0,
+            correspondences: 0,
+            translation_information: None,
+        }
+    }
+}
+
 fn transform(t: &Isometry3<f64>, p: &Vector3<f64>) -> Vector3<f64> {
     t.rotation * p + t.translation.vector
+}
+
+/// The Gauss–Newton step δ = −(JᵀWJ)⁻¹ JᵀWr, or `None` when the normal equations are
+/// singular or the step is not finite.
+pub(super) fn gauss_newton_step(jtj: &Matrix6<f64>, jtr: &Vector6<f64>) -> Option<Vector6<f64>> {
+    let dx = -jtj.cholesky()?.solve(jtr);
+    dx.iter().all(|v| v.is_finite()).then_some(dx)
+}
+
+/// Moves `points` by `step`, in parallel chunks.
+pub(super) fn move_points(points: &mut [Vector3<f64>], step: &Isometry3<f64>) {
+    points.par_chunks_mut(CHUNK).for_each(|c| {
+        for p in c {
+            *p = transform(step, p);
+        }
+    });
+}
+
+/// Per-chunk normal equations (JᵀWJ, JᵀWr, pairs) summed in chunk order, so that the sum
+/// does not depend on the number of threads.
+pub(super) fn sum_in_order(
+    partial: Vec<(Matrix6<f64>, Vector6<f64>, usize)>,
+) -> (Matrix6<f64>, Vector6<f64>, usize) {
+    partial.into_iter().fold(
+        (Matrix6::zeros(), Vector6::zeros(), 0),
+        |(a, b, n), (x, y, m)| (a + x, b + y, n + m),
+    )
 }
 
 /// JᵀWJ, JᵀWr and the number of correspondences, summed per chunk and combined in order.
@@ -130,10 +156,7 @@ fn normal_equations(
             (jtj, jtr, n)
         })
         .collect();
-    partial.into_iter().fold(
-        (Matrix6::zeros(), Vector6::zeros(), 0),
-        |(a, b, n), (x, y, m)| (a + x, b + y, n + m),
-    )
+    sum_in_order(partial)
 }
 
 #[cfg(test)]
