@@ -17,7 +17,7 @@
 //! Not for: choosing which scans to match (the moving-object detector does that), global
 //! registration from a poor initial guess, or point-to-line refinement.
 
-use super::nearest::PlanarGrid;
+use super::nearest::{symmetric2_eigenvalues, PlanarGrid};
 use crate::error::{Error, Result};
 use crate::geometry::pose2::{compose, transform_point};
 use crate::geometry::Pose2;
@@ -350,10 +350,9 @@ impl Icp {
             }
         }
         let share = lines as f64 / sampled.max(1) as f64;
-        let mean = 0.5 * (a + c);
-        let root = (0.25 * (a - c) * (a - c) + b * b).sqrt();
-        let ratio = if mean + root > 0.0 {
-            ((mean - root) / (mean + root)).max(0.0)
+        let (small, large) = symmetric2_eigenvalues(a, b, c);
+        let ratio = if large > 0.0 {
+            (small / large).max(0.0)
         } else {
             0.0
         };

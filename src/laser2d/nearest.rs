@@ -221,18 +221,7 @@ impl PlanarGrid {
         // A hair wider than the hint's distance, so that rounding cannot drop a cell that
         // holds a tie.
         let reach = d2.sqrt() * (1.0 + 1e-9) + 1e-12;
-        let s = self.cell;
-        let cell = |v: f64, o: f64, n: usize| -> i64 {
-            floor_i64(((v - o) / s).clamp(-1e15, 1e15)).clamp(-1, n as i64)
-        };
-        let (i0, i1) = (
-            cell(q[0] - reach, self.origin[0], self.nx).max(0),
-            cell(q[0] + reach, self.origin[0], self.nx).min(self.nx as i64 - 1),
-        );
-        let (j0, j1) = (
-            cell(q[1] - reach, self.origin[1], self.ny).max(0),
-            cell(q[1] + reach, self.origin[1], self.ny).min(self.ny as i64 - 1),
-        );
+        let ((i0, i1), (j0, j1)) = self.cells_around(q, reach);
         for i in i0..=i1 {
             self.scan_cells(i, j0, j1, &mut search);
         }
@@ -255,23 +244,11 @@ impl PlanarGrid {
     fn fit_line_normal(&self, c: [f64; 2]) -> Option<[f64; 2]> {
         let s = self.cell;
         let r2 = s * s;
-        let cell =
-            |v: f64, o: f64, n: usize| -> i64 { floor_i64((v - o) / s).clamp(0, n as i64 - 1) };
-        let (i0, i1) = (
-            cell(c[0] - s, self.origin[0], self.nx),
-            cell(c[0] + s, self.origin[0], self.nx),
-        );
-        let (j0, j1) = (
-            cell(c[1] - s, self.origin[1], self.ny),
-            cell(c[1] + s, self.origin[1], self.ny),
-        );
+        let ((i0, i1), (j0, j1)) = self.cells_around(c, s);
         // Moments about c (shifted sums keep the scatter exact at any coordinate size).
         let (mut n, mut sx, mut sy, mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
         for i in i0..=i1 {
-            let base = i as usize * self.ny;
-            let a = self.start[base + j0 as usize] as usize;
-            let b = self.start[base + j1 as usize + 1] as usize;
-            for p in &self.coords[a..b] {
+            for p in &self.coords[self.run(i, j0, j1)] {
                 let (x, y) = (p[0] - c[0], p[1] - c[1]);
                 if x * x + y * y <= r2 {
                     n += 1.0;
@@ -288,10 +265,7 @@ impl PlanarGrid {
         }
         let (mx, my) = (sx / n, sy / n);
         let (cxx, cxy, cyy) = (sxx / n - mx * mx, sxy / n - mx * my, syy / n - my * my);
-        // Eigenvalues of the scatter: mean ± root.
-        let mean = 0.5 * (cxx + cyy);
-        let root = (0.25 * (cxx - cyy) * (cxx - cyy) + cxy * cxy).sqrt();
-        let (small, large) = (mean - root, mean + root);
+        let (small, large) = symmetric2_eigenvalues(cxx, cxy, cyy);
         if large.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || small > 0.04 * large {
             return None;
         }
@@ -300,17 +274,40 @@ impl PlanarGrid {
         Some([-sin, cos])
     }
 
+    /// The columns and rows of the cells that the square of half-side `reach` about `c`
+    /// touches, clipped to the grid (an empty range when the square lies outside it).
+    fn cells_around(&self, c: [f64; 2], reach: f64) -> ((i64, i64), (i64, i64)) {
+        let s = self.cell;
+        let cell = |v: f64, o: f64, n: usize| -> i64 {
+            floor_i64(((v - o) / s).clamp(-1e15, 1e15)).clamp(-1, n as i64)
+        };
+        let span = |a: usize, n: usize| {
+            let o = self.origin[a];
+            (
+                cell(c[a] - reach, o, n).max(0),
+                cell(c[a] + reach, o, n).min(n as i64 - 1),
+            )
+        };
+        (span(0, self.nx), span(1, self.ny))
+    }
+
+    /// Where the points of cells (i, j0..=j1), one contiguous run, lie in `items` and
+    /// `coords` (`j0 ≤ j1`, all inside the grid).
+    #[inline]
+    fn run(&self, i: i64, j0: i64, j1: i64) -> std::ops::Range<usize> {
+        let base = i as usize * self.ny;
+        self.start[base + j0 as usize] as usize..self.start[base + j1 as usize + 1] as usize
+    }
+
     /// Offers the points of cells (i, j0..=j1) (one contiguous run) to the search.
     #[inline]
     fn scan_cells(&self, i: i64, j0: i64, j1: i64, search: &mut Search) {
         if j0 > j1 {
             return;
         }
-        let base = i as usize * self.ny;
-        let a = self.start[base + j0 as usize] as usize;
-        let b = self.start[base + j1 as usize + 1] as usize;
+        let r = self.run(i, j0, j1);
         let q = search.q;
-        for (p, &k) in self.coords[a..b].iter().zip(&self.items[a..b]) {
+        for (p, &k) in self.coords[r.clone()].iter().zip(&self.items[r]) {
             let (dx, dy) = (p[0] - q[0], p[1] - q[1]);
             let d2 = dx * dx + dy * dy;
             if d2 <= search.bound && k != search.exclude {
@@ -325,6 +322,14 @@ impl PlanarGrid {
             }
         }
     }
+}
+
+/// The eigenvalues (smaller, larger) of the symmetric 2 × 2 matrix [[a, b], [b, c]]: the
+/// mean of the diagonal ∓ the root.
+pub(crate) fn symmetric2_eigenvalues(a: f64, b: f64, c: f64) -> (f64, f64) {
+    let mean = 0.5 * (a + c);
+    let root = (0.25 * (a - c) * (a - c) + b * b).sqrt();
+    (mean - root, mean + root)
 }
 
 /// One query's state: the best point so far and the squared distance a point must not exceed.
