@@ -238,9 +238,29 @@ pub struct Leg {
     pub score: f64,
 }
 
+/// A person found by their legs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LegPerson {
+    /// Position (m, sensor frame): the mean of a pair's legs, or the lone leg's position.
+    pub position: [f64; 2],
+    /// The classifier's evidence: the sum of a pair's two leg scores, or the lone leg's
+    /// score (in `(−2, 2]`; a pair of clear legs scores higher than one).
+    pub score: f64,
+    /// Number of legs seen: 2 for a pair, 1 for a lone leg.
+    pub legs: usize,
+}
+
 /// Legs paired into people (step 4 of the module documentation): positions in the sensor
 /// frame.
 pub fn pair_legs(legs: &[Leg], config: &LegDetectorConfig) -> Vec<[f64; 2]> {
+    pair_legs_scored(legs, config)
+        .into_iter()
+        .map(|p| p.position)
+        .collect()
+}
+
+/// [`pair_legs`] with each person's score ([`LegPerson::score`]).
+pub fn pair_legs_scored(legs: &[Leg], config: &LegDetectorConfig) -> Vec<LegPerson> {
     let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
     for i in 0..legs.len() {
         for j in i + 1..legs.len() {
@@ -261,11 +281,19 @@ pub fn pair_legs(legs: &[Leg], config: &LegDetectorConfig) -> Vec<[f64; 2]> {
         used[i] = true;
         used[j] = true;
         let (a, b) = (legs[i].position, legs[j].position);
-        people.push([0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])]);
+        people.push(LegPerson {
+            position: [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])],
+            score: legs[i].score + legs[j].score,
+            legs: 2,
+        });
     }
     for (l, u) in legs.iter().zip(&used) {
         if !u && l.score > config.single_leg_score {
-            people.push(l.position);
+            people.push(LegPerson {
+                position: l.position,
+                score: l.score,
+                legs: 1,
+            });
         }
     }
     people
@@ -399,6 +427,12 @@ impl LegDetector {
         let legs = self.legs(scan)?;
         Ok(pair_legs(&legs, &self.config))
     }
+
+    /// The people of the next scan with their scores ([`LegPerson`]).
+    pub fn people_scored(&mut self, scan: &Scan) -> Result<Vec<LegPerson>> {
+        let legs = self.legs(scan)?;
+        Ok(pair_legs_scored(&legs, &self.config))
+    }
 }
 
 #[cfg(test)]
@@ -477,6 +511,15 @@ mod tests {
         );
         assert_eq!(p.len(), 2);
         assert!((p[0][1] - 0.1).abs() < 1e-12);
+        // Scores: a pair adds its legs' scores, a lone leg keeps its own.
+        let scored = pair_legs_scored(
+            &[leg(1.0, 0.0, 0.2), leg(1.0, 0.2, 0.3), leg(1.0, 0.5, 0.4)],
+            &cfg,
+        );
+        assert_eq!(scored.len(), 2);
+        assert!((scored[0].score - 0.5).abs() < 1e-12 && scored[0].legs == 2);
+        assert_eq!((scored[1].score, scored[1].legs), (0.4, 1));
+        assert_eq!(scored[1].position, [1.0, 0.5]);
     }
 
     #[test]

@@ -87,6 +87,10 @@ pub struct FrontEndOutput {
     pub corrected_pose: Option<Pose2>,
     /// The detector's output, when a detector runs.
     pub detections: Option<MovingDetections>,
+    /// Per measurement, the classifier's evidence that it is a person (the legs front end's
+    /// [`crate::laser2d::legs::LegPerson::score`]); `None` from the front ends without a
+    /// classifier.
+    pub evidence: Option<Vec<f64>>,
 }
 
 /// The front end; see the module documentation.
@@ -199,29 +203,31 @@ pub const MOVING_CONFIRM_DETECTIONS: f64 = 5.0;
 /// 0.08 (scenario one) and 0.12 (lobby) per scan, rounded up for recordings.
 pub const MOVING_CLUTTER_RATE: f64 = 0.3;
 
-/// p_D the tracker assumes behind [`FrontEnd::Legs`]. With [`LEGS_CONFIRM_DETECTIONS`],
-/// chosen on the pooled leave-one-bag-out folds of the annotated `leg_tracker` bags (the
-/// held-out positive bags and the held-out lasers of `negative_2.bag`, tracker seeds 1–4
-/// pooled, since one seed moves the tracker's F1 by ±0.04; tracker F1 / false people per
-/// empty-room scan): p_D 0.5 with 5, 6, 7, 8 detections 0.701 / 0.138, 0.692 / 0.079,
-/// 0.681 / 0.040, 0.668 / 0.027; p_D 0.6: 0.698 / 0.130, 0.685 / 0.085, 0.666 / 0.051,
-/// 0.647 / 0.035; p_D 0.7: 0.702 / 0.095, 0.688 / 0.059, 0.669 / 0.026, 0.646 / 0.017; p_D
-/// 0.8: 0.681 / 0.078, 0.668 / 0.049, 0.646 / 0.026, 0.626 / 0.012. With 7 the held-out
-/// `/right_scan` alone reaches 0.075, so 8 it stays (0.017 pooled). A low p_D keeps a person whose
-/// legs the detector misses for a few scans; the confirmation count keeps furniture legs
-/// that are found now and then from becoming people.
+/// p_D the tracker assumes behind [`FrontEnd::Legs`]: a low p_D keeps a person whose legs
+/// the detector misses for a few scans. Chosen on the pooled leave-one-bag-out folds of the
+/// annotated `leg_tracker` bags (the held-out positive bags and the held-out lasers of
+/// `negative_2.bag`, tracker seeds 1–4 pooled, since one seed moves the tracker's F1 by
+/// ±0.04), with [`LEGS_CONFIRM_EVIDENCE`] 0.6 (tracker F1 / false people per empty-room scan):
+/// p_D 0.5 0.704 / 0.014, 0.6 0.697 / 0.024, 0.7 0.694 / 0.001, 0.8 0.681 / 0.013.
 pub const LEGS_DETECTION_PROBABILITY: f64 = 0.7;
 
-/// Expected detections before a track behind [`FrontEnd::Legs`] is reported (see
-/// [`LEGS_DETECTION_PROBABILITY`]).
-pub const LEGS_CONFIRM_DETECTIONS: f64 = 8.0;
+/// Evidence a track behind [`FrontEnd::Legs`] must collect before it is reported
+/// ([`PeopleTrackerConfig::confirm_evidence`]: the sum of the association probability times
+/// the person's leg score, [`crate::laser2d::legs::LegPerson::score`]). On the same folds
+/// (F1 / false people per empty-room scan): 0.4 0.734 / 0.071, 0.5 0.713 / 0.027 (0.069 on the
+/// held-out `/right_scan`), 0.6 0.694 / 0.001, 0.7 0.673 / 0.000, 1.0 0.629 / 0.000; the count
+/// of expected detections used before (8) gave 0.646 / 0.017. Counting each leg's evidence
+/// against a neutral score (score − τ per leg) made both worse (τ = 0.05: 0.616 at 0.3; τ =
+/// −0.05: 0.699 / 0.031 at 1.0); asking for existence 0.5 or 0.9 instead of 0.99 changed
+/// nothing.
+pub const LEGS_CONFIRM_EVIDENCE: f64 = 0.6;
 
 /// Adapts the LMB people tracker to the front end `kind`: behind [`FrontEnd::Moving`] misses
 /// come in runs ([`MOVING_DETECTABILITY`], p_D [`MOVING_DETECTABLE_PROBABILITY`] while
 /// detectable), tracks are confirmed after [`MOVING_CONFIRM_DETECTIONS`] and the clutter rate
 /// is [`MOVING_CLUTTER_RATE`]; behind [`FrontEnd::Legs`] p_D is [`LEGS_DETECTION_PROBABILITY`]
-/// and tracks are confirmed after [`LEGS_CONFIRM_DETECTIONS`]; the segment front end keeps
-/// the tracker's own settings.
+/// and tracks are confirmed on the leg classifier's evidence ([`LEGS_CONFIRM_EVIDENCE`], no
+/// count of detections); the segment front end keeps the tracker's own settings.
 pub fn adapt_tracker_config(people: &mut PeopleTrackerConfig, kind: FrontEnd) {
     if kind == FrontEnd::Legs {
         if let crate::config::DetectionConfig::FieldOfView { p_inside, .. } =
@@ -229,7 +235,8 @@ pub fn adapt_tracker_config(people: &mut PeopleTrackerConfig, kind: FrontEnd) {
         {
             *p_inside = LEGS_DETECTION_PROBABILITY;
         }
-        people.confirm_detections = LEGS_CONFIRM_DETECTIONS;
+        people.confirm_detections = 0.0;
+        people.confirm_evidence = LEGS_CONFIRM_EVIDENCE;
         return;
     }
     if kind != FrontEnd::Moving {
@@ -333,15 +340,19 @@ impl PersonFrontEnd {
             None => None,
         };
         if let Some(legs) = &mut self.legs {
-            let rows: Vec<[f64; 2]> = legs
-                .people(scan)?
+            let people = legs.people_scored(scan)?;
+            let rows: Vec<[f64; 2]> = people
                 .iter()
-                .map(|p| [p[0].hypot(p[1]), p[1].atan2(p[0])])
+                .map(|p| {
+                    let [x, y] = p.position;
+                    [x.hypot(y), y.atan2(x)]
+                })
                 .collect();
             return Ok(FrontEndOutput {
                 measurements: Measurements::from_rows(2, &rows)?,
                 corrected_pose: detections.as_ref().map(|d| d.pose).or(Some(legs.pose())),
                 detections,
+                evidence: Some(people.iter().map(|p| p.score).collect()),
             });
         }
         let groups = person_groups(scan, &person_grouping(&self.people))?;
@@ -376,6 +387,7 @@ impl PersonFrontEnd {
             measurements: Measurements::from_rows(2, &rows)?,
             corrected_pose: detections.as_ref().map(|d| d.pose),
             detections,
+            evidence: None,
         })
     }
 }
@@ -487,7 +499,8 @@ mod tests {
         let base = PeopleTrackerConfig::for_scanner(0.03, 0.01, 20.0, 1.5, [0.0, 0.0]);
         let mut legs = base.clone();
         adapt_tracker_config(&mut legs, FrontEnd::Legs);
-        assert_eq!(legs.confirm_detections, LEGS_CONFIRM_DETECTIONS);
+        assert_eq!(legs.confirm_evidence, LEGS_CONFIRM_EVIDENCE);
+        assert_eq!(base.confirm_evidence, 0.0);
         assert!(matches!(
             legs.filter.detection,
             crate::config::DetectionConfig::FieldOfView { p_inside, .. }

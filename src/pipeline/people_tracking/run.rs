@@ -184,7 +184,12 @@ fn track_all(
         let pose = out.corrected_pose.or(scan.odometry);
         tracker.observe(scan);
         let people = tracker
-            .step_measured(out.measurements, scan.time, pose.map(platform_isometry))
+            .step_measured_with_evidence(
+                out.measurements,
+                out.evidence.as_deref(),
+                scan.time,
+                pose.map(platform_isometry),
+            )
             .map_err(at)?;
         run.scans.push(ScanPeople {
             scan: i,

@@ -99,6 +99,13 @@ pub struct PeopleTrackerConfig {
     /// the probability that it was detected; the birth scan's measurement is not counted).
     /// Default 0.
     pub confirm_detections: f64,
+    /// … and once the measurements it was most probably associated with have brought this
+    /// much evidence (the sum over its life of the association probability times the
+    /// measurement's evidence: the front end's classifier score, or 1 from a front end
+    /// without one, see [`PeopleTracker::step_measured_with_evidence`]). A walking person's
+    /// clear leg pairs reach it in a few scans, furniture legs that the classifier takes for
+    /// legs now and then only slowly. Default 0.
+    pub confirm_evidence: f64,
     /// A person is reported by [`PeopleTracker::step`] when the expected share of their
     /// beams the scanner sees is at least this. Default 0.5.
     pub min_visibility: f64,
@@ -147,6 +154,7 @@ impl PeopleTrackerConfig {
             detectability: None,
             confirm_existence: 0.99,
             confirm_detections: 0.0,
+            confirm_evidence: 0.0,
             min_visibility: 0.5,
             motion: MotionConfig::default(),
             filter: RunConfig {
@@ -248,6 +256,8 @@ pub struct PeopleTracker {
     birth: PeopleBirth,
     motion: MotionClassifier,
     confirmed: std::collections::BTreeSet<Label>,
+    /// Evidence collected by each track (see [`PeopleTrackerConfig::confirm_evidence`]).
+    evidence: std::collections::BTreeMap<Label, f64>,
     last_time: Option<f64>,
     /// The range-bearing model of the people's centres (births, innovations).
     sensor: RangeBearing,
@@ -362,6 +372,7 @@ impl PeopleTracker {
             birth,
             motion,
             confirmed: Default::default(),
+            evidence: Default::default(),
             last_time: None,
             sensor,
             innovations: None,
@@ -471,6 +482,31 @@ impl PeopleTracker {
         time: f64,
         platform: Option<Isometry3<f64>>,
     ) -> Result<Vec<PersonEstimate>> {
+        self.step_measured_with_evidence(measurements, None, time, platform)
+    }
+
+    /// [`PeopleTracker::step_measured`] with each measurement's evidence that it is a person
+    /// (e.g. a classifier's score; `None` counts 1 for each), which the tracks collect
+    /// towards [`PeopleTrackerConfig::confirm_evidence`].
+    pub fn step_measured_with_evidence(
+        &mut self,
+        measurements: Measurements,
+        evidence: Option<&[f64]>,
+        time: f64,
+        platform: Option<Isometry3<f64>>,
+    ) -> Result<Vec<PersonEstimate>> {
+        if let Some(e) = evidence {
+            if e.len() != measurements.len() || e.iter().any(|v| !v.is_finite()) {
+                return Err(Error::invalid(
+                    "measurement evidence",
+                    format!(
+                        "{} finite values needed, one per measurement (got {})",
+                        measurements.len(),
+                        e.len()
+                    ),
+                ));
+            }
+        }
         let dt = self.last_time.map_or(0.0, |t0| (time - t0).max(0.0));
         self.last_time = Some(time);
         let confirmed = self.filter.tracks().iter().map(|t| {
@@ -514,16 +550,28 @@ impl PeopleTracker {
         ctx.platform = platform;
         let p_max = self.detection.field_of_view().p_inside();
         let tracks = self.filter.tracks();
-        let (confirm, detections) = (
+        let (confirm, detections, needed) = (
             self.config.confirm_existence,
             self.config.confirm_detections,
+            self.config.confirm_evidence,
         );
+        for m in self.filter.most_probable_measurements() {
+            let e = evidence.map_or(1.0, |e| e[m.measurement]);
+            *self.evidence.entry(m.label).or_insert(0.0) += m.probability * e;
+        }
+        self.evidence
+            .retain(|l, _| tracks.iter().any(|t| t.label == *l));
         self.confirmed
             .retain(|l| tracks.iter().any(|t| t.label == *l));
+        let collected = |l: &Label| self.evidence.get(l).copied().unwrap_or(0.0);
         self.confirmed.extend(
             tracks
                 .iter()
-                .filter(|t| t.existence >= confirm && t.expected_detections >= detections)
+                .filter(|t| {
+                    t.existence >= confirm
+                        && t.expected_detections >= detections
+                        && (needed <= 0.0 || collected(&t.label) >= needed)
+                })
                 .map(|t| t.label),
         );
         let mut out = Vec::with_capacity(estimates.len());
@@ -877,5 +925,59 @@ mod tests {
         cfg.confirm_existence = 0.5;
         let (labels, _) = walk(cfg, 16, y, 3..16);
         assert!(labels.iter().any(|l| !l.is_empty()), "{labels:?}");
+    }
+
+    /// The first scan in which the walking person of [`walk`] is reported when each of the
+    /// front end's measurements brings `evidence` (None if never within `scans`).
+    fn first_report_with_evidence(
+        cfg: &PeopleTrackerConfig,
+        scans: usize,
+        evidence: f64,
+    ) -> Option<usize> {
+        let mut tracker = PeopleTracker::new(cfg.clone()).unwrap();
+        for k in 0..scans {
+            let t = k as f64 * 0.125;
+            let scan = scan_with_person(t, 5.0, -2.0 + 0.8 * t);
+            let z = tracker.measurements(&scan).unwrap();
+            let e = vec![evidence; z.len()];
+            tracker.observe(&scan);
+            let people = tracker
+                .step_measured_with_evidence(z, Some(&e), t, None)
+                .unwrap();
+            if !tracker.visible(people).is_empty() {
+                return Some(k);
+            }
+        }
+        None
+    }
+
+    /// With `confirm_evidence` a track is reported once its measurements have brought that
+    /// much evidence: sooner when each brings more, never when none brings any. Without the
+    /// requirement the evidence changes nothing. Evidence that does not match the
+    /// measurements is an error.
+    #[test]
+    fn confirmation_waits_for_the_measurements_evidence() {
+        let mut cfg = static_scanner_config();
+        cfg.confirm_evidence = 1.2;
+        let strong = first_report_with_evidence(&cfg, 24, 0.5).expect("strong evidence confirms");
+        let weak = first_report_with_evidence(&cfg, 24, 0.15).expect("weak evidence confirms");
+        assert!(strong + 4 <= weak, "strong {strong}, weak {weak}");
+        assert_eq!(first_report_with_evidence(&cfg, 24, 0.0), None);
+        cfg.confirm_evidence = 0.0;
+        let off = first_report_with_evidence(&cfg, 24, 0.0);
+        assert!(off.is_some_and(|k| k <= strong), "{off:?} vs {strong}");
+
+        let mut tracker = PeopleTracker::new(static_scanner_config()).unwrap();
+        let scan = scan_with_person(0.0, 5.0, 0.0);
+        let z = tracker.measurements(&scan).unwrap();
+        assert_eq!(z.len(), 1);
+        tracker.observe(&scan);
+        for bad in [vec![], vec![0.5, 0.5], vec![f64::NAN]] {
+            let e = tracker
+                .step_measured_with_evidence(z.clone(), Some(&bad), 0.0, None)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("evidence"), "{e}");
+        }
     }
 }
