@@ -3,8 +3,8 @@
 //! `pipeline::people_tracking::score`, against the targets of issue 22: per-scan F1 ≥ 0.8 for
 //! the detector and for the tracker's people, ≤ 0.05 false people per scan in the empty rooms
 //! of `negative_2.bag`. The numbers these bounds are checked against are in
-//! `docs/people_real.md`; the target not met yet (F1 on held-out recordings) is an ignored
-//! test naming the measured values.
+//! `docs/people_real.md`; the targets not met yet (F1 on held-out recordings) are ignored
+//! tests naming the measured values.
 
 mod common;
 
@@ -136,7 +136,7 @@ fn a_missing_annotation_topic_names_the_bag_and_topic() {
 }
 
 /// The rate is pooled over the tracker's seeds 0–3: one run's count moves by a track or so
-/// with the seed (the shipped model on `/rear_scan`: 0.056, 0.023, 0.038, 0.000 false people
+/// with the seed (the shipped model on `/rear_scan`: 0.000, 0.000, 0.000, 0.085 false people
 /// per scan with seeds 0–3; docs/people_real.md).
 #[test]
 fn empty_rooms_stay_empty() {
@@ -158,21 +158,19 @@ fn empty_rooms_stay_empty() {
     }
 }
 
-#[test]
-#[ignore = "target not met: held-out F1 about 0.74 (detector) and 0.69 (tracker) pooled (docs/people_real.md)"]
-fn held_out_recordings_reach_the_f1_target() {
-    // Leave one bag out, as `examples/train_legs.rs` does.
+/// Detector and tracker scores pooled over the four bags, each scored by a model trained
+/// without it (leave one bag out, as `examples/train_legs.rs` does, with all three lasers of
+/// `negative_2.bag` as negatives); the tracker pooled over `seeds` too.
+fn held_out_scores(seeds: std::ops::Range<u64>) -> Option<(DetectionScore, DetectionScore)> {
     let mut bags = Vec::new();
     for i in 1..=4 {
-        let Some(p) = positive(i) else { return };
+        let p = positive(i)?;
         let b = read_bag(&p, &BagOptions::topic("/training_scan")).unwrap();
         let ann = read_pose_arrays(&p, "/leg_cluster_positions").unwrap();
         let legs = legs_for_scans(&b.receive_times, &ann, "test").unwrap();
         bags.push((b.scans, legs));
     }
-    let Some(neg) = bag("negative_2.bag") else {
-        return;
-    };
+    let neg = bag("negative_2.bag")?;
     let shipped = LegModel::shipped().unwrap();
     let finder = {
         let mut m = shipped.clone();
@@ -221,10 +219,31 @@ fn held_out_recordings_reach_the_f1_target() {
             .iter()
             .map(|l| people_from_legs(l, LEG_MERGE))
             .collect();
-        let (di, ti) = score(&run(scans, Some(model)), &truth);
-        d.merge(&di);
-        t.merge(&ti);
+        for seed in seeds.clone() {
+            let (di, ti) = score(&run_seeded(scans, Some(model.clone()), Some(seed)), &truth);
+            if seed == seeds.start {
+                d.merge(&di);
+            }
+            t.merge(&ti);
+        }
     }
+    Some((d, t))
+}
+
+#[test]
+#[ignore = "target not met: held-out detector F1 0.737 (docs/people_real.md)"]
+fn held_out_detector_reaches_the_f1_target() {
+    let Some((d, _)) = held_out_scores(0..1) else {
+        return;
+    };
     assert!(d.f1() >= F1_TARGET, "held-out detector F1 {:.3}", d.f1());
+}
+
+#[test]
+#[ignore = "target not met: held-out tracker F1 0.772 pooled over seeds 0–3 (the train_legs folds: 0.794 over seeds 1–12, docs/people_real.md)"]
+fn held_out_tracker_reaches_the_f1_target() {
+    let Some((_, t)) = held_out_scores(0..4) else {
+        return;
+    };
     assert!(t.f1() >= F1_TARGET, "held-out tracker F1 {:.3}", t.f1());
 }

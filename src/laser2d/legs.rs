@@ -21,7 +21,10 @@
 //! 3. **Legs**: a segment whose boosted score exceeds [`LegDetectorConfig::leg_score`].
 //! 4. **People** ([`pair_legs`]): legs closer than `pair_distance` are paired, closest pairs
 //!    first, into a person at their mean; a leg left alone is a person only when its score
-//!    exceeds `single_leg_score` (the other leg hidden behind it).
+//!    exceeds `single_leg_score` (the other leg hidden behind it). Each person carries its
+//!    score (a pair's two leg scores added). For a tracker that weighs people by their score,
+//!    [`LegDetector::people_for_tracking`] also pairs the candidates down to the lower
+//!    `tracking_leg_score`: legs the classifier doubts still feed the tracks there are.
 //!
 //! The shipped model ([`LegModel::shipped`], `leg_model.json` beside this file) is trained
 //! by `cargo run --release --example train_legs` on the annotated recordings of
@@ -80,6 +83,18 @@ pub struct LegDetectorConfig {
     pub single_leg_score: f64,
     /// Legs closer than this are one person (m).
     pub pair_distance: f64,
+    /// For a tracker that weighs its measurements by their score
+    /// ([`LegDetector::people_for_tracking`]): candidates scoring above this are legs, paired
+    /// the same way, and a lone one is a person too. Default −0.1, below `leg_score`: a
+    /// tracked person whose legs the classifier doubts for a few scans still gets its
+    /// measurements, and the low scores keep such candidates from confirming tracks of their
+    /// own. Models written before this setting existed read the default.
+    #[serde(default = "default_tracking_leg_score")]
+    pub tracking_leg_score: f64,
+}
+
+fn default_tracking_leg_score() -> f64 {
+    -0.08
 }
 
 impl Default for LegDetectorConfig {
@@ -92,6 +107,7 @@ impl Default for LegDetectorConfig {
             leg_score: 0.0,
             single_leg_score: 0.025,
             pair_distance: 0.6,
+            tracking_leg_score: default_tracking_leg_score(),
         }
     }
 }
@@ -248,6 +264,16 @@ pub struct LegPerson {
     pub score: f64,
     /// Number of legs seen: 2 for a pair, 1 for a lone leg.
     pub legs: usize,
+}
+
+/// One scan's people twice: as the detector reports them, and down to the lower score of
+/// [`LegDetectorConfig::tracking_leg_score`] for a tracker that weighs them by their scores.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LegPeople {
+    /// The detector's people ([`pair_legs_scored`] with `leg_score` and `single_leg_score`).
+    pub reported: Vec<LegPerson>,
+    /// The people of every candidate scoring above `tracking_leg_score`, paired the same way.
+    pub for_tracking: Vec<LegPerson>,
 }
 
 /// Legs paired into people (step 4 of the module documentation): positions in the sensor
@@ -433,6 +459,42 @@ impl LegDetector {
         let legs = self.legs(scan)?;
         Ok(pair_legs_scored(&legs, &self.config))
     }
+
+    /// The people of the next scan as reported and for a tracker ([`LegPeople`]).
+    pub fn people_for_tracking(&mut self, scan: &Scan) -> Result<LegPeople> {
+        let c = self.candidates(scan)?;
+        let floor = self.config.tracking_leg_score;
+        let weak: Vec<Leg> = c
+            .iter()
+            .map(|c| Leg {
+                position: c.centroid,
+                score: self.score(c),
+            })
+            .filter(|l| l.score > floor.min(self.config.leg_score))
+            .collect();
+        let strong: Vec<Leg> = weak
+            .iter()
+            .filter(|l| l.score > self.config.leg_score)
+            .cloned()
+            .collect();
+        let tracking = LegDetectorConfig {
+            leg_score: floor,
+            single_leg_score: floor,
+            ..self.config
+        };
+        let strong_legs = pair_legs_scored(&strong, &self.config);
+        let for_tracking = pair_legs_scored(
+            &weak
+                .into_iter()
+                .filter(|l| l.score > floor)
+                .collect::<Vec<_>>(),
+            &tracking,
+        );
+        Ok(LegPeople {
+            reported: strong_legs,
+            for_tracking,
+        })
+    }
 }
 
 #[cfg(test)]
@@ -480,6 +542,67 @@ mod tests {
         }
         // The wall itself is far wider than max_width: split into pieces or dropped.
         assert!(c.iter().all(|c| c.features[5] <= 0.8));
+    }
+
+    /// A model whose score is `near` for candidates nearer than 3 m and −1 beyond: two
+    /// stumps on the range feature, the first voting +1 below 3 m, the second −1 always.
+    fn range_model(near: f64) -> LegModel {
+        let stump = |threshold: f64, polarity: f64, alpha: f64| crate::laser2d::boost::Stump {
+            feature: 13,
+            threshold,
+            polarity,
+            alpha,
+        };
+        // (a − b) / (a + b) = near with a + b = 2
+        let (a, b) = (1.0 + near, 1.0 - near);
+        LegModel {
+            description: "test".into(),
+            features: LEG_FEATURE_NAMES.iter().map(|s| s.to_string()).collect(),
+            config: LegDetectorConfig::default(),
+            classifier: Boosted {
+                stumps: vec![stump(3.0, -1.0, a), stump(100.0, 1.0, b)],
+            },
+        }
+    }
+
+    /// A model written before `tracking_leg_score` existed reads its default.
+    #[test]
+    fn older_models_read_the_default_tracking_score() {
+        let json = range_model(0.1).to_json();
+        let old = json.replace(",\n    \"tracking_leg_score\": -0.08", "");
+        assert_ne!(old, json);
+        let m = LegModel::from_json(&old).unwrap();
+        assert_eq!(m.config.tracking_leg_score, -0.08);
+    }
+
+    /// Legs the classifier doubts (score between `tracking_leg_score` and `leg_score`) are not
+    /// reported but are handed to a tracker, paired, with their summed score; legs it
+    /// believes are both; the wall behind is neither.
+    #[test]
+    fn doubted_legs_go_to_the_tracker_only() {
+        let s = scan_with_legs();
+        let mut doubted = LegDetector::new(range_model(-0.05)).unwrap();
+        let p = doubted.people_for_tracking(&s).unwrap();
+        assert!(p.reported.is_empty(), "{p:?}");
+        assert_eq!(p.for_tracking.len(), 1, "{p:?}");
+        let person = p.for_tracking[0];
+        assert_eq!(person.legs, 2);
+        assert!((person.score + 0.1).abs() < 1e-9, "{person:?}");
+        assert!((person.position[0] - 1.95).abs() < 0.05, "{person:?}");
+        assert!((person.position[1] - 0.125).abs() < 0.02, "{person:?}");
+
+        let mut believed = LegDetector::new(range_model(0.05)).unwrap();
+        let p = believed.people_for_tracking(&s).unwrap();
+        assert_eq!(p.reported.len(), 1, "{p:?}");
+        assert_eq!(p.reported, p.for_tracking);
+        assert!((p.reported[0].score - 0.1).abs() < 1e-9);
+        // The same scan through `people`: the reported people.
+        let mut again = LegDetector::new(range_model(0.05)).unwrap();
+        assert_eq!(again.people(&s).unwrap(), vec![p.reported[0].position]);
+
+        let mut rejected = LegDetector::new(range_model(-0.5)).unwrap();
+        let p = rejected.people_for_tracking(&s).unwrap();
+        assert!(p.reported.is_empty() && p.for_tracking.is_empty(), "{p:?}");
     }
 
     #[test]

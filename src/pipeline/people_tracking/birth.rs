@@ -15,7 +15,9 @@
 //!   suppression the second piece starts a duplicate that the next split confirms.
 //!
 //! The tracks to suppress around are handed over by the tracker before each step through a
-//! shared list (see [`PeopleBirth::set_confirmed`]). Not for: the filter's other birth models
+//! shared list (see [`PeopleBirth::set_confirmed`]), and so are the measurements that may not
+//! propose at all, those the front end's classifier doubts ([`PeopleBirth::set_barren`]). Not
+//! for: the filter's other birth models
 //! or deciding what a measurement is.
 
 use crate::error::{ensure_positive, ensure_probability, Result};
@@ -60,6 +62,9 @@ pub struct PeopleBirth {
     /// ([`super::models::detectability`]), set to detectable (the person was just detected).
     pub with_detectability: bool,
     confirmed: Suppressors,
+    /// Per measurement of the last step, whether it may not start a track (see
+    /// [`PeopleBirth::set_barren`]); shared by clones.
+    barren: Arc<RwLock<Vec<bool>>>,
 }
 
 impl PeopleBirth {
@@ -94,6 +99,7 @@ impl PeopleBirth {
             suppress_spread: 0.0,
             with_detectability: false,
             confirmed: Arc::new(RwLock::new(Vec::new())),
+            barren: Arc::new(RwLock::new(Vec::new())),
         })
     }
 
@@ -101,6 +107,15 @@ impl PeopleBirth {
     /// around which no birth is proposed; tracks below `suppress_existence` are ignored.
     pub fn set_confirmed(&self, tracks: impl IntoIterator<Item = ([f64; 2], f64)>) {
         self.set_confirmed_with_spread(tracks.into_iter().map(|(p, r)| (p, r, 0.0)));
+    }
+
+    /// Marks the measurements of the step just made that may not start a track (births come
+    /// from the last step's measurements), e.g. those the front end's classifier doubts.
+    /// Indexed like that step's measurements; an empty list (the default) bars none.
+    pub fn set_barren(&self, barren: impl IntoIterator<Item = bool>) {
+        let mut b = self.barren.write().unwrap_or_else(|e| e.into_inner());
+        b.clear();
+        b.extend(barren);
     }
 
     /// [`PeopleBirth::set_confirmed`] with each track's position spread σ (m): no proposal
@@ -163,12 +178,14 @@ impl BirthModel for PeopleBirth {
             return Vec::new();
         };
         let confirmed = self.confirmed.read().unwrap_or_else(|e| e.into_inner());
+        let barren = self.barren.read().unwrap_or_else(|e| e.into_inner());
         ev.measurements
             .iter()
             .zip(ev.assigned)
-            .filter_map(|(z, &a)| {
+            .enumerate()
+            .filter_map(|(j, (z, &a))| {
                 let r = self.existence(a);
-                if r < self.min_existence || z.len() < 2 {
+                if r < self.min_existence || z.len() < 2 || barren.get(j) == Some(&true) {
                     return None;
                 }
                 let zz = [z[0], z[1]];
@@ -255,5 +272,17 @@ mod tests {
         let some = b.birth(&ctx, Some(&ev), &mut seeded(1));
         assert_eq!(some.len(), 1);
         assert!((some[0].particles.mean()[0] - 5.0).abs() < 0.05);
+        // a barren measurement proposes nothing; an empty list bars none
+        b.set_confirmed([]);
+        b.set_barren([true, false]);
+        let one = b.birth(&ctx, Some(&ev), &mut seeded(1));
+        assert_eq!(one.len(), 1);
+        assert!(
+            one[0].particles.mean()[2] > 3.9,
+            "{:?}",
+            one[0].particles.mean()
+        );
+        b.set_barren([]);
+        assert_eq!(b.birth(&ctx, Some(&ev), &mut seeded(1)).len(), 2);
     }
 }

@@ -16,7 +16,9 @@
 //!   scans of a laser at leg height; the simulated scenarios draw people as discs and keep
 //!   the other two. Without a moving-object detector the corrected pose is the leg
 //!   detector's chain of scan-to-scan alignments ([`LegDetector::pose`]), so that a scanner
-//!   without odometry still sees walls and furniture stand still.
+//!   without odometry still sees walls and furniture stand still. Besides its people it
+//!   hands a tracker that weighs evidence ([`FrontEndOutput::weighed`]) the legs the
+//!   classifier doubts too, each person with its leg score.
 //!
 //! The detector also refines the odometry by ICP against its local map; the corrected robot
 //! pose is returned with the measurements ([`FrontEndOutput::corrected_pose`]) whenever a
@@ -32,7 +34,7 @@ use crate::error::{Error, Result};
 use crate::filter::Measurements;
 use crate::geometry::pose2::{between, compose};
 use crate::geometry::Pose2;
-use crate::laser2d::legs::{LegDetector, LegModel};
+use crate::laser2d::legs::{LegDetector, LegModel, LegPerson};
 use crate::laser2d::moving::{
     ClusterStage, MovingDetections, MovingDetectorConfig, MovingObjectDetector,
 };
@@ -87,10 +89,21 @@ pub struct FrontEndOutput {
     pub corrected_pose: Option<Pose2>,
     /// The detector's output, when a detector runs.
     pub detections: Option<MovingDetections>,
-    /// Per measurement, the classifier's evidence that it is a person (the legs front end's
-    /// [`crate::laser2d::legs::LegPerson::score`]); `None` from the front ends without a
-    /// classifier.
-    pub evidence: Option<Vec<f64>>,
+    /// For a tracker that weighs each measurement by the classifier's evidence (the LMB
+    /// people tracker, [`super::tracker::PeopleTracker::step_measured_with_evidence`]): more
+    /// and weaker measurements than `measurements`, each with its evidence. The legs front end
+    /// gives its people down to [`crate::laser2d::legs::LegDetectorConfig::tracking_leg_score`]
+    /// with their scores ([`crate::laser2d::legs::LegPerson::score`]); the others give none.
+    pub weighed: Option<WeighedMeasurements>,
+}
+
+/// Measurements with the evidence that each is a person (see [`FrontEndOutput::weighed`]).
+#[derive(Clone, Debug)]
+pub struct WeighedMeasurements {
+    /// Range-bearing rows `[range, bearing]` (sensor frame).
+    pub measurements: Measurements,
+    /// One evidence value per measurement.
+    pub evidence: Vec<f64>,
 }
 
 /// The front end; see the module documentation.
@@ -203,23 +216,27 @@ pub const MOVING_CONFIRM_DETECTIONS: f64 = 5.0;
 /// 0.08 (scenario one) and 0.12 (lobby) per scan, rounded up for recordings.
 pub const MOVING_CLUTTER_RATE: f64 = 0.3;
 
-/// p_D the tracker assumes behind [`FrontEnd::Legs`]: a low p_D keeps a person whose legs
-/// the detector misses for a few scans. Chosen on the pooled leave-one-bag-out folds of the
-/// annotated `leg_tracker` bags (the held-out positive bags and the held-out lasers of
-/// `negative_2.bag`, tracker seeds 1–4 pooled, since one seed moves the tracker's F1 by
-/// ±0.04), with [`LEGS_CONFIRM_EVIDENCE`] 0.6 (tracker F1 / false people per empty-room scan):
-/// p_D 0.5 0.704 / 0.014, 0.6 0.697 / 0.024, 0.7 0.694 / 0.001, 0.8 0.681 / 0.013.
-pub const LEGS_DETECTION_PROBABILITY: f64 = 0.7;
+/// p_D the tracker assumes behind [`FrontEnd::Legs`], whose tracker gets every person down to
+/// the leg model's `tracking_leg_score` (−0.08) with their scores ([`WeighedMeasurements`];
+/// the doubted ones, score ≤ 0, only near a likely track and starting none,
+/// [`PeopleTrackerConfig::doubted_gate`]). Chosen with [`LEGS_CONFIRM_EVIDENCE`] and that
+/// floor on the pooled leave-one-bag-out folds of the annotated `leg_tracker` bags (the
+/// held-out positive bags and the held-out lasers of `negative_2.bag`, tracker seeds 1–12
+/// pooled, since one seed moves the tracker's F1 by ±0.04; tracker F1 / false people per
+/// empty-room scan, without the gate), floor −0.08 and evidence 0.6: p_D 0.7 0.776 / 0.012,
+/// 0.8 0.801 / 0.000, 0.9 0.782 / 0.002. See `docs/people_real.md`.
+pub const LEGS_DETECTION_PROBABILITY: f64 = 0.8;
 
 /// Evidence a track behind [`FrontEnd::Legs`] must collect before it is reported
 /// ([`PeopleTrackerConfig::confirm_evidence`]: the sum of the association probability times
-/// the person's leg score, [`crate::laser2d::legs::LegPerson::score`]). On the same folds
-/// (F1 / false people per empty-room scan): 0.4 0.734 / 0.071, 0.5 0.713 / 0.027 (0.069 on the
-/// held-out `/right_scan`), 0.6 0.694 / 0.001, 0.7 0.673 / 0.000, 1.0 0.629 / 0.000; the count
-/// of expected detections used before (8) gave 0.646 / 0.017. Counting each leg's evidence
-/// against a neutral score (score − τ per leg) made both worse (τ = 0.05: 0.616 at 0.3; τ =
-/// −0.05: 0.699 / 0.031 at 1.0); asking for existence 0.5 or 0.9 instead of 0.99 changed
-/// nothing.
+/// the person's leg score, [`crate::laser2d::legs::LegPerson::score`]; legs the classifier
+/// doubts score below 0 and count against it). On the same folds with p_D 0.8, without the
+/// gate (F1 / false people per empty-room scan), floor −0.06: evidence 0.4 0.812 / 0.038, 0.5
+/// 0.797 / 0.005, 0.6 0.778 / 0.002; floor −0.08: 0.820 / 0.054, 0.808 / 0.014 (0.056 on one
+/// held-out laser), 0.801 / 0.000; floor −0.1: 0.808 / 0.019, 0.799 / 0.000, 0.784 / 0.000;
+/// floor −0.12 with 0.5: 0.750 / 0.004. The gate (0.5 m) costs 0.801 → 0.794 and keeps the
+/// tracker at its speed in empty rooms. Reporting people only (no doubted legs) with p_D 0.7
+/// and 8 expected detections, as before, gave 0.646 / 0.017.
 pub const LEGS_CONFIRM_EVIDENCE: f64 = 0.6;
 
 /// Adapts the LMB people tracker to the front end `kind`: behind [`FrontEnd::Moving`] misses
@@ -340,19 +357,25 @@ impl PersonFrontEnd {
             None => None,
         };
         if let Some(legs) = &mut self.legs {
-            let people = legs.people_scored(scan)?;
-            let rows: Vec<[f64; 2]> = people
-                .iter()
-                .map(|p| {
-                    let [x, y] = p.position;
-                    [x.hypot(y), y.atan2(x)]
-                })
-                .collect();
+            let people = legs.people_for_tracking(scan)?;
+            let rows = |people: &[LegPerson]| -> Result<Measurements> {
+                let rows: Vec<[f64; 2]> = people
+                    .iter()
+                    .map(|p| {
+                        let [x, y] = p.position;
+                        [x.hypot(y), y.atan2(x)]
+                    })
+                    .collect();
+                Measurements::from_rows(2, &rows)
+            };
             return Ok(FrontEndOutput {
-                measurements: Measurements::from_rows(2, &rows)?,
+                measurements: rows(&people.reported)?,
                 corrected_pose: detections.as_ref().map(|d| d.pose).or(Some(legs.pose())),
                 detections,
-                evidence: Some(people.iter().map(|p| p.score).collect()),
+                weighed: Some(WeighedMeasurements {
+                    measurements: rows(&people.for_tracking)?,
+                    evidence: people.for_tracking.iter().map(|p| p.score).collect(),
+                }),
             });
         }
         let groups = person_groups(scan, &person_grouping(&self.people))?;
@@ -387,7 +410,7 @@ impl PersonFrontEnd {
             measurements: Measurements::from_rows(2, &rows)?,
             corrected_pose: detections.as_ref().map(|d| d.pose),
             detections,
-            evidence: None,
+            weighed: None,
         })
     }
 }

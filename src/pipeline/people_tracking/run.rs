@@ -183,14 +183,17 @@ fn track_all(
             .collect();
         let pose = out.corrected_pose.or(scan.odometry);
         tracker.observe(scan);
-        let people = tracker
-            .step_measured_with_evidence(
-                out.measurements,
-                out.evidence.as_deref(),
+        let at_pose = pose.map(platform_isometry);
+        let people = match out.weighed {
+            Some(w) => tracker.step_measured_with_evidence(
+                w.measurements,
+                Some(&w.evidence),
                 scan.time,
-                pose.map(platform_isometry),
-            )
-            .map_err(at)?;
+                at_pose,
+            ),
+            None => tracker.step_measured(out.measurements, scan.time, at_pose),
+        }
+        .map_err(at)?;
         run.scans.push(ScanPeople {
             scan: i,
             time: scan.time,

@@ -106,6 +106,14 @@ pub struct PeopleTrackerConfig {
     /// clear leg pairs reach it in a few scans, furniture legs that the classifier takes for
     /// legs now and then only slowly. Default 0.
     pub confirm_evidence: f64,
+    /// A measurement whose evidence is 0 or less (one the front end's classifier doubts, see
+    /// [`PeopleTracker::step_measured_with_evidence`]) is used only within this distance (m)
+    /// of a track's predicted position whose existence is at least `doubted_gate_existence`,
+    /// and never starts a track: it may keep a person's track fed through a few doubtful
+    /// scans, but not start or feed tracks of its own. Default 0.5 m.
+    pub doubted_gate: f64,
+    /// See `doubted_gate`. Default 0.5.
+    pub doubted_gate_existence: f64,
     /// A person is reported by [`PeopleTracker::step`] when the expected share of their
     /// beams the scanner sees is at least this. Default 0.5.
     pub min_visibility: f64,
@@ -155,6 +163,8 @@ impl PeopleTrackerConfig {
             confirm_existence: 0.99,
             confirm_detections: 0.0,
             confirm_evidence: 0.0,
+            doubted_gate: 0.5,
+            doubted_gate_existence: 0.5,
             min_visibility: 0.5,
             motion: MotionConfig::default(),
             filter: RunConfig {
@@ -528,6 +538,31 @@ impl PeopleTracker {
             )
         });
         let confirmed: Vec<_> = confirmed.collect();
+        // Doubted measurements (evidence ≤ 0) only near a likely track.
+        let mut kept_evidence = Vec::new();
+        let (measurements, evidence) = match evidence {
+            Some(e) if e.iter().any(|&v| v <= 0.0) => {
+                let mut gctx = StepContext::new(self.filter.steps(), time, 0.0);
+                gctx.platform = platform;
+                let (gate, min_r) = (self.config.doubted_gate, self.config.doubted_gate_existence);
+                let mut rows = Vec::with_capacity(e.len());
+                for (j, &ej) in e.iter().enumerate() {
+                    let z = measurements.get(j);
+                    let keep = ej > 0.0 || {
+                        let p = self.sensor.to_cartesian([z[0], z[1]], &gctx);
+                        confirmed.iter().any(|&(_, next, r, _)| {
+                            r >= min_r && (next[0] - p[0]).hypot(next[1] - p[1]) < gate
+                        })
+                    };
+                    if keep {
+                        rows.push([z[0], z[1]]);
+                        kept_evidence.push(ej);
+                    }
+                }
+                (Measurements::from_rows(2, &rows)?, Some(&kept_evidence[..]))
+            }
+            other => (measurements, other),
+        };
         self.birth
             .set_confirmed_with_spread(confirmed.iter().map(|&(at, _, r, s)| (at, r, s)));
         let min_r = self.birth.suppress_existence;
@@ -546,6 +581,11 @@ impl PeopleTracker {
             },
             &mut self.rng,
         )?;
+        // The next step's births come from these measurements: none from a doubted one.
+        match evidence {
+            Some(e) => self.birth.set_barren(e.iter().map(|&v| v <= 0.0)),
+            None => self.birth.set_barren(std::iter::empty()),
+        }
         let mut ctx = StepContext::new(self.filter.steps(), time, 0.0);
         ctx.platform = platform;
         let p_max = self.detection.field_of_view().p_inside();
@@ -952,8 +992,8 @@ mod tests {
     }
 
     /// With `confirm_evidence` a track is reported once its measurements have brought that
-    /// much evidence: sooner when each brings more, never when none brings any. Without the
-    /// requirement the evidence changes nothing. Evidence that does not match the
+    /// much evidence: sooner when each brings more, not within 24 scans when each brings
+    /// little. Without the requirement the evidence changes nothing. Evidence that does not match the
     /// measurements is an error.
     #[test]
     fn confirmation_waits_for_the_measurements_evidence() {
@@ -962,9 +1002,9 @@ mod tests {
         let strong = first_report_with_evidence(&cfg, 24, 0.5).expect("strong evidence confirms");
         let weak = first_report_with_evidence(&cfg, 24, 0.15).expect("weak evidence confirms");
         assert!(strong + 4 <= weak, "strong {strong}, weak {weak}");
-        assert_eq!(first_report_with_evidence(&cfg, 24, 0.0), None);
+        assert_eq!(first_report_with_evidence(&cfg, 24, 0.02), None);
         cfg.confirm_evidence = 0.0;
-        let off = first_report_with_evidence(&cfg, 24, 0.0);
+        let off = first_report_with_evidence(&cfg, 24, 0.02);
         assert!(off.is_some_and(|k| k <= strong), "{off:?} vs {strong}");
 
         let mut tracker = PeopleTracker::new(static_scanner_config()).unwrap();
@@ -979,5 +1019,56 @@ mod tests {
                 .to_string();
             assert!(e.contains("evidence"), "{e}");
         }
+    }
+
+    /// Walks the person of [`first_report_with_evidence`] for `scans` scans with the evidence
+    /// `evidence(k)` in scan k; returns the tracker and the reported people of every scan.
+    fn walk_with_evidence(
+        cfg: &PeopleTrackerConfig,
+        scans: usize,
+        evidence: impl Fn(usize) -> f64,
+    ) -> (PeopleTracker, Vec<Vec<Estimate>>) {
+        let mut tracker = PeopleTracker::new(cfg.clone()).unwrap();
+        let mut reported = Vec::new();
+        for k in 0..scans {
+            let t = k as f64 * 0.125;
+            let scan = scan_with_person(t, 5.0, -2.0 + 0.8 * t);
+            let z = tracker.measurements(&scan).unwrap();
+            let e = vec![evidence(k); z.len()];
+            tracker.observe(&scan);
+            let people = tracker
+                .step_measured_with_evidence(z, Some(&e), t, None)
+                .unwrap();
+            reported.push(tracker.visible(people));
+        }
+        (tracker, reported)
+    }
+
+    /// Measurements the classifier doubts (evidence ≤ 0) start no track, and are dropped
+    /// away from tracks; near a person's track they keep it updated.
+    #[test]
+    fn doubted_measurements_only_feed_tracks_there_are() {
+        let mut cfg = static_scanner_config();
+        cfg.confirm_evidence = 1.0;
+        let (tracker, reported) = walk_with_evidence(&cfg, 16, |_| -0.1);
+        assert!(tracker.filter().tracks().is_empty());
+        assert!(reported.iter().all(Vec::is_empty));
+
+        // Believed for 12 scans, then doubted for 12: still reported, and followed.
+        let (_, reported) = walk_with_evidence(&cfg, 24, |k| if k < 12 { 0.5 } else { -0.05 });
+        assert!(reported[11].len() == 1, "{:?}", reported[11]);
+        for (k, people) in reported.iter().enumerate().skip(12) {
+            assert_eq!(people.len(), 1, "scan {k}: {people:?}");
+            let y = -2.0 + 0.8 * k as f64 * 0.125;
+            assert!((people[0].state[2] - y).abs() < 0.3, "scan {k}: {people:?}");
+        }
+        // Without the gate's room they are dropped and the track coasts off them.
+        cfg.doubted_gate = 0.0;
+        let (_, coasting) = walk_with_evidence(&cfg, 24, |k| if k < 12 { 0.5 } else { -0.05 });
+        let last = |r: &[Vec<Estimate>]| r[23].first().map(|e| e.existence);
+        assert!(
+            last(&coasting).unwrap_or(0.0) < last(&reported).unwrap(),
+            "{coasting:?}"
+        );
     }
 }
