@@ -3,14 +3,18 @@
 //! over a whole simulated run of scenario one (240 scans, five walkers, a moving robot) and
 //! over a crowd of twenty walkers (up to 20 tracks at 500 particles, 80 scans); and the moving
 //! front end alone (background map, ICP against the local map, shape classes) in the lobby of
-//! scenario two, where walls and pillars give ICP something to hold on to. Throughput is
-//! reported per scan, so criterion's "elem/s" reads as scans per second.
+//! scenario two, where walls and pillars give ICP something to hold on to; and the legs front
+//! end with the tracker on two shared real recordings. Throughput is reported per scan, so
+//! criterion's "elem/s" reads as scans per second.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use smc_lmb::pipeline::people_tracking::front_end::{
     adapt_tracker_config, default_detector_config, FrontEnd, PersonFrontEnd,
 };
-use smc_lmb::pipeline::people_tracking::{PeopleTracker, PeopleTrackerConfig};
+use smc_lmb::laser2d::{read_bag, BagOptions};
+use smc_lmb::pipeline::people_tracking::{
+    config_for_scans, track_scans_with_model, PeopleTracker, PeopleTrackerConfig,
+};
 use smc_lmb::sim::{PeopleScenario, PersonLeg, PersonSpec, RobotLeg};
 use std::time::Duration;
 
@@ -133,6 +137,44 @@ fn laser2d_pipeline(c: &mut Criterion) {
                 .sum::<usize>()
         })
     });
+    g.finish();
+
+    legs_on_recordings(c);
+}
+
+/// The legs front end and the LMB tracker behind it (`track_scans_with_model`, as the
+/// `laser2d` example runs them) on the first 200 scans of a shared recording: the annotated
+/// `positive_1_extracted.bag` and the right laser of `negative_2.bag` (empty rooms, the
+/// slowest). Skipped, with a note, when `../shared/data` is absent.
+fn legs_on_recordings(c: &mut Criterion) {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/laser2d/leg_annotated");
+    let mut g = c.benchmark_group("laser2d_pipeline");
+    g.sample_size(10).measurement_time(Duration::from_secs(10));
+    for (name, bag, topic) in [
+        ("positive_1", "positive_1_extracted.bag", "/training_scan"),
+        ("negative_2_right", "negative_2.bag", "/right_scan"),
+    ] {
+        let path = dir.join(bag);
+        if !path.is_file() {
+            eprintln!("skipping legs/{name}: {} is absent", path.display());
+            continue;
+        }
+        let mut scans = read_bag(&path, &BagOptions::topic(topic))
+            .expect("bag")
+            .scans;
+        scans.truncate(200);
+        let cfg = config_for_scans(&scans, 0.03, 0.005, 15.0, [0.0, 0.0]).expect("config");
+        g.throughput(Throughput::Elements(scans.len() as u64));
+        g.bench_function(format!("legs_front_end_and_tracker/{name}"), |b| {
+            b.iter(|| {
+                track_scans_with_model(&scans, cfg.clone(), FrontEnd::Legs, None)
+                    .expect("run")
+                    .scans
+                    .len()
+            })
+        });
+    }
     g.finish();
 }
 
