@@ -8,10 +8,10 @@
 //! criterion's "elem/s" reads as scans per second.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use smc_lmb::laser2d::{read_bag, BagOptions};
 use smc_lmb::pipeline::people_tracking::front_end::{
     adapt_tracker_config, default_detector_config, FrontEnd, PersonFrontEnd,
 };
-use smc_lmb::laser2d::{read_bag, BagOptions};
 use smc_lmb::pipeline::people_tracking::{
     config_for_scans, track_scans_with_model, PeopleTracker, PeopleTrackerConfig,
 };
