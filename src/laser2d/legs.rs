@@ -85,7 +85,7 @@ pub struct LegDetectorConfig {
     pub pair_distance: f64,
     /// For a tracker that weighs its measurements by their score
     /// ([`LegDetector::people_for_tracking`]): candidates scoring above this are legs, paired
-    /// the same way, and a lone one is a person too. Default −0.1, below `leg_score`: a
+    /// the same way, and a lone one is a person too. Default −0.08, below `leg_score`: a
     /// tracked person whose legs the classifier doubts for a few scans still gets its
     /// measurements, and the low scores keep such candidates from confirming tracks of their
     /// own. Models written before this setting existed read the default.
@@ -438,13 +438,18 @@ impl LegDetector {
 
     /// The legs of the next scan.
     pub fn legs(&mut self, scan: &Scan) -> Result<Vec<Leg>> {
+        self.scored_candidates(scan, self.config.leg_score)
+    }
+
+    /// Every candidate of the next scan scoring above `floor`, as a leg with its score.
+    fn scored_candidates(&mut self, scan: &Scan, floor: f64) -> Result<Vec<Leg>> {
         let c = self.candidates(scan)?;
         Ok(c.iter()
             .map(|c| Leg {
                 position: c.centroid,
                 score: self.score(c),
             })
-            .filter(|l| l.score > self.config.leg_score)
+            .filter(|l| l.score > floor)
             .collect())
     }
 
@@ -454,45 +459,24 @@ impl LegDetector {
         Ok(pair_legs(&legs, &self.config))
     }
 
-    /// The people of the next scan with their scores ([`LegPerson`]).
-    pub fn people_scored(&mut self, scan: &Scan) -> Result<Vec<LegPerson>> {
-        let legs = self.legs(scan)?;
-        Ok(pair_legs_scored(&legs, &self.config))
-    }
-
     /// The people of the next scan as reported and for a tracker ([`LegPeople`]).
     pub fn people_for_tracking(&mut self, scan: &Scan) -> Result<LegPeople> {
-        let c = self.candidates(scan)?;
-        let floor = self.config.tracking_leg_score;
-        let weak: Vec<Leg> = c
+        let (floor, leg_score) = (self.config.tracking_leg_score, self.config.leg_score);
+        let scored = self.scored_candidates(scan, floor.min(leg_score))?;
+        let strong: Vec<Leg> = scored
             .iter()
-            .map(|c| Leg {
-                position: c.centroid,
-                score: self.score(c),
-            })
-            .filter(|l| l.score > floor.min(self.config.leg_score))
+            .copied()
+            .filter(|l| l.score > leg_score)
             .collect();
-        let strong: Vec<Leg> = weak
-            .iter()
-            .filter(|l| l.score > self.config.leg_score)
-            .cloned()
-            .collect();
+        let weak: Vec<Leg> = scored.into_iter().filter(|l| l.score > floor).collect();
         let tracking = LegDetectorConfig {
             leg_score: floor,
             single_leg_score: floor,
             ..self.config
         };
-        let strong_legs = pair_legs_scored(&strong, &self.config);
-        let for_tracking = pair_legs_scored(
-            &weak
-                .into_iter()
-                .filter(|l| l.score > floor)
-                .collect::<Vec<_>>(),
-            &tracking,
-        );
         Ok(LegPeople {
-            reported: strong_legs,
-            for_tracking,
+            reported: pair_legs_scored(&strong, &self.config),
+            for_tracking: pair_legs_scored(&weak, &tracking),
         })
     }
 }

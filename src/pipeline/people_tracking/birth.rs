@@ -16,9 +16,8 @@
 //!
 //! The tracks to suppress around are handed over by the tracker before each step through a
 //! shared list (see [`PeopleBirth::set_confirmed`]), and so are the measurements that may not
-//! propose at all, those the front end's classifier doubts ([`PeopleBirth::set_barren`]). Not
-//! for: the filter's other birth models
-//! or deciding what a measurement is.
+//! propose at all, those the front end's classifier doubts ([`PeopleBirth::set_barren`]).
+//! Not for: the filter's other birth models or deciding what a measurement is.
 
 use crate::error::{ensure_positive, ensure_probability, Result};
 use crate::filter::birth::BirthEvidence;
