@@ -22,6 +22,7 @@ pub mod ply_io;
 pub mod points;
 pub mod range_image;
 pub mod scan_file;
+pub mod voxel_groups;
 
 pub use cluster::{euclidean_clusters, euclidean_clusters_of, Cluster, ClusterParams};
 pub use kitti_bin::{read_kitti_bin, read_kitti_bin_with, write_kitti_bin, BinScan, NonFinite};

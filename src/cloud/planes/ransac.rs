@@ -5,8 +5,8 @@
 //! Not for: the sequence of rounds or the classification of planes (see the parent module).
 
 use super::PlaneConfig;
+use crate::cloud::voxel_groups::VoxelGroups;
 use crate::geometry::Plane;
-use crate::numerics::floor::floor_f32_i32;
 use crate::rng::FilterRng;
 use nalgebra::{Matrix3, Point3, Vector3};
 use rand::RngExt;
@@ -59,7 +59,7 @@ pub(super) fn one_round(
             .map(|_| pts[pool[rng.random_range(0..pool.len())] as usize])
             .collect()
     };
-    let cells = SampleCells::new(&sample, config.sample_cell as f32);
+    let cells = VoxelGroups::new(&sample, config.sample_cell as f32);
 
     // 2. Hypotheses, drawn sequentially.
     let mut hyps: Vec<PlaneF32> = Vec::with_capacity(config.hypotheses);
@@ -67,7 +67,7 @@ pub(super) fn one_round(
     while hyps.len() < config.hypotheses && attempts < config.hypotheses * 20 {
         attempts += 1;
         let a = rng.random_range(0..m);
-        let cell = cells.members_with(a);
+        let cell = cells.members(cells.group_of(a));
         if cell.len() < 3 {
             continue;
         }
@@ -147,87 +147,6 @@ pub(super) fn one_round(
         fitted = Some(p);
     }
     fitted.map(|p| (p, inliers))
-}
-
-/// The subsample's voxel grid: sample indices grouped by cell (ascending within a cell), so
-/// that the members of the cell of any sample point are one contiguous slice. Built in
-/// linear time: cells are numbered by a hash table in order of first appearance, then the
-/// indices are placed by a counting sort on that number.
-struct SampleCells {
-    /// Sample indices grouped by cell, ascending within a cell.
-    order: Vec<u32>,
-    /// Per sample index: the range of its cell in `order`.
-    range_of: Vec<(u32, u32)>,
-}
-
-impl SampleCells {
-    fn new(sample: &[[f32; 3]], cell: f32) -> Self {
-        let inv = 1.0 / cell;
-        let m = sample.len();
-        // Open addressing with linear probing, at most half full; a slot holds a cell number
-        // and the cell's coordinates are kept once per cell.
-        let slots = (2 * m).next_power_of_two().max(2);
-        let mask = slots - 1;
-        let mut table: Vec<u32> = vec![u32::MAX; slots];
-        let mut cell_key: Vec<[i32; 3]> = Vec::new();
-        let mut count: Vec<u32> = Vec::new();
-        let mut cell_of: Vec<u32> = Vec::with_capacity(m);
-        for p in sample {
-            let key = [
-                floor_f32_i32(p[0] * inv),
-                floor_f32_i32(p[1] * inv),
-                floor_f32_i32(p[2] * inv),
-            ];
-            let mut slot = cell_hash(key) as usize & mask;
-            let id = loop {
-                let id = table[slot];
-                if id == u32::MAX {
-                    let id = cell_key.len() as u32;
-                    table[slot] = id;
-                    cell_key.push(key);
-                    count.push(0);
-                    break id;
-                }
-                if cell_key[id as usize] == key {
-                    break id;
-                }
-                slot = (slot + 1) & mask;
-            };
-            count[id as usize] += 1;
-            cell_of.push(id);
-        }
-        // Start of every cell's run, then the indices in ascending order into their runs.
-        let mut start: Vec<u32> = Vec::with_capacity(count.len());
-        let mut acc = 0u32;
-        for &c in &count {
-            start.push(acc);
-            acc += c;
-        }
-        let mut next = start.clone();
-        let mut order = vec![0u32; m];
-        let mut range_of = vec![(0u32, 0u32); m];
-        for (i, &id) in cell_of.iter().enumerate() {
-            let id = id as usize;
-            order[next[id] as usize] = i as u32;
-            next[id] += 1;
-            range_of[i] = (start[id], start[id] + count[id]);
-        }
-        SampleCells { order, range_of }
-    }
-
-    /// Sample indices in the cell of sample point `i`, ascending.
-    fn members_with(&self, i: usize) -> &[u32] {
-        let (a, b) = self.range_of[i];
-        &self.order[a as usize..b as usize]
-    }
-}
-
-/// A 64-bit mix of a cell's three coordinates (for the hash table of [`SampleCells`]).
-#[inline]
-fn cell_hash(key: [i32; 3]) -> u64 {
-    let packed =
-        (key[0] as u32 as u64) ^ ((key[1] as u32 as u64) << 21) ^ ((key[2] as u32 as u64) << 42);
-    crate::rng::mix64(packed)
 }
 
 /// Points as three contiguous coordinate columns, for vectorised residual counts.
@@ -405,36 +324,6 @@ mod tests {
     use super::*;
     use crate::rng::seeded;
     use rand_distr::{Distribution, Normal};
-
-    #[test]
-    fn sample_cells_hold_exactly_the_points_of_each_cell_in_ascending_order() {
-        let mut rng = seeded(11);
-        for (m, spread) in [
-            (1usize, 1.0f32),
-            (7, 0.5),
-            (500, 3.0),
-            (3000, 40.0),
-            (3000, -8.0),
-        ] {
-            let sample: Vec<[f32; 3]> = (0..m)
-                .map(|_| {
-                    let mut p = [0.0f32; 3];
-                    for v in &mut p {
-                        *v = rng.random_range(-1.0f32..1.0) * spread;
-                    }
-                    p
-                })
-                .collect();
-            let cells = SampleCells::new(&sample, 2.0);
-            let cell = |p: &[f32; 3]| p.map(|v| (v / 2.0).floor() as i64);
-            for (i, p) in sample.iter().enumerate() {
-                let want: Vec<u32> = (0..m as u32)
-                    .filter(|&j| cell(&sample[j as usize]) == cell(p))
-                    .collect();
-                assert_eq!(cells.members_with(i), want.as_slice(), "m {m}, point {i}");
-            }
-        }
-    }
 
     #[test]
     fn msse_threshold_tracks_noise_scale() {
