@@ -177,9 +177,9 @@ mod tests {
                 prop_assert_eq!(g.group_of(i), first);
             }
             prop_assert_eq!(g.len(), seen.len());
-            for v in 0..g.len() {
+            for (v, k) in seen.iter().enumerate() {
                 let want: Vec<u32> = (0..pts.len() as u32)
-                    .filter(|&i| key(&pts[i as usize]) == seen[v])
+                    .filter(|&i| key(&pts[i as usize]) == *k)
                     .collect();
                 prop_assert_eq!(g.members(v), &want[..]);
             }

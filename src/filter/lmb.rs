@@ -33,6 +33,10 @@ use rayon::prelude::*;
 /// rather than failing an allocation in the middle of a run.
 pub const MAX_PARTICLES: usize = 10_000_000;
 
+/// The longest [`LmbConfig::smoothing_lag`] accepts: 100 steps (the genealogy of a particle
+/// set degenerates to a few ancestors long before).
+pub const MAX_SMOOTHING_LAG: usize = 100;
+
 /// The most tracks [`LmbConfig::validate`] accepts in `max_tracks`: one million.
 pub const MAX_TRACKS: usize = 1_000_000;
 
@@ -60,6 +64,10 @@ pub struct LmbConfig {
     /// At most this many tracks (those with the highest existence) are kept, 1 to
     /// [`MAX_TRACKS`]. Default 100.
     pub max_tracks: usize,
+    /// Steps of every track's particle history kept for fixed-lag smoothing
+    /// ([`crate::filter::smoothing::FixedLagSmoother`]), at most [`MAX_SMOOTHING_LAG`]; each
+    /// step of lag copies every particle once more per step. Default 0: none kept.
+    pub smoothing_lag: usize,
 }
 
 impl Default for LmbConfig {
@@ -71,6 +79,7 @@ impl Default for LmbConfig {
             jitter: Jitter::default(),
             prune_threshold: 1e-3,
             max_tracks: 100,
+            smoothing_lag: 0,
         }
     }
 }
@@ -106,6 +115,15 @@ impl LmbConfig {
             return Err(Error::invalid(
                 "config field `prune_threshold`",
                 format!("{} outside [0, 1)", self.prune_threshold),
+            ));
+        }
+        if self.smoothing_lag > MAX_SMOOTHING_LAG {
+            return Err(Error::invalid(
+                "config field `smoothing_lag`",
+                format!(
+                    "{} is above the limit of {MAX_SMOOTHING_LAG}",
+                    self.smoothing_lag
+                ),
             ));
         }
         if self.max_tracks == 0 {
@@ -488,6 +506,7 @@ impl LmbFilter {
         }
         let m = &self.models;
         let step = self.step;
+        let lag = self.config.smoothing_lag;
         let bad: Vec<Option<String>> = self
             .tracks
             .par_iter_mut()
@@ -503,6 +522,8 @@ impl LmbFilter {
                     _ => t.particles.reweight(&ps),
                 };
                 t.existence *= eta_s.clamp(0.0, 1.0);
+                t.particles.keep_history(lag);
+                t.particles.push_history();
                 m.transition.predict(&mut t.particles, ctx, &mut rng);
                 t.age += 1;
                 (0..t.particles.dim()).find_map(|c| {

@@ -21,6 +21,7 @@ pub mod lmb;
 pub mod measurements;
 pub mod model;
 pub mod particles;
+pub mod smoothing;
 pub mod survival;
 pub mod track;
 
@@ -32,7 +33,7 @@ pub use birth::{
 pub use label::Label;
 pub use lmb::{
     Frame, LmbConfig, LmbFilter, LmbFilterBuilder, MostProbableMeasurement, MAX_PARTICLES,
-    MAX_TRACKS,
+    MAX_SMOOTHING_LAG, MAX_TRACKS,
 };
 pub use measurements::Measurements;
 pub use model::{
@@ -40,5 +41,6 @@ pub use model::{
     TransitionModel,
 };
 pub use particles::{Jitter, ParticleSet};
+pub use smoothing::FixedLagSmoother;
 pub use survival::ConstantSurvival;
 pub use track::{Estimate, Track};

@@ -7,7 +7,14 @@
 //! empty a set; factors already in [0, 1] such as p_S and p_D reweight linearly
 //! ([`ParticleSet::reweight`]), which leaves the weights unchanged when the weighted sum is 0
 //! or not finite. Resampling is systematic, followed by optional roughening or a
-//! regularised Gaussian kernel ([`Jitter`]). Not for: the association or existence logic.
+//! regularised Gaussian kernel ([`Jitter`]). A set can also carry its particles' ancestral
+//! states over the last few steps ([`ParticleSet::keep_history`]): resampling copies a
+//! particle's past along with it, so the weighted particles of step k with their pasts
+//! approximate the joint posterior of the last steps' states given every measurement up to k
+//! (the genealogy, or path-space, fixed-lag smoother: Kitagawa 1996; Doucet & Johansen 2011,
+//! Sec. 4.4). Not for: the association or existence logic.
+
+mod history;
 
 use crate::rng::FilterRng;
 use rand::RngExt;
@@ -22,6 +29,13 @@ pub struct ParticleSet {
     states: Vec<f64>,
     /// Normalised weights (sum 1).
     weights: Vec<f64>,
+    /// Ancestral states, slot-major: `history[(s * dim + c) * len + i]` is component `c` of
+    /// the state particle `i`'s ancestor had `s + 1` steps back. Empty unless kept.
+    history: Vec<f64>,
+    /// Steps of history kept (the lag); 0 keeps none.
+    history_lag: usize,
+    /// Slots filled so far (at most `history_lag`).
+    history_depth: usize,
 }
 
 /// What is added to resampled particles to restore diversity.
@@ -61,6 +75,9 @@ impl ParticleSet {
             len,
             states: vec![0.0; dim * len],
             weights: vec![w; len],
+            history: Vec::new(),
+            history_lag: 0,
+            history_depth: 0,
         }
     }
 
@@ -326,6 +343,14 @@ impl ParticleSet {
         for c in 0..self.dim {
             let src = self.component(c);
             states.extend(idx.iter().map(|&j| src[j]));
+        }
+        if self.history_lag > 0 {
+            // Each new particle takes its ancestor's past along.
+            let mut history = Vec::with_capacity(self.history.len() / self.len.max(1) * n);
+            for row in self.history.chunks(self.len) {
+                history.extend(idx.iter().map(|&j| row[j]));
+            }
+            self.history = history;
         }
         self.states = states;
         self.len = n;
