@@ -131,7 +131,7 @@ impl Default for PlaneTuning {
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ClusterTuning {
-    /// Acceleration noise of the constant-velocity model (m/s²). Default 2.
+    /// Acceleration noise of the constant-velocity model (m/s²). Default 4.
     pub sigma_accel: f64,
     /// Centroid measurement noise per axis (m). Default 0.3.
     pub sigma: f64,
@@ -154,7 +154,7 @@ pub struct ClusterTuning {
 impl Default for ClusterTuning {
     fn default() -> Self {
         ClusterTuning {
-            sigma_accel: 2.0,
+            sigma_accel: 4.0,
             sigma: 0.3,
             gate: 4.0,
             detection: 0.8,
