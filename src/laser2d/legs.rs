@@ -7,7 +7,7 @@
 //!    return" beams) closer than [`LegDetectorConfig::cluster_distance`] (0.13 m, as the ROS
 //!    `leg_tracker`) are one segment; segments with fewer than `min_points` returns, wider
 //!    than `max_width` or farther than `max_range` are dropped.
-//! 2. **Features** ([`leg_features`], [`NUM_LEG_FEATURES`]): the thirteen shape features of
+//! 2. **Features** ([`LegCandidate::features`], [`NUM_LEG_FEATURES`]): the thirteen shape features of
 //!    [`super::features`] without the speed (number of points, standard deviation, mean
 //!    deviation from the median, jump distances to the preceding and succeeding segments,
 //!    width, linearity, circularity, radius, boundary length and regularity, mean curvature,
@@ -45,7 +45,7 @@ use serde::{Deserialize, Serialize};
 /// Number of features of a leg candidate.
 pub const NUM_LEG_FEATURES: usize = 17;
 
-/// Feature names, in [`leg_features`] order.
+/// Feature names, in the order of [`LegCandidate::features`].
 pub const LEG_FEATURE_NAMES: [&str; NUM_LEG_FEATURES] = [
     "points",
     "std_dev",

@@ -31,7 +31,7 @@
 //!
 //! # Determinism
 //! Voxels are fitted in sorted order and every sum is taken over fixed chunks of
-//! [`CHUNK`](super::registration::CHUNK) points combined in chunk order: the result does not
+//! [`super::registration::CHUNK`] points combined in chunk order: the result does not
 //! depend on the number of rayon threads.
 
 use super::registration::{gauss_newton_step, move_points, sum_in_order, Alignment, CHUNK};

@@ -10,7 +10,7 @@
 //! A static birth term is a broad density, and few of its particles would land where a new
 //! object is seen. Given a [`BirthProposal`] (the default in [`crate::config`]), static birth
 //! samples each term from a mixture of the term and the term conditioned on each of the
-//! step's measurements that no existing track explains ([`proposal`], [`unexplained`]), and
+//! step's measurements that no existing track explains (`proposal`, [`unexplained`]), and
 //! weights the particles prior / proposal: the same birth density, better sampled. The filter
 //! hands a birth model the step's measurements through [`BirthModel::birth_guided`].
 

@@ -10,7 +10,7 @@
 //!   practice); a lone leg is a person at that leg.
 //! * **Matching.** In every scored scan estimates and people are paired one to one, only
 //!   pairs closer than [`MATCH_DISTANCE`] (0.5 m), by the GOSPA pairing (the most pairs, then
-//!   the smallest summed distance; [`crate::metrics::gospa`]). A paired estimate is a true
+//!   the smallest summed distance; [`crate::metrics::gospa()`]). A paired estimate is a true
 //!   positive, an unpaired estimate a false person, an unpaired person a miss.
 //! * **Scans.** Scans before the 10th ([`FIRST_SCORED_SCAN`] = 9, 0-based) are not scored: a
 //!   tracker needs a few scans to confirm anyone.
