@@ -166,8 +166,26 @@ impl Columns {
     }
 
     /// Number of points with `|n·p + d| < thr` (the same arithmetic as
-    /// [`PlaneF32::residual`]), written as a plain indexed reduction so that it vectorises.
+    /// [`PlaneF32::residual`]), written as a plain indexed reduction so that it vectorises;
+    /// on x86-64 with AVX2 the same loop runs eight lanes wide (the same multiplications and
+    /// additions, never fused, so the same count).
     fn support(&self, h: &PlaneF32, thr: f32) -> usize {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has just been found to support AVX2.
+            return unsafe { self.support_avx2(h, thr) };
+        }
+        self.support_lanes(h, thr)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn support_avx2(&self, h: &PlaneF32, thr: f32) -> usize {
+        self.support_lanes(h, thr)
+    }
+
+    #[inline(always)]
+    fn support_lanes(&self, h: &PlaneF32, thr: f32) -> usize {
         let [a, b, c] = h.n;
         let d = h.d;
         let n = self.x.len();
