@@ -19,15 +19,12 @@
 //! tracking benchmark layout (see [`super::tracking`]).
 
 use super::calib::{read_cam_to_cam, read_rigid_calib, CamToCamCalib, RigidCalib};
-use super::frames::{
-    frame_file_name, list_frame_files, list_scan_files, listed_path, numbering_gaps,
-    require_contiguous,
-};
+use super::frames::{list_frame_files, numbering_gaps, require_contiguous, ScanFolder};
 use super::issue::Issue;
 use super::oxts::{read_oxts_file, OxtsPacket};
 use super::poses::{self, VehicleState};
 use super::timestamps::{read_timestamps, Timestamps};
-use crate::cloud::{read_scan_with, BinScan, NonFinite, PointCloud};
+use crate::cloud::{BinScan, NonFinite, PointCloud};
 use crate::error::{Error, Result};
 use nalgebra::Isometry3;
 use std::path::{Path, PathBuf};
@@ -47,8 +44,8 @@ type FrameFiles = Vec<(u64, PathBuf)>;
 pub struct RawDrive {
     dir: PathBuf,
     date_dir: PathBuf,
-    /// `None` when `velodyne_points/data` does not exist.
-    velodyne: Option<FrameFiles>,
+    /// `velodyne_points/data`, as listed when opened.
+    velodyne: ScanFolder,
     /// `None` when `oxts/data` does not exist.
     oxts: Option<FrameFiles>,
 }
@@ -90,12 +87,7 @@ impl RawDrive {
             Some(_) => PathBuf::from("."),
             None => dir.clone(),
         };
-        let vdir = dir.join("velodyne_points").join("data");
-        let velodyne = if vdir.is_dir() {
-            Some(list_scan_files(&vdir)?)
-        } else {
-            None
-        };
+        let velodyne = ScanFolder::open(dir.join("velodyne_points").join("data"), 10)?;
         let oxts = list_if_present(&dir.join("oxts").join("data"), "txt")?;
         Ok(RawDrive {
             dir,
@@ -145,7 +137,7 @@ impl RawDrive {
 
     /// Whether `velodyne_points/data` exists.
     pub fn has_velodyne(&self) -> bool {
-        self.velodyne.is_some()
+        self.velodyne.exists()
     }
 
     /// Whether `oxts/data` exists.
@@ -156,7 +148,7 @@ impl RawDrive {
     /// Number of scan files (`.bin`, or `.pcd` when there is no `.bin`) in
     /// `velodyne_points/data` (0 when the folder is missing).
     pub fn velodyne_count(&self) -> usize {
-        self.velodyne.as_ref().map_or(0, Vec::len)
+        self.velodyne.count()
     }
 
     /// Number of `.txt` files in `oxts/data` (0 when the folder is missing).
@@ -177,11 +169,7 @@ impl RawDrive {
     /// Path of Velodyne frame `k`: the listed `.bin` or `.pcd` file, else (whether or not it
     /// exists) the `.bin` name.
     pub fn velodyne_path(&self, k: usize) -> PathBuf {
-        self.velodyne
-            .as_deref()
-            .and_then(|v| listed_path(v, k as u64))
-            .map(Path::to_path_buf)
-            .unwrap_or_else(|| self.velodyne_dir().join(frame_file_name(k as u64, "bin")))
+        self.velodyne.path(k)
     }
 
     /// Reads Velodyne frame `k`; a non-finite value is an error naming the file and point.
@@ -191,13 +179,9 @@ impl RawDrive {
 
     /// Reads Velodyne frame `k` with a choice for non-finite points.
     pub fn velodyne_with(&self, k: usize, policy: NonFinite) -> Result<BinScan> {
-        if !self.has_velodyne() {
-            return Err(missing_folder(
-                &self.velodyne_dir(),
-                "this drive has no Velodyne point clouds",
-            ));
-        }
-        read_scan_with(self.velodyne_path(k), policy)
+        self.velodyne.read(k, policy, |dir| {
+            missing_folder(dir, "this drive has no Velodyne point clouds")
+        })
     }
 
     /// Reads every OXTS packet, in frame order.
@@ -287,17 +271,17 @@ impl RawDrive {
     /// An empty list means the drive is consistent.
     pub fn check(&self) -> Vec<Issue> {
         let mut issues = Vec::new();
-        let sensors: [(&str, &Option<FrameFiles>, PathBuf, PathBuf, &str); 2] = [
+        let sensors = [
             (
                 "no point clouds",
-                &self.velodyne,
+                self.velodyne.files(),
                 self.velodyne_dir(),
                 self.velodyne_timestamps_path(),
                 "Velodyne frames have no time stamps",
             ),
             (
                 "no OXTS packets, so no poses (point clouds only)",
-                &self.oxts,
+                self.oxts.as_deref(),
                 self.oxts_dir(),
                 self.oxts_timestamps_path(),
                 "OXTS packets have no time stamps",
@@ -348,7 +332,7 @@ impl RawDrive {
                 }
             }
         }
-        if let (Some(v), Some(o)) = (&self.velodyne, &self.oxts) {
+        if let (Some(v), Some(o)) = (self.velodyne.files(), &self.oxts) {
             if v.len() != o.len() {
                 issues.push(Issue::CountMismatch {
                     a: self.velodyne_dir(),
@@ -366,7 +350,7 @@ impl RawDrive {
                 });
             }
         }
-        for (_, path) in self.velodyne.iter().flatten() {
+        for (_, path) in self.velodyne.files().into_iter().flatten() {
             match std::fs::metadata(path) {
                 Err(e) => issues.push(Issue::Unreadable {
                     path: path.clone(),

@@ -4,6 +4,7 @@
 //!
 //! Not for: reading the files' contents.
 
+use crate::cloud::{read_scan_with, BinScan, NonFinite};
 use crate::error::{Error, Result};
 use std::path::{Path, PathBuf};
 
@@ -69,6 +70,77 @@ pub fn list_scan_files(dir: &Path) -> Result<Vec<(u64, PathBuf)>> {
         (true, false) => Ok(pcd),
         _ => Ok(bin),
     }
+}
+
+/// A recording's scan folder as listed when the recording was opened: its numbered scan
+/// files ([`list_scan_files`]), or none when the folder does not exist. Scan `k` is the listed
+/// file numbered `k`, else the `.bin` name with `digits` digits (whether or not it exists).
+#[derive(Clone, Debug)]
+pub(crate) struct ScanFolder {
+    dir: PathBuf,
+    files: Option<Vec<(u64, PathBuf)>>,
+    digits: usize,
+}
+
+impl ScanFolder {
+    /// Lists `dir` when it is a folder; names scans with `digits` digits when not listed.
+    pub(crate) fn open(dir: PathBuf, digits: usize) -> Result<Self> {
+        let files = if dir.is_dir() {
+            Some(list_scan_files(&dir)?)
+        } else {
+            None
+        };
+        Ok(ScanFolder { dir, files, digits })
+    }
+
+    /// Whether the folder exists.
+    pub(crate) fn exists(&self) -> bool {
+        self.files.is_some()
+    }
+
+    /// The listed scans, sorted by number; `None` without the folder.
+    pub(crate) fn files(&self) -> Option<&[(u64, PathBuf)]> {
+        self.files.as_deref()
+    }
+
+    /// Number of listed scans (0 without the folder).
+    pub(crate) fn count(&self) -> usize {
+        self.files.as_ref().map_or(0, Vec::len)
+    }
+
+    /// Path of scan `k`.
+    pub(crate) fn path(&self, k: usize) -> PathBuf {
+        self.files
+            .as_deref()
+            .and_then(|v| listed_path(v, k as u64))
+            .map(Path::to_path_buf)
+            .unwrap_or_else(|| {
+                self.dir
+                    .join(format!("{k:0width$}.bin", width = self.digits))
+            })
+    }
+
+    /// Reads scan `k` with a choice for non-finite points; without the folder, the error
+    /// `missing` makes from its path.
+    pub(crate) fn read(
+        &self,
+        k: usize,
+        policy: NonFinite,
+        missing: impl FnOnce(&Path) -> Error,
+    ) -> Result<BinScan> {
+        if !self.exists() {
+            return Err(missing(&self.dir));
+        }
+        read_scan_with(self.path(k), policy)
+    }
+}
+
+/// The error for reading a scan of the folder `dir` that does not exist.
+pub(crate) fn no_scans(dir: &Path) -> Error {
+    Error::io(
+        dir,
+        std::io::Error::new(std::io::ErrorKind::NotFound, "folder missing; no scans"),
+    )
 }
 
 /// The path of frame `k` in a sorted frame list, when listed.

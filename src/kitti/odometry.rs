@@ -15,11 +15,11 @@
 //! Not for: the raw-drive layout (see [`super::drive`]).
 
 use super::calib::{rigid_from_parts, CalibFile};
-use super::frames::{list_scan_files, listed_path, numbering_gaps};
+use super::frames::{no_scans, numbering_gaps, ScanFolder};
 use super::issue::Issue;
 use super::text::{numbered_lines, parse_f64, read_text};
 use crate::atomic::write_atomically;
-use crate::cloud::{read_scan_with, BinScan, NonFinite, PointCloud};
+use crate::cloud::{BinScan, NonFinite, PointCloud};
 use crate::error::{Error, Result};
 use nalgebra::{Isometry3, Matrix3, Vector3};
 use std::io::Write;
@@ -100,7 +100,7 @@ pub fn camera_to_velodyne_poses(
 pub struct OdometrySequence {
     root: PathBuf,
     name: String,
-    velodyne: Option<Vec<(u64, PathBuf)>>,
+    velodyne: ScanFolder,
 }
 
 impl OdometrySequence {
@@ -119,12 +119,7 @@ impl OdometrySequence {
                 "is not a folder",
             ));
         }
-        let vdir = dir.join("velodyne");
-        let velodyne = if vdir.is_dir() {
-            Some(list_scan_files(&vdir)?)
-        } else {
-            None
-        };
+        let velodyne = ScanFolder::open(dir.join("velodyne"), 6)?;
         Ok(OdometrySequence {
             root,
             name,
@@ -164,17 +159,13 @@ impl OdometrySequence {
 
     /// Number of Velodyne scans (0 without a `velodyne` folder).
     pub fn frame_count(&self) -> usize {
-        self.velodyne.as_ref().map_or(0, Vec::len)
+        self.velodyne.count()
     }
 
     /// Path of scan `k`: the listed `.bin` or `.pcd` file, else (whether or not it exists)
     /// `NNNNNN.bin`, six digits as in the benchmark.
     pub fn velodyne_path(&self, k: usize) -> PathBuf {
-        self.velodyne
-            .as_deref()
-            .and_then(|v| listed_path(v, k as u64))
-            .map(Path::to_path_buf)
-            .unwrap_or_else(|| self.velodyne_dir().join(format!("{k:06}.bin")))
+        self.velodyne.path(k)
     }
 
     /// Reads scan `k`; a non-finite value is an error naming the file and point.
@@ -184,14 +175,7 @@ impl OdometrySequence {
 
     /// Reads scan `k` with a choice for non-finite points.
     pub fn velodyne_with(&self, k: usize, policy: NonFinite) -> Result<BinScan> {
-        if self.velodyne.is_none() {
-            let dir = self.velodyne_dir();
-            return Err(Error::io(
-                &dir,
-                std::io::Error::new(std::io::ErrorKind::NotFound, "folder missing; no scans"),
-            ));
-        }
-        read_scan_with(self.velodyne_path(k), policy)
+        self.velodyne.read(k, policy, no_scans)
     }
 
     /// The frame times, seconds.
@@ -220,7 +204,7 @@ impl OdometrySequence {
     /// times and poses that disagree (poses are optional: only sequences 00–10 have them).
     pub fn check(&self) -> Vec<Issue> {
         let mut issues = Vec::new();
-        match &self.velodyne {
+        match self.velodyne.files() {
             None => issues.push(Issue::MissingFolder {
                 path: self.velodyne_dir(),
                 consequence: "no scans".into(),
@@ -247,7 +231,7 @@ impl OdometrySequence {
             });
         }
         let mut counted = Vec::new();
-        if let Some(files) = &self.velodyne {
+        if let Some(files) = self.velodyne.files() {
             counted.push((self.velodyne_dir(), files.len()));
         }
         if !self.times_path().exists() {

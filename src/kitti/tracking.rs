@@ -21,13 +21,13 @@
 //! [`super::odometry`]).
 
 use super::calib::{rigid_from_parts, CalibEntry, CalibFile};
-use super::frames::{list_scan_files, listed_path, numbering_gaps};
+use super::frames::{no_scans, numbering_gaps, ScanFolder};
 use super::issue::Issue;
 use super::labels::{read_tracking_labels, TrackingLabel};
 use super::oxts::OxtsPacket;
 use super::poses::{self, VehicleState};
 use super::text::{numbered_lines, read_text};
-use crate::cloud::{read_scan_with, BinScan, NonFinite, PointCloud};
+use crate::cloud::{BinScan, NonFinite, PointCloud};
 use crate::error::{Error, Result};
 use nalgebra::{Isometry3, Matrix3, Matrix3x4, Point3, Translation3, UnitQuaternion, Vector3};
 use std::path::{Path, PathBuf};
@@ -218,8 +218,8 @@ impl TrackingCalib {
 pub struct TrackingSequence {
     root: PathBuf,
     name: String,
-    /// `None` when `velodyne/NNNN` does not exist.
-    velodyne: Option<Vec<(u64, PathBuf)>>,
+    /// `velodyne/NNNN`, as listed when opened.
+    velodyne: ScanFolder,
 }
 
 impl TrackingSequence {
@@ -238,12 +238,7 @@ impl TrackingSequence {
             ));
         }
         let name = format!("{sequence:04}");
-        let vdir = root.join("velodyne").join(&name);
-        let velodyne = if vdir.is_dir() {
-            Some(list_scan_files(&vdir)?)
-        } else {
-            None
-        };
+        let velodyne = ScanFolder::open(root.join("velodyne").join(&name), 6)?;
         Ok(TrackingSequence {
             root,
             name,
@@ -285,7 +280,7 @@ impl TrackingSequence {
 
     /// Whether `velodyne/NNNN` exists.
     pub fn has_velodyne(&self) -> bool {
-        self.velodyne.is_some()
+        self.velodyne.exists()
     }
 
     /// Whether `oxts/NNNN.txt` exists.
@@ -300,7 +295,7 @@ impl TrackingSequence {
 
     /// Number of scans in `velodyne/NNNN` (0 when the folder is missing).
     pub fn velodyne_count(&self) -> usize {
-        self.velodyne.as_ref().map_or(0, Vec::len)
+        self.velodyne.count()
     }
 
     /// Number of packets in `oxts/NNNN.txt`, whatever the number of scans (0 when the file is
@@ -322,11 +317,7 @@ impl TrackingSequence {
     /// Path of scan `k`: the listed `.bin` or `.pcd` file, else (whether or not it exists)
     /// `NNNNNN.bin`, six digits as in the benchmark.
     pub fn velodyne_path(&self, k: usize) -> PathBuf {
-        self.velodyne
-            .as_deref()
-            .and_then(|v| listed_path(v, k as u64))
-            .map(Path::to_path_buf)
-            .unwrap_or_else(|| self.velodyne_dir().join(format!("{k:06}.bin")))
+        self.velodyne.path(k)
     }
 
     /// Reads scan `k`; a non-finite value is an error naming the file and point.
@@ -336,14 +327,7 @@ impl TrackingSequence {
 
     /// Reads scan `k` with a choice for non-finite points.
     pub fn velodyne_with(&self, k: usize, policy: NonFinite) -> Result<BinScan> {
-        if !self.has_velodyne() {
-            let dir = self.velodyne_dir();
-            return Err(Error::io(
-                &dir,
-                std::io::Error::new(std::io::ErrorKind::NotFound, "folder missing; no scans"),
-            ));
-        }
-        read_scan_with(self.velodyne_path(k), policy)
+        self.velodyne.read(k, policy, no_scans)
     }
 
     /// Every packet of the OXTS file, whatever the number of scans.
@@ -468,7 +452,7 @@ impl TrackingSequence {
     /// split has none). An empty list means the sequence is consistent.
     pub fn check(&self) -> Vec<Issue> {
         let mut issues = Vec::new();
-        match &self.velodyne {
+        match self.velodyne.files() {
             None => issues.push(Issue::MissingFolder {
                 path: self.velodyne_dir(),
                 consequence: "no point clouds".into(),
