@@ -4,13 +4,17 @@
 //!   confirmed targets (1 … 50), each target measured once per step with light clutter, to
 //!   show that the cost of a step grows linearly in both;
 //! * `rfs/nonlinear` and `rfs/linear`: a step of the standard benchmark scenarios (the median
-//!   of a step drawn from a whole run).
+//!   of a step drawn from a whole run);
+//! * `rfs/nonlinear/whole_run_1000_particles_smoothed_lag_5`: the same nonlinear run keeping
+//!   five steps of particle history and handing every step's estimates out smoothed
+//!   (`FixedLagSmoother`), against the run above for the smoother's cost.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use smc_lmb::filter::birth::BirthEvidence;
 use smc_lmb::filter::StepContext;
 use smc_lmb::filter::{
-    BirthModel, BirthTrack, Frame, LmbConfig, LmbFilter, Measurements, StaticBirth,
+    BirthModel, BirthTrack, FixedLagSmoother, Frame, LmbConfig, LmbFilter, Measurements,
+    StaticBirth,
 };
 use smc_lmb::models::{ConstantDetection, ConstantVelocity, PositionMeasurement, UniformClutter};
 use smc_lmb::rng::seeded;
@@ -128,6 +132,35 @@ fn rfs(c: &mut Criterion) {
                 f.tracks().len()
             })
         });
+        if name == "nonlinear" {
+            let lag = 5;
+            g.bench_function(
+                format!("{name}/whole_run_{particles}_particles_smoothed_lag_{lag}"),
+                |b| {
+                    b.iter(|| {
+                        let config = LmbConfig {
+                            particles,
+                            smoothing_lag: lag,
+                            ..LmbConfig::default()
+                        };
+                        let mut f = scenario.filter(config, Default::default()).unwrap();
+                        let mut smoother = FixedLagSmoother::new(lag);
+                        let mut rng = seeded(3);
+                        let mut handed = 0;
+                        for (k, z) in sim.measurements.iter().enumerate() {
+                            let est = f
+                                .step(
+                                    &Frame::new(k as f64, Measurements::from_rows(2, z).unwrap()),
+                                    &mut rng,
+                                )
+                                .unwrap();
+                            handed += smoother.push(&f, est).unwrap().map_or(0, |e| e.len());
+                        }
+                        handed + smoother.finish(&f).len()
+                    })
+                },
+            );
+        }
     }
     g.finish();
 }
