@@ -1,12 +1,9 @@
 //! Points grouped by the voxel (a cube of a given edge, aligned to the origin) they fall
 //! into, in linear time: voxels are numbered by a hash table in the order their first point
 //! appears, then the point indices are placed by a counting sort on that number. The members
-//! of a voxel are one contiguous, ascending slice, and the first member of each voxel is a
-//! natural representative: thinning a scan to one point per voxel keeps real points (their
-//! noise is the sensor's) in the input order.
+//! of a voxel are one contiguous, ascending slice.
 //!
-//! Used by the plane segmentation (it works on the representatives and hands its labels back
-//! to every member) and by the RANSAC's triple sampling (the points of a coarse cell).
+//! Used by the plane RANSAC's triple sampling (the points of a coarse cell).
 //!
 //! Not for: neighbour queries across voxels (see [`crate::cloud::cluster`]), or points with a
 //! non-finite coordinate (the caller drops them first).
@@ -104,24 +101,6 @@ impl VoxelGroups {
     pub fn group_of(&self, i: usize) -> usize {
         self.group_of[i] as usize
     }
-
-    /// The first point of every voxel, in voxel order (ascending: voxels are numbered by
-    /// their first point).
-    pub fn firsts(&self) -> impl Iterator<Item = u32> + '_ {
-        self.start[..self.len()]
-            .iter()
-            .map(|&s| self.order[s as usize])
-    }
-
-    /// The points of the voxels `groups`, ascending.
-    pub fn points_of(&self, groups: impl IntoIterator<Item = u32>) -> Vec<u32> {
-        let mut out: Vec<u32> = Vec::new();
-        for g in groups {
-            out.extend_from_slice(self.members(g as usize));
-        }
-        out.sort_unstable();
-        out
-    }
 }
 
 /// A 64-bit mix of a voxel's three coordinates.
@@ -151,9 +130,7 @@ mod tests {
         assert_eq!(g.members(0), &[0, 2]);
         assert_eq!(g.members(1), &[1, 4]);
         assert_eq!(g.members(2), &[3]);
-        assert_eq!(g.firsts().collect::<Vec<_>>(), vec![0, 1, 3]);
         assert_eq!(g.group_of(4), 1);
-        assert_eq!(g.points_of([2, 0]), vec![0, 2, 3]);
         assert!(VoxelGroups::new(&[], 1.0).is_empty());
     }
 

@@ -1,8 +1,9 @@
 //! Numbered frame files: KITTI stores one file per frame, named by the frame index padded to
 //! ten digits (`0000000042.bin`, `0000000042.txt`). This module lists such files in a folder,
-//! finds gaps in the numbering, and builds the names.
+//! finds gaps in the numbering, builds the names, and keeps a recording's listed scan folder
+//! ([`ScanFolder`]), whose scans it hands to the point-cloud readers.
 //!
-//! Not for: reading the files' contents.
+//! Not for: parsing the files' contents (see [`crate::cloud`] and the layout readers).
 
 use crate::cloud::{read_scan_with, BinScan, NonFinite};
 use crate::error::{Error, Result};
