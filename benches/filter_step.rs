@@ -18,7 +18,7 @@ use smc_lmb::filter::{
 };
 use smc_lmb::models::{ConstantDetection, ConstantVelocity, PositionMeasurement, UniformClutter};
 use smc_lmb::rng::seeded;
-use smc_lmb::sim::Scenario;
+use smc_lmb::sim::{Scenario, SimRun};
 use smc_lmb::FilterRng;
 use std::time::Duration;
 
@@ -103,6 +103,38 @@ fn scaling(c: &mut Criterion) {
     g.finish();
 }
 
+/// A whole run of `scenario`'s measurements `sim` with `particles` per track; with `lag` > 0
+/// the tracks keep that many steps of history and every step's estimates are handed out
+/// smoothed. Returns how many tracks (or smoothed estimates) there were, so nothing is
+/// optimised away.
+fn whole_run(scenario: &Scenario, sim: &SimRun, particles: usize, lag: usize) -> usize {
+    let config = LmbConfig {
+        particles,
+        smoothing_lag: lag,
+        ..LmbConfig::default()
+    };
+    let mut f = scenario.filter(config, Default::default()).unwrap();
+    let mut smoother = FixedLagSmoother::new(lag);
+    let mut rng = seeded(3);
+    let mut handed = 0;
+    for (k, z) in sim.measurements.iter().enumerate() {
+        let est = f
+            .step(
+                &Frame::new(k as f64, Measurements::from_rows(2, z).unwrap()),
+                &mut rng,
+            )
+            .unwrap();
+        if lag > 0 {
+            handed += smoother.push(&f, est).unwrap().map_or(0, |e| e.len());
+        }
+    }
+    if lag > 0 {
+        handed + smoother.finish(&f).len()
+    } else {
+        f.tracks().len()
+    }
+}
+
 fn rfs(c: &mut Criterion) {
     let mut g = c.benchmark_group("rfs");
     g.sample_size(10)
@@ -115,50 +147,13 @@ fn rfs(c: &mut Criterion) {
         let sim = scenario.generate(1).unwrap();
         g.throughput(Throughput::Elements(scenario.steps as u64));
         g.bench_function(format!("{name}/whole_run_{particles}_particles"), |b| {
-            b.iter(|| {
-                let config = LmbConfig {
-                    particles,
-                    ..LmbConfig::default()
-                };
-                let mut f = scenario.filter(config, Default::default()).unwrap();
-                let mut rng = seeded(3);
-                for (k, z) in sim.measurements.iter().enumerate() {
-                    f.step(
-                        &Frame::new(k as f64, Measurements::from_rows(2, z).unwrap()),
-                        &mut rng,
-                    )
-                    .unwrap();
-                }
-                f.tracks().len()
-            })
+            b.iter(|| whole_run(&scenario, &sim, particles, 0))
         });
         if name == "nonlinear" {
             let lag = 5;
             g.bench_function(
                 format!("{name}/whole_run_{particles}_particles_smoothed_lag_{lag}"),
-                |b| {
-                    b.iter(|| {
-                        let config = LmbConfig {
-                            particles,
-                            smoothing_lag: lag,
-                            ..LmbConfig::default()
-                        };
-                        let mut f = scenario.filter(config, Default::default()).unwrap();
-                        let mut smoother = FixedLagSmoother::new(lag);
-                        let mut rng = seeded(3);
-                        let mut handed = 0;
-                        for (k, z) in sim.measurements.iter().enumerate() {
-                            let est = f
-                                .step(
-                                    &Frame::new(k as f64, Measurements::from_rows(2, z).unwrap()),
-                                    &mut rng,
-                                )
-                                .unwrap();
-                            handed += smoother.push(&f, est).unwrap().map_or(0, |e| e.len());
-                        }
-                        handed + smoother.finish(&f).len()
-                    })
-                },
+                |b| b.iter(|| whole_run(&scenario, &sim, particles, lag)),
             );
         }
     }

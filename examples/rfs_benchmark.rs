@@ -137,8 +137,8 @@ fn run_once(
                     .push((o.distance, o.localisation, o.cardinality));
             }
         }
-        let x: Vec<Vec<f64>> = est.iter().map(|e| vec![e.state[0], e.state[2]]).collect();
-        let truth: Vec<Vec<f64>> = sim.truth[k].iter().map(|(_, s)| vec![s[0], s[2]]).collect();
+        let x = position(&est);
+        let truth = truth_at(k);
         let o = ospa(&truth, &x, c, p)?;
         let g = gospa(&truth, &x, c, p)?;
         out.ospa.push(o.distance);
