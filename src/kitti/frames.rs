@@ -1,7 +1,7 @@
 //! Numbered frame files: KITTI stores one file per frame, named by the frame index padded to
 //! ten digits (`0000000042.bin`, `0000000042.txt`). This module lists such files in a folder,
 //! finds gaps in the numbering, builds the names, and keeps a recording's listed scan folder
-//! ([`ScanFolder`]), whose scans it hands to the point-cloud readers.
+//! (`ScanFolder`), whose scans it hands to the point-cloud readers.
 //!
 //! Not for: parsing the files' contents (see [`crate::cloud`] and the layout readers).
 
