@@ -17,7 +17,14 @@
 //!    with [`LEG_ICP`]: the scanner's own motion, no odometry needed) and the motion is the
 //!    mean distance from the segment's aligned returns to the nearest return of the previous
 //!    scan, capped at 1 m (−1 on the first scan or when the alignment fails). Walls and furniture stay
-//!    put; a walking person's legs do not.
+//!    put; a walking person's legs do not. Between two scans a leg in its stance phase does
+//!    not move either, so the last feature looks [`MOTION_LAG`] seconds back (0.6 s: five
+//!    scans at 7.5 Hz), when a walking person stood elsewhere: the share of the segment's
+//!    returns whose place that scan saw through (placed there by the chained alignments, the
+//!    three beams around its bearing all reached [`SEEN_THROUGH_MARGIN`] farther), among
+//!    those it saw at all (not hidden behind something nearer); −1 when it saw none. A place
+//!    newly in view because the scanner moved was hidden or out of view then, not free, so a
+//!    moving scanner does not make its room move.
 //! 3. **Legs**: a segment whose boosted score exceeds [`LegDetectorConfig::leg_score`].
 //! 4. **People** ([`pair_legs`]): legs closer than `pair_distance` are paired, closest pairs
 //!    first, into a person at their mean; a leg left alone is a person only when its score
@@ -38,12 +45,13 @@ use super::features::{segment_features, SegmentContext};
 use super::icp::{Icp, IcpConfig};
 use super::scan::Scan;
 use crate::error::{Error, Result};
-use crate::geometry::pose2::{compose, identity, transform_point};
+use crate::geometry::pose2::{compose, identity, inverse, transform_point};
 use crate::geometry::Pose2;
 use serde::{Deserialize, Serialize};
+use std::collections::VecDeque;
 
 /// Number of features of a leg candidate.
-pub const NUM_LEG_FEATURES: usize = 17;
+pub const NUM_LEG_FEATURES: usize = 18;
 
 /// Feature names, in the order of [`LegCandidate::features`].
 pub const LEG_FEATURE_NAMES: [&str; NUM_LEG_FEATURES] = [
@@ -64,6 +72,7 @@ pub const LEG_FEATURE_NAMES: [&str; NUM_LEG_FEATURES] = [
     "occlusion_prev",
     "occlusion_next",
     "motion",
+    "seen_through",
 ];
 
 /// Settings of the detector (see the module documentation).
@@ -124,12 +133,12 @@ pub struct LegCandidate {
 }
 
 /// The leg candidates of `scan` (steps 1 and 2 of the module documentation); `motion` gives
-/// the motion feature of a segment's returns ([`LegDetector::candidates`] measures it against
-/// the previous scan).
+/// the two motion features of a segment's returns ([`LegDetector::candidates`] measures them
+/// against the previous scan and the scan [`MOTION_LAG`] earlier).
 pub fn leg_segments(
     scan: &Scan,
     config: &LegDetectorConfig,
-    motion: &dyn Fn(&[[f64; 2]]) -> f64,
+    motion: &dyn Fn(&[[f64; 2]]) -> [f64; 2],
 ) -> Result<Vec<LegCandidate>> {
     // Every segment, filtered or not, so that jumps and occlusions see all neighbours.
     let mut segs: Vec<Vec<(usize, [f64; 2])>> = Vec::new();
@@ -187,7 +196,7 @@ pub fn leg_segments(
         features[13] = range;
         features[14] = occl(prev, first);
         features[15] = occl(next, lastp);
-        features[16] = motion(&pts);
+        [features[16], features[17]] = motion(&pts);
         out.push(LegCandidate {
             beams: (s[0].0, s[s.len() - 1].0 + 1),
             centroid: c,
@@ -339,6 +348,9 @@ pub struct LegDetector {
     pose: Pose2,
     /// The last alignment's motion, the next alignment's first guess.
     step: Pose2,
+    /// The recent scans with their poses in the first scan's frame, oldest first: the
+    /// lagged motion's reference.
+    recent: VecDeque<(Pose2, Scan)>,
 }
 
 /// Motion feature when it cannot be measured.
@@ -365,6 +377,47 @@ pub const LEG_ICP: IcpConfig = IcpConfig {
 /// its target).
 pub const ICP_STRIDE: usize = 3;
 
+/// The seen-through feature looks back to the latest scan at least this much older (s).
+pub const MOTION_LAG: f64 = 0.6;
+
+/// A place counts as seen through when the earlier scan's beams reached this much beyond it
+/// (m).
+pub const SEEN_THROUGH_MARGIN: f64 = 0.15;
+
+/// Scans kept for the seen-through feature at most (a fast scanner keeps [`MOTION_LAG`] of
+/// them only as far as this goes).
+const MAX_RECENT_SCANS: usize = 64;
+
+/// Share of `places` (in the frame of the scan `then`) that `then` saw through: the three
+/// beams nearest the place's bearing all reached [`SEEN_THROUGH_MARGIN`] beyond it (a "no
+/// return" beam reaches everywhere), among the places it saw at all (a place hidden behind a
+/// nearer return, or outside its field of view, does not count); [`UNKNOWN_MOTION`] when it
+/// saw none.
+fn seen_through(then: &Scan, places: impl Iterator<Item = [f64; 2]>) -> f64 {
+    let reach = |i: usize| then.range(i).unwrap_or(f64::INFINITY);
+    let (mut free, mut seen) = (0usize, 0usize);
+    for q in places {
+        let d = q[0].hypot(q[1]);
+        let beam = ((q[1].atan2(q[0]) - then.angle_min) / then.angle_increment).round();
+        if !(beam >= 1.0 && beam < then.len() as f64 - 1.0) {
+            continue;
+        }
+        let j = beam as usize;
+        let (a, b, c) = (reach(j - 1), reach(j), reach(j + 1));
+        if a.min(b).min(c) > d + SEEN_THROUGH_MARGIN {
+            free += 1;
+            seen += 1;
+        } else if a.max(b).max(c) > d - SEEN_THROUGH_MARGIN {
+            seen += 1;
+        }
+    }
+    if seen == 0 {
+        UNKNOWN_MOTION
+    } else {
+        free as f64 / seen as f64
+    }
+}
+
 impl LegDetector {
     /// A detector running `model` with its own settings.
     pub fn new(model: LegModel) -> Result<Self> {
@@ -378,6 +431,7 @@ impl LegDetector {
             source: Vec::new(),
             pose: identity(),
             step: identity(),
+            recent: VecDeque::new(),
         })
     }
 
@@ -386,8 +440,8 @@ impl LegDetector {
         LegDetector::new(LegModel::shipped()?)
     }
 
-    /// The leg candidates of the next scan, with the motion feature measured against the
-    /// scan before it.
+    /// The leg candidates of the next scan, with the motion features measured against the
+    /// scan before it and against the scan [`MOTION_LAG`] earlier.
     pub fn candidates(&mut self, scan: &Scan) -> Result<Vec<LegCandidate>> {
         self.current.clear();
         self.current.extend(scan.points().map(|(_, p)| p));
@@ -403,9 +457,19 @@ impl LegDetector {
         if let Some(f) = fit {
             self.step = f.transform;
         }
+        // A failed alignment counts as standing still.
+        let pose = fit.map_or(self.pose, |f| compose(self.pose, f.transform));
+        while self.recent.len() > 1 && self.recent[1].1.time <= scan.time - MOTION_LAG {
+            self.recent.pop_front();
+        }
+        let lagged = self
+            .recent
+            .front()
+            .filter(|(_, s)| s.time <= scan.time - MOTION_LAG)
+            .map(|(p, s)| (compose(inverse(*p), pose), s));
         let icp = &self.icp;
-        let motion = |pts: &[[f64; 2]]| match fit {
-            Some(f) => {
+        let motion = |pts: &[[f64; 2]]| {
+            let last = fit.map_or(UNKNOWN_MOTION, |f| {
                 pts.iter()
                     .map(|&p| {
                         icp.nearest_target_distance(transform_point(f.transform, p))
@@ -413,13 +477,18 @@ impl LegDetector {
                     })
                     .sum::<f64>()
                     / pts.len() as f64
-            }
-            None => UNKNOWN_MOTION,
+            });
+            let through = lagged.map_or(UNKNOWN_MOTION, |(to_then, then)| {
+                seen_through(then, pts.iter().map(|&p| transform_point(to_then, p)))
+            });
+            [last, through]
         };
         let out = leg_segments(scan, &self.config, &motion)?;
-        if let Some(f) = fit {
-            self.pose = compose(self.pose, f.transform);
+        self.pose = pose;
+        if self.recent.len() == MAX_RECENT_SCANS {
+            self.recent.pop_front();
         }
+        self.recent.push_back((pose, scan.clone()));
         std::mem::swap(&mut self.previous, &mut self.current);
         Ok(out)
     }
@@ -509,7 +578,7 @@ mod tests {
     #[test]
     fn leg_sized_discs_are_candidates_with_their_features() {
         let s = scan_with_legs();
-        let c = leg_segments(&s, &LegDetectorConfig::default(), &|_| 0.5).unwrap();
+        let c = leg_segments(&s, &LegDetectorConfig::default(), &|_| [0.5, 0.25]).unwrap();
         let near: Vec<_> = c.iter().filter(|c| c.features[13] < 3.0).collect();
         assert_eq!(near.len(), 2, "{c:?}");
         for l in near {
@@ -523,6 +592,7 @@ mod tests {
                 l.features[8]
             );
             assert_eq!(l.features[16], 0.5);
+            assert_eq!(l.features[17], 0.25);
         }
         // The wall itself is far wider than max_width: split into pieces or dropped.
         assert!(c.iter().all(|c| c.features[5] <= 0.8));
@@ -640,6 +710,128 @@ mod tests {
             again.iter().all(|c| (0.0..0.01).contains(&c.features[16])),
             "{again:?}"
         );
+    }
+
+    /// A scan of a straight wall at x = 4 m, 201 beams over ±0.5 rad, with "no return" on
+    /// the beams of bearings above 0.3 rad.
+    fn wall_then() -> Scan {
+        let (a0, inc) = (-0.5f64, 0.005f64);
+        let ranges = (0..201)
+            .map(|i| {
+                let b = a0 + inc * i as f64;
+                if b > 0.3 {
+                    f32::INFINITY
+                } else {
+                    (4.0 / b.cos()) as f32
+                }
+            })
+            .collect();
+        Scan::new(0.0, a0, inc, ranges, 0.0, 30.0).unwrap()
+    }
+
+    #[test]
+    fn seen_through_counts_free_places_among_those_seen() {
+        let then = wall_then();
+        // Free in front of the wall, on the wall itself, and behind it (hidden).
+        let (free, on, behind) = ([2.0, 0.0], [4.0, 0.1], [6.0, -0.2]);
+        assert_eq!(seen_through(&then, [free, free].into_iter()), 1.0);
+        assert_eq!(seen_through(&then, [on].into_iter()), 0.0);
+        assert_eq!(seen_through(&then, [free, on, behind].into_iter()), 0.5);
+        // Within the margin of the wall: seen, not free.
+        assert_eq!(seen_through(&then, [[3.9, 0.0]].into_iter()), 0.0);
+        // Where the beams returned nothing the scanner saw through everything.
+        assert_eq!(seen_through(&then, [[10.0, 5.0]].into_iter()), 1.0);
+        // Only hidden places, or places outside the field of view: unknown.
+        assert_eq!(seen_through(&then, [behind].into_iter()), UNKNOWN_MOTION);
+        assert_eq!(
+            seen_through(&then, [[-1.0, 0.0]].into_iter()),
+            UNKNOWN_MOTION
+        );
+        assert_eq!(seen_through(&then, std::iter::empty()), UNKNOWN_MOTION);
+    }
+
+    #[test]
+    fn a_walking_leg_is_seen_through_and_a_still_post_is_not() {
+        // A still scanner, a wall at 4 m, a post at (3, 0.6) and a leg-sized disc at x = 2 m
+        // that walks across the line of sight: once the detector has a scan MOTION_LAG old,
+        // the disc stands where that scan saw the wall behind (free), the post where it saw
+        // the post.
+        let scan_at = |t: f64, y: f64| {
+            let (a0, inc) = (-0.7f64, 0.0035f64);
+            let ranges = (0..401)
+                .map(|i| {
+                    let b = a0 + inc * i as f64;
+                    let (dx, dy) = (b.cos(), b.sin());
+                    let mut r = 4.0 / dx;
+                    for (cx, cy) in [(2.0, y), (3.0, 0.6)] {
+                        let tc = cx * dx + cy * dy;
+                        let d2 = cx * cx + cy * cy - tc * tc;
+                        if d2 < 0.06 * 0.06 {
+                            r = r.min(tc - (0.06 * 0.06 - d2).sqrt());
+                        }
+                    }
+                    r as f32
+                })
+                .collect();
+            Scan::new(t, a0, inc, ranges, 0.0, 30.0).unwrap()
+        };
+        let mut d = LegDetector::shipped().unwrap();
+        let mut last = Vec::new();
+        for k in 0..8 {
+            // 1 m/s, 7.5 scans a second.
+            let t = k as f64 / 7.5;
+            last = d.candidates(&scan_at(t, -0.8 + t)).unwrap();
+            if t < MOTION_LAG {
+                assert!(last.iter().all(|c| c.features[17] == UNKNOWN_MOTION));
+            }
+        }
+        let near = |x: f64| {
+            last.iter()
+                .find(|c| (c.centroid[0] - x).abs() < 0.2)
+                .expect("a candidate")
+                .features[17]
+        };
+        assert_eq!(near(2.0), 1.0, "{last:?}");
+        assert_eq!(near(3.0), 0.0, "{last:?}");
+    }
+
+    #[test]
+    fn a_still_post_is_not_seen_through_by_a_moving_scanner() {
+        // The scanner drives 5 cm a scan through a room (walls at x = 4 m, y = ±2.5 m) with a
+        // post at (3, 0.6): only the chained alignments place the post where the earlier scan
+        // saw it (0.3 m nearer to the scanner then, which would look free).
+        let scan_from = |k: usize| {
+            let x = 0.05 * k as f64;
+            let (a0, inc) = (-1.2f64, 0.006f64);
+            let ranges = (0..401)
+                .map(|i| {
+                    let b = a0 + inc * i as f64;
+                    let (dx, dy) = (b.cos(), b.sin());
+                    let mut r = (4.0 - x) / dx;
+                    if dy.abs() > 1e-9 {
+                        r = r.min(2.5 / dy.abs());
+                    }
+                    let (cx, cy) = (3.0 - x, 0.6);
+                    let tc = cx * dx + cy * dy;
+                    let d2 = cx * cx + cy * cy - tc * tc;
+                    if d2 < 0.06 * 0.06 {
+                        r = r.min(tc - (0.06 * 0.06 - d2).sqrt());
+                    }
+                    r as f32
+                })
+                .collect();
+            Scan::new(k as f64 / 7.5, a0, inc, ranges, 0.0, 30.0).unwrap()
+        };
+        let mut d = LegDetector::shipped().unwrap();
+        let mut last = Vec::new();
+        for k in 0..10 {
+            last = d.candidates(&scan_from(k)).unwrap();
+        }
+        let post = last
+            .iter()
+            .find(|c| (c.centroid[0] - 2.55).abs() < 0.2 && (c.centroid[1] - 0.6).abs() < 0.2)
+            .expect("the post is a candidate");
+        assert_eq!(post.features[17], 0.0, "{post:?}");
     }
 
     /// A scan from (`x`, 0) facing +x in a room with walls at x = 4 m and y = ±2.5 m.
