@@ -234,12 +234,12 @@ pub const LEGS_DETECTION_PROBABILITY: f64 = 0.8;
 /// doubts score below 0 and count against it). Chosen on the leave-one-bag-out folds of
 /// `examples/train_legs.rs` (tracker F1 / false people per empty-room scan, seeds 1–12
 /// pooled, floor −0.08, p_D 0.8, the 0.5 m gate and [`LEGS_PRUNE_THRESHOLD`]) with the
-/// classifier's seen-through feature: evidence 0.4 0.827 / 0.013 (0.050 on one held-out
-/// laser), **0.5 0.826 / 0.006** (0.816–0.834 per four seeds), 0.6 0.811 / 0.000. The shipped
-/// model reports nobody in `negative_2.bag` with 0.5 (any laser, seeds 0–7). Before the
-/// seen-through feature the classifier's scores took 0.6 (0.799 / 0.000). Reporting people
-/// only (no doubted legs) with p_D 0.7 and 8 expected detections, as at first, gave 0.646 /
-/// 0.017.
+/// classifier of today (side-free jumps and occlusions, the seen-through feature, things
+/// carried along dropped): **0.5 0.826 / 0.006** (0.794–0.855 per four seeds), 0.6 0.811 /
+/// 0.002. With the seen-through feature alone: 0.4 0.827 / 0.013 (0.050 on one held-out
+/// laser), 0.5 0.826 / 0.006, 0.6 0.811 / 0.000. Before it the classifier's scores took 0.6
+/// (0.799 / 0.000). Reporting people only (no doubted
+/// legs) with p_D 0.7 and 8 expected detections, as at first, gave 0.646 / 0.017.
 pub const LEGS_CONFIRM_EVIDENCE: f64 = 0.5;
 
 /// Existence below which a track behind [`FrontEnd::Legs`] is dropped (the filter's default
