@@ -22,10 +22,12 @@
 //! remove), `moving` for scenario two (the lobby's walls, pillars and desk) and for
 //! recordings. `--pose icp` hands the trackers the detector's ICP-corrected pose.
 //!
-//! With `--carmen` or `--bag` a recording is tracked end to end instead (LMB only): per-scan
+//! With `--carmen` or `--bag` a recording is tracked end to end instead by the LMB: per-scan
 //! people as JSON (`--out`), a plot of the tracks over the scan points (`--plot`, `.svg` or
 //! `.png`), and a summary of the tracks on standard output. `--truth-topic` scores a bag
-//! against its leg annotations, `--empty` a recording without people:
+//! against its leg annotations, `--empty` a recording without people; a scored recording also
+//! runs the baselines of `--trackers` on the people the front end handed the LMB
+//! (`pipeline::people_tracking::baselines`) and scores them the same way:
 //!
 //! ```text
 //! cargo run --release --example laser2d -- --bag positive_1_extracted.bag --topic /training_scan \
@@ -409,13 +411,19 @@ mod recording {
     use smc_lmb::laser2d::{
         read_bag, read_carmen, read_pose_arrays, BagOptions, CarmenOptions, Scan, TimeOrder,
     };
+    use smc_lmb::models::RangeBearing;
+    use smc_lmb::pipeline::people_tracking::baselines::track_front_end_people;
     use smc_lmb::pipeline::people_tracking::score::{
         truth_for_scans, DetectionScore, TrackScore, TrackScoreSummary, FIRST_SCORED_SCAN,
     };
     use smc_lmb::pipeline::people_tracking::{
-        config_for_scans, track_scans_with_model, write_people_json, PeopleRun,
+        centre_noise, config_for_scans, track_scans_with_model, write_people_json, PeopleRun,
     };
     use smc_lmb::pipeline::people_tracking::{write_people_plot, PeoplePlotOptions};
+    use smc_lmb::trackers::{
+        GnnConfig, GnnTracker, JpdaImmConfig, JpdaImmTracker, MlRansacConfig, MlRansacTracker,
+        PointTracker,
+    };
     use std::path::Path;
     use std::time::Instant;
 
@@ -429,6 +437,8 @@ mod recording {
         pub tracker: TrackScoreSummary,
         /// The tracker's visible people classed dynamic.
         pub dynamic: TrackScoreSummary,
+        /// The baselines of `--trackers` on the front end's people, by name.
+        pub baselines: Vec<(String, TrackScoreSummary)>,
     }
 
     /// Tracks the recording, writes and prints what `args` ask for; the scores when the run
@@ -470,9 +480,77 @@ mod recording {
         report(&scans, &run, read_s, secs);
         if args.truth_topic.is_some() || args.empty {
             let truth = truth(args, &scans)?;
-            return Ok(Some(score(&run, &truth, min_visibility)?));
+            let mut scores = score(&run, &truth, min_visibility)?;
+            for name in args.trackers.split(',').map(str::trim) {
+                if name != "lmb" {
+                    let b = score_baseline(args, name, &scans, &run, &truth)?;
+                    scores.baselines.push((name.to_string(), b));
+                }
+            }
+            return Ok(Some(scores));
         }
         Ok(None)
+    }
+
+    /// Runs the baseline `name` on the front end's people of `run`, prints its scores as the
+    /// LMB's are printed and returns them.
+    fn score_baseline(
+        args: &Args,
+        name: &str,
+        scans: &[Scan],
+        run: &PeopleRun,
+        truth: &[Vec<[f64; 2]>],
+    ) -> Result<TrackScoreSummary> {
+        let mut tracker = baseline(args, name, &scans[0])?;
+        let t0 = Instant::now();
+        let tracks = track_front_end_people(run, scans, tracker.as_mut())
+            .with_context(|| format!("{name} on the front end's people"))?;
+        let secs = t0.elapsed().as_secs_f64();
+        let mut score = TrackScore::default();
+        for ((s, t), est) in run.scans.iter().zip(truth).zip(&tracks) {
+            score.add_scan(t, est, s.scan >= FIRST_SCORED_SCAN)?;
+        }
+        let t = score.summary();
+        let d = &t.detection;
+        println!(
+            "{name}: {} scans scored, {} people, {} reported; precision {:.3}, recall {:.3}, F1 {:.3}, false people per scan {:.3}",
+            d.scans, d.people, d.estimates, d.precision(), d.recall(), d.f1(), d.false_per_scan()
+        );
+        println!(
+            "{name}: MOTA {:.3}, IDF1 {:.3}, ID switches {} (tracked in {:.3} s)",
+            t.mota, t.idf1, t.id_switches, secs
+        );
+        Ok(t)
+    }
+
+    /// A baseline for a recorded scanner: the beam noise of `--sigma-range` and
+    /// `--sigma-bearing` at a person's centre (as the LMB assumes it); the JPDA's clutter
+    /// spread over the scanner's field of view and range.
+    fn baseline(args: &Args, name: &str, first: &Scan) -> Result<Box<dyn PointTracker>> {
+        let (sr, sb) = centre_noise(args.sigma_range, args.sigma_bearing);
+        let sensor = RangeBearing::new(sr, sb)?;
+        Ok(match name {
+            "gnn" => Box::new(GnnTracker::new(GnnConfig::new(sensor))?),
+            "ml_ransac" => {
+                let mut cfg = MlRansacConfig::new(sensor);
+                cfg.seed = args.seed;
+                Box::new(MlRansacTracker::new(cfg)?)
+            }
+            "jpda_imm" => {
+                let mut cfg = JpdaImmConfig::new(sensor);
+                let fov = (first.angle_max() - first.angle_min).abs() + first.angle_increment.abs();
+                let range = if first.range_max.is_finite() {
+                    first.range_max.min(args.max_range)
+                } else {
+                    args.max_range
+                };
+                cfg.clutter_density = 1.0 / (fov * range);
+                Box::new(JpdaImmTracker::new(cfg)?)
+            }
+            other => {
+                anyhow::bail!("unknown tracker `{other}` (expected lmb, gnn, ml_ransac, jpda_imm)")
+            }
+        })
     }
 
     /// The people of every scan: from the annotations of `--truth-topic`, or nobody.
@@ -545,6 +623,7 @@ mod recording {
             front_end: detector,
             tracker: tracks.summary(),
             dynamic: walking.summary(),
+            baselines: Vec::new(),
         };
         for (what, t) in [
             ("tracker", &scores.tracker),
@@ -776,6 +855,15 @@ mod tests {
         assert!(s.tracker.detection.f1() >= 0.9, "{s:?}");
         assert_eq!(s.tracker.id_switches, 0);
         assert_eq!(run.tracks_with(20).count(), 1, "{:?}", run.tracks);
+        // The baselines ran on the same people and were scored on the same scans.
+        let names: Vec<&str> = s.baselines.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(names, ["gnn", "ml_ransac", "jpda_imm"]);
+        for (name, b) in &s.baselines {
+            assert_eq!(b.detection.scans, s.tracker.detection.scans, "{name}");
+            assert_eq!(b.detection.people, s.tracker.detection.people, "{name}");
+            assert_sane(&b.detection);
+            assert!(b.detection.recall() >= 0.8, "{name}: {b:?}");
+        }
     }
 
     #[test]

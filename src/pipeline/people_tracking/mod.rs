@@ -12,6 +12,7 @@
 //! Not for: reading or segmenting scans (see [`crate::laser2d`]) or the baseline trackers
 //! themselves (see [`crate::trackers`]).
 
+pub mod baselines;
 pub mod birth;
 pub mod evaluate;
 pub mod front_end;
