@@ -799,26 +799,7 @@ mod tests {
         // MOTION_LAG (0.6 s, 0.23 m driven) the disc is dropped, the post is kept.
         let scan_from = |k: usize| {
             let x = 0.05 * k as f64;
-            let (a0, inc) = (-1.2f64, 0.006f64);
-            let ranges = (0..401)
-                .map(|i| {
-                    let b = a0 + inc * i as f64;
-                    let (dx, dy) = (b.cos(), b.sin());
-                    let mut r = (4.0 - x) / dx;
-                    if dy.abs() > 1e-9 {
-                        r = r.min(2.5 / dy.abs());
-                    }
-                    for (cx, cy) in [(3.0 - x, 0.6), (1.0, -0.8)] {
-                        let tc = cx * dx + cy * dy;
-                        let d2 = cx * cx + cy * cy - tc * tc;
-                        if d2 < 0.06 * 0.06 {
-                            r = r.min(tc - (0.06 * 0.06 - d2).sqrt());
-                        }
-                    }
-                    r as f32
-                })
-                .collect();
-            Scan::new(k as f64 / 7.5, a0, inc, ranges, 0.0, 30.0).unwrap()
+            room_scan(k as f64 / 7.5, x, &[[3.0 - x, 0.6], [1.0, -0.8]])
         };
         let near = |c: &[LegCandidate], p: [f64; 2]| {
             c.iter()
@@ -880,29 +861,11 @@ mod tests {
 
     #[test]
     fn a_walking_leg_is_seen_through_and_a_still_post_is_not() {
-        // A still scanner, a wall at 4 m, a post at (3, 0.6) and a leg-sized disc at x = 2 m
-        // that walks across the line of sight: once the detector has a scan MOTION_LAG old,
+        // A still scanner in a room, a post at (3, 0.6) and a leg-sized disc at x = 2 m that
+        // walks across the line of sight: once the detector has a scan MOTION_LAG old,
         // the disc stands where that scan saw the wall behind (free), the post where it saw
         // the post.
-        let scan_at = |t: f64, y: f64| {
-            let (a0, inc) = (-0.7f64, 0.0035f64);
-            let ranges = (0..401)
-                .map(|i| {
-                    let b = a0 + inc * i as f64;
-                    let (dx, dy) = (b.cos(), b.sin());
-                    let mut r = 4.0 / dx;
-                    for (cx, cy) in [(2.0, y), (3.0, 0.6)] {
-                        let tc = cx * dx + cy * dy;
-                        let d2 = cx * cx + cy * cy - tc * tc;
-                        if d2 < 0.06 * 0.06 {
-                            r = r.min(tc - (0.06 * 0.06 - d2).sqrt());
-                        }
-                    }
-                    r as f32
-                })
-                .collect();
-            Scan::new(t, a0, inc, ranges, 0.0, 30.0).unwrap()
-        };
+        let scan_at = |t: f64, y: f64| room_scan(t, 0.0, &[[2.0, y], [3.0, 0.6]]);
         let mut d = LegDetector::shipped().unwrap();
         let mut last = Vec::new();
         for k in 0..8 {
@@ -930,25 +893,7 @@ mod tests {
         // saw it (0.3 m nearer to the scanner then, which would look free).
         let scan_from = |k: usize| {
             let x = 0.05 * k as f64;
-            let (a0, inc) = (-1.2f64, 0.006f64);
-            let ranges = (0..401)
-                .map(|i| {
-                    let b = a0 + inc * i as f64;
-                    let (dx, dy) = (b.cos(), b.sin());
-                    let mut r = (4.0 - x) / dx;
-                    if dy.abs() > 1e-9 {
-                        r = r.min(2.5 / dy.abs());
-                    }
-                    let (cx, cy) = (3.0 - x, 0.6);
-                    let tc = cx * dx + cy * dy;
-                    let d2 = cx * cx + cy * cy - tc * tc;
-                    if d2 < 0.06 * 0.06 {
-                        r = r.min(tc - (0.06 * 0.06 - d2).sqrt());
-                    }
-                    r as f32
-                })
-                .collect();
-            Scan::new(k as f64 / 7.5, a0, inc, ranges, 0.0, 30.0).unwrap()
+            room_scan(k as f64 / 7.5, x, &[[3.0 - x, 0.6]])
         };
         let mut d = LegDetector::shipped().unwrap();
         let mut last = Vec::new();
@@ -962,8 +907,10 @@ mod tests {
         assert_eq!(post.features[17], 0.0, "{post:?}");
     }
 
-    /// A scan from (`x`, 0) facing +x in a room with walls at x = 4 m and y = ±2.5 m.
-    fn room_from(x: f64) -> Scan {
+    /// A scan at time `t` from (`x`, 0) facing +x in a room with walls at x = 4 m and
+    /// y = ±2.5 m, with leg-sized discs (radius 6 cm) centred at `discs` in the scanner's
+    /// frame.
+    fn room_scan(t: f64, x: f64, discs: &[[f64; 2]]) -> Scan {
         let (a0, inc) = (-1.2f64, 0.006f64);
         let ranges = (0..401)
             .map(|i| {
@@ -973,10 +920,21 @@ mod tests {
                 if dy.abs() > 1e-9 {
                     r = r.min(2.5 / dy.abs());
                 }
+                for &[cx, cy] in discs {
+                    let tc = cx * dx + cy * dy;
+                    let d2 = cx * cx + cy * cy - tc * tc;
+                    if d2 < 0.06 * 0.06 {
+                        r = r.min(tc - (0.06 * 0.06 - d2).sqrt());
+                    }
+                }
                 r as f32
             })
             .collect();
-        Scan::new(0.0, a0, inc, ranges, 0.0, 30.0).unwrap()
+        Scan::new(t, a0, inc, ranges, 0.0, 30.0).unwrap()
+    }
+
+    fn room_from(x: f64) -> Scan {
+        room_scan(0.0, x, &[])
     }
 
     #[test]
