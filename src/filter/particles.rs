@@ -29,13 +29,17 @@ pub struct ParticleSet {
     states: Vec<f64>,
     /// Normalised weights (sum 1).
     weights: Vec<f64>,
-    /// Ancestral states, slot-major: `history[(s * dim + c) * len + i]` is component `c` of
-    /// the state particle `i`'s ancestor had `s + 1` steps back. Empty unless kept.
+    /// Ancestral states in a ring of `history_lag` slots, slot-major:
+    /// `history[(s * dim + c) * len + i]` is component `c` of the state particle `i`'s
+    /// ancestor had `k` steps back, where `s = (history_head + k − 1) mod history_lag`.
+    /// Empty unless kept.
     history: Vec<f64>,
     /// Steps of history kept (the lag); 0 keeps none.
     history_lag: usize,
     /// Slots filled so far (at most `history_lag`).
     history_depth: usize,
+    /// The slot holding the states one step back.
+    history_head: usize,
 }
 
 /// What is added to resampled particles to restore diversity.
@@ -78,6 +82,7 @@ impl ParticleSet {
             history: Vec::new(),
             history_lag: 0,
             history_depth: 0,
+            history_head: 0,
         }
     }
 

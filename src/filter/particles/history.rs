@@ -23,6 +23,7 @@ impl ParticleSet {
         }
         self.history_lag = lag;
         self.history_depth = 0;
+        self.history_head = 0;
         self.history = vec![0.0; lag * self.dim * self.len];
     }
 
@@ -36,17 +37,19 @@ impl ParticleSet {
         self.history_depth
     }
 
-    /// Records the current states as every particle's state one step back, shifting the
-    /// older ones a step further (the oldest beyond the lag is dropped). Called once per
-    /// step, before the transition moves the particles. Does nothing unless history is kept.
+    /// Records the current states as every particle's state one step back, the older ones
+    /// a step further (the oldest beyond the lag is dropped: its slot of the ring takes the
+    /// current states, so nothing else moves). Called once per step, before the transition
+    /// moves the particles. Does nothing unless history is kept.
     pub fn push_history(&mut self) {
         let lag = self.history_lag;
         if lag == 0 {
             return;
         }
         let block = self.dim * self.len;
-        self.history.copy_within(0..(lag - 1) * block, block);
-        self.history[..block].copy_from_slice(&self.states);
+        self.history_head = (self.history_head + lag - 1) % lag;
+        let start = self.history_head * block;
+        self.history[start..start + block].copy_from_slice(&self.states);
         self.history_depth = (self.history_depth + 1).min(lag);
     }
 
@@ -62,7 +65,8 @@ impl ParticleSet {
         if steps_back > self.history_depth {
             return None;
         }
-        let start = ((steps_back - 1) * self.dim + c) * self.len;
+        let slot = (self.history_head + steps_back - 1) % self.history_lag;
+        let start = (slot * self.dim + c) * self.len;
         Some(&self.history[start..start + self.len])
     }
 
