@@ -25,6 +25,19 @@ fn standing_scans(dir: &Path) -> PathBuf {
     scans
 }
 
+/// Runs `kitti-tools odometry --scans SCANS --out OUT EXTRA…`: (success, stdout, stderr).
+fn odometry(scans: &Path, out: &Path, extra: &[&str]) -> (bool, String, String) {
+    let mut args = vec![
+        "odometry",
+        "--scans",
+        scans.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    run(&args)
+}
+
 fn identity_lines(n: usize) -> String {
     "1 0 0 0 0 1 0 0 0 0 1 0\n".repeat(n)
 }
@@ -36,16 +49,11 @@ fn a_standing_sensor_stays_at_the_origin() {
     let out = dir.path().join("poses.txt");
     let reference = dir.path().join("reference.txt");
     std::fs::write(&reference, identity_lines(2)).unwrap();
-    let (good, stdout, stderr) = run(&[
-        "odometry",
-        "--scans",
-        scans.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--reference",
-        reference.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let (good, stdout, stderr) = odometry(
+        &scans,
+        &out,
+        &["--reference", reference.to_str().unwrap(), "--quiet"],
+    );
     assert!(good, "{stdout}\n{stderr}");
     assert!(
         stdout.contains("2 scans") && stdout.contains("ms/scan"),
@@ -59,15 +67,7 @@ fn a_standing_sensor_stays_at_the_origin() {
     // here when this was written; KISS-ICP's recipe alone (`--no-refine`, below) 0.5 mm.
     assert!(poses[1].translation.vector.norm() < 2e-3, "{:?}", poses[1]);
     let exact = dir.path().join("poses_p2p.txt");
-    let (good, stdout, stderr) = run(&[
-        "odometry",
-        "--scans",
-        scans.to_str().unwrap(),
-        "--out",
-        exact.to_str().unwrap(),
-        "--no-refine",
-        "--quiet",
-    ]);
+    let (good, stdout, stderr) = odometry(&scans, &exact, &["--no-refine", "--quiet"]);
     assert!(good, "{stdout}\n{stderr}");
     let p2p = smc_lmb::kitti::odometry::read_odometry_poses(&exact).unwrap();
     assert!(p2p[1].translation.vector.norm() < 1e-3, "{:?}", p2p[1]);
@@ -112,13 +112,7 @@ fn the_odometry_layout_is_scored_against_its_poses_file() {
 fn an_empty_folder_is_refused_naming_it() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("poses.txt");
-    let (good, _, stderr) = run(&[
-        "odometry",
-        "--scans",
-        dir.path().to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let (good, _, stderr) = odometry(dir.path(), &out, &[]);
     assert!(!good);
     assert!(
         stderr.contains("no .bin or .pcd scans") && stderr.contains(dir.path().to_str().unwrap()),
@@ -128,14 +122,8 @@ fn an_empty_folder_is_refused_naming_it() {
 
 /// Runs the odometry on `scans` and returns the poses written.
 fn poses_of(scans: &Path, out: &Path) -> Vec<nalgebra::Isometry3<f64>> {
-    ok(&common::output(&[
-        "odometry",
-        "--scans",
-        scans.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-    ]));
+    let (good, stdout, stderr) = odometry(scans, out, &["--quiet"]);
+    assert!(good, "{stdout}\n{stderr}");
     smc_lmb::kitti::odometry::read_odometry_poses(out).unwrap()
 }
 
@@ -161,13 +149,7 @@ fn a_folder_of_pcd_clouds_gives_the_poses_of_the_same_bin_scans() {
     }
     // A folder holding both kinds is refused.
     std::fs::copy(frame(), pcd.join("c.bin")).unwrap();
-    let (good, _, stderr) = run(&[
-        "odometry",
-        "--scans",
-        pcd.to_str().unwrap(),
-        "--out",
-        dir.path().join("mixed.txt").to_str().unwrap(),
-    ]);
+    let (good, _, stderr) = odometry(&pcd, &dir.path().join("mixed.txt"), &[]);
     assert!(
         !good && stderr.contains("both .bin (1) and .pcd (2)"),
         "{stderr}"
@@ -180,14 +162,7 @@ fn an_empty_scan_is_refused_naming_the_file() {
     let scans = standing_scans(dir.path());
     std::fs::write(scans.join("0000000002.bin"), b"").unwrap();
     let out = dir.path().join("poses.txt");
-    let (good, _, stderr) = run(&[
-        "odometry",
-        "--scans",
-        scans.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let (good, _, stderr) = odometry(&scans, &out, &["--quiet"]);
     assert!(!good);
     assert!(
         stderr.contains("0000000002.bin") && stderr.contains("no finite point"),
@@ -203,16 +178,11 @@ fn a_short_reference_is_refused_naming_the_file() {
     let out = dir.path().join("poses.txt");
     let reference = dir.path().join("short.txt");
     std::fs::write(&reference, identity_lines(1)).unwrap();
-    let (good, _, stderr) = run(&[
-        "odometry",
-        "--scans",
-        scans.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--reference",
-        reference.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let (good, _, stderr) = odometry(
+        &scans,
+        &out,
+        &["--reference", reference.to_str().unwrap(), "--quiet"],
+    );
     assert!(!good);
     assert!(
         stderr.contains("short.txt") && stderr.contains("1 poses for 2 scans"),
