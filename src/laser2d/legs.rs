@@ -420,11 +420,9 @@ fn seen_through(then: &Scan, places: impl Iterator<Item = [f64; 2]>) -> f64 {
     let (mut free, mut seen) = (0usize, 0usize);
     for q in places {
         let d = q[0].hypot(q[1]);
-        let beam = ((q[1].atan2(q[0]) - then.angle_min) / then.angle_increment).round();
-        if !(beam >= 1.0 && beam < then.len() as f64 - 1.0) {
+        let Some(j) = then.beam_of(q).filter(|&j| j >= 1 && j + 1 < then.len()) else {
             continue;
-        }
-        let j = beam as usize;
+        };
         let (a, b, c) = (reach(j - 1), reach(j), reach(j + 1));
         if a.min(b).min(c) > d + SEEN_THROUGH_MARGIN {
             free += 1;

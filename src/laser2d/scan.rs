@@ -147,6 +147,25 @@ impl Scan {
         self.angle_min + i as f64 * self.angle_increment
     }
 
+    /// The beam whose bearing is nearest that of `p` (sensor frame; bearings taken modulo a
+    /// full turn, so a scanner whose beams start anywhere on the circle is served), `None`
+    /// outside the scan's beams or for a zero or non-finite increment. A return at `p` came
+    /// from this beam: the scan reports its bearings without noise.
+    pub fn beam_of(&self, p: [f64; 2]) -> Option<usize> {
+        let inc = self.angle_increment;
+        if inc == 0.0 || !inc.is_finite() {
+            return None;
+        }
+        let tau = std::f64::consts::TAU;
+        let from_first = (p[1].atan2(p[0]) - self.angle_min) * inc.signum();
+        let steps = (from_first.rem_euclid(tau) / inc.abs()).round();
+        let wrapped = ((from_first.rem_euclid(tau) - tau) / inc.abs()).round();
+        [steps, wrapped]
+            .into_iter()
+            .find(|s| *s >= 0.0 && (*s as usize) < self.len())
+            .map(|s| s as usize)
+    }
+
     /// Bearing of the last beam (rad).
     pub fn angle_max(&self) -> f64 {
         self.bearing(self.len().saturating_sub(1))
@@ -221,6 +240,30 @@ mod tests {
 
     fn scan(ranges: &[f32]) -> Scan {
         Scan::new(0.0, -0.5, 0.25, ranges.to_vec(), 0.1, 10.0).unwrap()
+    }
+
+    #[test]
+    fn returns_map_back_to_their_beams() {
+        use std::f64::consts::{FRAC_PI_2, PI};
+        // 181 beams over 180°, counter-clockwise and clockwise, and 360 beams from 0 to
+        // 359° (bearings past π wrap round).
+        let ccw = Scan::new(0.0, -FRAC_PI_2, PI / 180.0, vec![5.0; 181], 0.0, 30.0).unwrap();
+        let cw = Scan::new(0.0, FRAC_PI_2, -PI / 180.0, vec![5.0; 181], 0.0, 30.0).unwrap();
+        for s in [&ccw, &cw] {
+            for b in [0, 1, 90, 179, 180] {
+                assert_eq!(s.beam_of(s.point(b).unwrap()), Some(b));
+            }
+            // Behind the scanner: no beam.
+            assert_eq!(s.beam_of([-1.0, 0.0]), None);
+        }
+        let round = Scan::new(0.0, 0.0, PI / 180.0, vec![5.0; 360], 0.0, 30.0).unwrap();
+        for b in [0, 90, 180, 270, 359] {
+            assert_eq!(round.beam_of(round.point(b).unwrap()), Some(b));
+        }
+        // A scan whose increment was zeroed after checking has no beam for anything.
+        let mut flat = ccw.clone();
+        flat.angle_increment = 0.0;
+        assert_eq!(flat.beam_of([1.0, 0.0]), None);
     }
 
     #[test]

@@ -443,28 +443,14 @@ pub fn moving_groups(
             let on = g
                 .points
                 .iter()
-                .filter(|&&p| beam_of(scan, p).is_some_and(|b| moving.get(b) == Some(&true)))
+                .filter(|&&p| {
+                    scan.beam_of(p)
+                        .is_some_and(|b| moving.get(b) == Some(&true))
+                })
                 .count();
             !g.points.is_empty() && on as f64 >= min_share * g.points.len() as f64
         })
         .collect()
-}
-
-/// The beam a return at `p` (sensor frame) came from: its bearing, which the scan reports
-/// without noise, rounded to the nearest beam.
-fn beam_of(scan: &Scan, p: [f64; 2]) -> Option<usize> {
-    let inc = scan.angle_increment;
-    if inc == 0.0 || !inc.is_finite() {
-        return None;
-    }
-    let tau = std::f64::consts::TAU;
-    let from_first = (p[1].atan2(p[0]) - scan.angle_min) * inc.signum();
-    let steps = (from_first.rem_euclid(tau) / inc.abs()).round();
-    let wrapped = ((from_first.rem_euclid(tau) - tau) / inc.abs()).round();
-    [steps, wrapped]
-        .into_iter()
-        .find(|s| *s >= 0.0 && (*s as usize) < scan.len())
-        .map(|s| s as usize)
 }
 
 #[cfg(test)]
@@ -490,16 +476,6 @@ mod tests {
             range: 5.2,
             bearing: s.bearing(beams[0]),
         }
-    }
-
-    #[test]
-    fn returns_map_back_to_their_beams() {
-        let s = scan();
-        for b in [0, 1, 90, 179, 180] {
-            assert_eq!(beam_of(&s, s.point(b).unwrap()), Some(b));
-        }
-        // Behind the scanner: no beam.
-        assert_eq!(beam_of(&s, [-1.0, 0.0]), None);
     }
 
     #[test]
