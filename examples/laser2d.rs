@@ -317,14 +317,39 @@ fn build_tracker(
     seed: u64,
     fe: FrontEnd,
 ) -> Result<Box<dyn PointTracker>> {
-    let sensor = sensor_model(scenario)?;
+    if name == "lmb" {
+        let mut t = PeopleTracker::new(lmb_config(args, scenario, seed, fe))?;
+        // RMS prediction error and NIS as the baselines report them.
+        t.record_innovations(true);
+        return Ok(Box::new(t));
+    }
+    let s = &scenario.scanner;
+    // The JPDA's P_D and clutter follow the front end as the LMB's do.
+    let (rate, detection) = if fe == FrontEnd::Moving {
+        (MOVING_CLUTTER_RATE, Some(MOVING_DETECTION_PROBABILITY))
+    } else {
+        (1.0, None)
+    };
+    baseline_tracker(
+        name,
+        sensor_model(scenario)?,
+        seed,
+        rate / (s.fov * s.range_max),
+        detection,
+    )
+}
+
+/// The baseline `name` (`gnn`, `ml_ransac`, `jpda_imm`) assuming `sensor`: ML-RANSAC draws
+/// from `seed`; the JPDA takes `clutter_density` false measurements per unit of range ×
+/// bearing and, when given, its probability of detection.
+fn baseline_tracker(
+    name: &str,
+    sensor: RangeBearing,
+    seed: u64,
+    clutter_density: f64,
+    detection: Option<f64>,
+) -> Result<Box<dyn PointTracker>> {
     Ok(match name {
-        "lmb" => {
-            let mut t = PeopleTracker::new(lmb_config(args, scenario, seed, fe))?;
-            // RMS prediction error and NIS as the baselines report them.
-            t.record_innovations(true);
-            Box::new(t)
-        }
         "gnn" => Box::new(GnnTracker::new(GnnConfig::new(sensor))?),
         "ml_ransac" => {
             let mut cfg = MlRansacConfig::new(sensor);
@@ -333,12 +358,9 @@ fn build_tracker(
         }
         "jpda_imm" => {
             let mut cfg = JpdaImmConfig::new(sensor);
-            let s = &scenario.scanner;
-            cfg.clutter_density = 1.0 / (s.fov * s.range_max);
-            // The JPDA's P_D and clutter follow the front end as the LMB's do.
-            if fe == FrontEnd::Moving {
-                cfg.detection = MOVING_DETECTION_PROBABILITY;
-                cfg.clutter_density = MOVING_CLUTTER_RATE / (s.fov * s.range_max);
+            cfg.clutter_density = clutter_density;
+            if let Some(p) = detection {
+                cfg.detection = p;
             }
             Box::new(JpdaImmTracker::new(cfg)?)
         }
@@ -420,10 +442,6 @@ mod recording {
         centre_noise, config_for_scans, track_scans_with_model, write_people_json, PeopleRun,
     };
     use smc_lmb::pipeline::people_tracking::{write_people_plot, PeoplePlotOptions};
-    use smc_lmb::trackers::{
-        GnnConfig, GnnTracker, JpdaImmConfig, JpdaImmTracker, MlRansacConfig, MlRansacTracker,
-        PointTracker,
-    };
     use std::path::Path;
     use std::time::Instant;
 
@@ -458,6 +476,7 @@ mod recording {
         cfg.filter.seed = args.seed;
         super::apply_lmb_args(args, &mut cfg);
         let min_visibility = cfg.min_visibility;
+        let clutter_volume = cfg.filter.clutter.volume;
         let t0 = Instant::now();
         let fe = super::front_end(args)?;
         println!("front end {}", fe.name());
@@ -483,7 +502,7 @@ mod recording {
             let mut scores = score(&run, &truth, min_visibility)?;
             for name in args.trackers.split(',').map(str::trim) {
                 if name != "lmb" {
-                    let b = score_baseline(args, name, &scans, &run, &truth)?;
+                    let b = score_baseline(args, name, &scans, &run, &truth, clutter_volume)?;
                     scores.baselines.push((name.to_string(), b));
                 }
             }
@@ -492,16 +511,22 @@ mod recording {
         Ok(None)
     }
 
-    /// Runs the baseline `name` on the front end's people of `run`, prints its scores as the
-    /// LMB's are printed and returns them.
+    /// Runs the baseline `name` on the front end's people of `run` (the JPDA with one false
+    /// measurement per `clutter_volume`, the LMB's range × bearing field of view), prints its
+    /// scores as the LMB's are printed and returns them.
     fn score_baseline(
         args: &Args,
         name: &str,
         scans: &[Scan],
         run: &PeopleRun,
         truth: &[Vec<[f64; 2]>],
+        clutter_volume: f64,
     ) -> Result<TrackScoreSummary> {
-        let mut tracker = baseline(args, name, &scans[0])?;
+        // The noise of a person's centre and the clutter volume the LMB assumes.
+        let (sr, sb) = centre_noise(args.sigma_range, args.sigma_bearing);
+        let sensor = RangeBearing::new(sr, sb)?;
+        let mut tracker =
+            super::baseline_tracker(name, sensor, args.seed, 1.0 / clutter_volume, None)?;
         let t0 = Instant::now();
         let tracks = track_front_end_people(run, scans, tracker.as_mut())
             .with_context(|| format!("{name} on the front end's people"))?;
@@ -521,36 +546,6 @@ mod recording {
             t.mota, t.idf1, t.id_switches, secs
         );
         Ok(t)
-    }
-
-    /// A baseline for a recorded scanner: the beam noise of `--sigma-range` and
-    /// `--sigma-bearing` at a person's centre (as the LMB assumes it); the JPDA's clutter
-    /// spread over the scanner's field of view and range.
-    fn baseline(args: &Args, name: &str, first: &Scan) -> Result<Box<dyn PointTracker>> {
-        let (sr, sb) = centre_noise(args.sigma_range, args.sigma_bearing);
-        let sensor = RangeBearing::new(sr, sb)?;
-        Ok(match name {
-            "gnn" => Box::new(GnnTracker::new(GnnConfig::new(sensor))?),
-            "ml_ransac" => {
-                let mut cfg = MlRansacConfig::new(sensor);
-                cfg.seed = args.seed;
-                Box::new(MlRansacTracker::new(cfg)?)
-            }
-            "jpda_imm" => {
-                let mut cfg = JpdaImmConfig::new(sensor);
-                let fov = (first.angle_max() - first.angle_min).abs() + first.angle_increment.abs();
-                let range = if first.range_max.is_finite() {
-                    first.range_max.min(args.max_range)
-                } else {
-                    args.max_range
-                };
-                cfg.clutter_density = 1.0 / (fov * range);
-                Box::new(JpdaImmTracker::new(cfg)?)
-            }
-            other => {
-                anyhow::bail!("unknown tracker `{other}` (expected lmb, gnn, ml_ransac, jpda_imm)")
-            }
-        })
     }
 
     /// The people of every scan: from the annotations of `--truth-topic`, or nobody.
