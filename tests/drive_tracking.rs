@@ -10,7 +10,8 @@ use smc_lmb::cloud::{read_las, read_ply, write_las_labelled, write_ply_labelled,
 use smc_lmb::filter::Label;
 use smc_lmb::kitti::RawDrive;
 use smc_lmb::pipeline::drive_tracking::{
-    drive_plot, point_labels, track_drive, ClusterMethod, DriveTracks, TrackingConfig,
+    detect_objects, drive_plot, point_labels, track_drive, ClusterMethod, DriveTracker,
+    DriveTracks, TrackingConfig,
 };
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -357,6 +358,64 @@ fn assert_clusters_are_components(cloud: &PointCloud, clusters: &[Vec<u32>], tol
         expected.len()
     );
     assert!(found == expected, "clusters differ from the components");
+}
+
+#[test]
+fn unreported_static_clutter_carries_fewer_particles() {
+    let cloud = smc_lmb::cloud::read_kitti_bin(
+        vendored_kitti()
+            .join("2011_09_26/2011_09_26_drive_UNKNOWN_sync/velodyne_points/data/0000000000.bin"),
+    )
+    .unwrap();
+    let mut config = config();
+    config.all_clusters = false;
+    let cap = config.cluster.clutter_particles.expect("capped by default");
+    assert!(cap < config.filter.particles);
+    let det = detect_objects(&cloud, &config, &mut smc_lmb::rng::seeded(1)).unwrap();
+    let mut tracker = DriveTracker::new(&config, 4).unwrap();
+    let pose = nalgebra::Isometry3::identity();
+    let mut last = None;
+    for k in 0..6 {
+        last = Some(tracker.step(k, k as f64 * 0.1, pose, None, &det).unwrap());
+    }
+    let reported: BTreeSet<Label> = last.unwrap().clusters.iter().map(|c| c.label).collect();
+    // Confirmed clusters that are not reported hold the cap (resampled to it once they held
+    // more than twice as many); reported ones keep at least half the full count.
+    let (mut capped, mut full) = (0, 0);
+    for t in tracker.filter().tracks() {
+        if t.existence < 0.9 || t.particles.is_empty() {
+            continue;
+        }
+        let n = t.particles.len();
+        if reported.contains(&t.label) {
+            assert!(
+                2 * n >= config.filter.particles,
+                "reported {}: {n}",
+                t.label
+            );
+            full += 1;
+        } else if n <= cap {
+            capped += 1;
+        }
+    }
+    eprintln!("{capped} capped confirmed tracks, {full} reported");
+    assert!(capped > 0, "no confirmed clutter was capped");
+    // Without the cap every confirmed track keeps its count.
+    config.cluster.clutter_particles = None;
+    let mut tracker = DriveTracker::new(&config, 4).unwrap();
+    for k in 0..6 {
+        tracker.step(k, k as f64 * 0.1, pose, None, &det).unwrap();
+    }
+    assert!(tracker
+        .filter()
+        .tracks()
+        .iter()
+        .filter(|t| t.existence >= 0.9)
+        .all(|t| 2 * t.particles.len() >= config.filter.particles));
+    // A cap of 0 is refused.
+    config.cluster.clutter_particles = Some(0);
+    let err = DriveTracker::new(&config, 4).unwrap_err();
+    assert!(err.to_string().contains("clutter_particles"), "{err}");
 }
 
 #[test]

@@ -197,6 +197,42 @@ fn particles_follow_existence_when_scaled() {
 }
 
 #[test]
+fn capped_tracks_carry_fewer_particles_until_the_cap_is_lifted() {
+    let frames = scene(11);
+    let config = LmbConfig {
+        particles: 500,
+        ..LmbConfig::default()
+    };
+    let mut filter = adaptive_filter_with(AssociationMethod::default(), config);
+    let mut rng = seeded(5);
+    for (f, _) in &frames[..6] {
+        filter.step(f, &mut rng).unwrap();
+    }
+    // Cap the most certain track; the others keep their fixed count.
+    let capped = filter
+        .tracks()
+        .iter()
+        .max_by(|a, b| a.existence.total_cmp(&b.existence))
+        .map(|t| t.label)
+        .expect("tracks after six frames");
+    filter.set_particle_caps(std::collections::HashMap::from([(capped, 60)]));
+    let mut est = Vec::new();
+    for (f, _) in &frames[6..12] {
+        est.push(filter.step(f, &mut rng).unwrap());
+        for t in filter.tracks() {
+            let expected = if t.label == capped { 60 } else { 500 };
+            assert_eq!(t.particles.len(), expected, "track {}", t.label);
+        }
+    }
+    // The capped track is still followed.
+    assert!(est.iter().all(|e| e.iter().any(|x| x.label == capped)));
+    // Lifted: back to the configured count at the next resampling.
+    filter.set_particle_caps(std::collections::HashMap::new());
+    filter.step(&frames[12].0, &mut rng).unwrap();
+    assert!(filter.tracks().iter().all(|t| t.particles.len() == 500));
+}
+
+#[test]
 fn same_seed_same_estimates_at_one_and_two_threads() {
     let frames = scene(3);
     let go = |threads: usize| {

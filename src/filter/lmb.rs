@@ -27,6 +27,7 @@ use crate::rng::{stream, FilterRng};
 use nalgebra::Isometry3;
 use rand::Rng;
 use rayon::prelude::*;
+use std::collections::HashMap;
 
 /// The most particles per track [`LmbConfig::validate`] accepts: ten million (a 6-component
 /// state then takes about half a gigabyte per track). Larger values are refused up front
@@ -257,6 +258,7 @@ impl LmbFilterBuilder {
             most_probable: Vec::new(),
             keep_predicted: false,
             predicted: Vec::new(),
+            particle_caps: HashMap::new(),
         })
     }
 }
@@ -346,6 +348,9 @@ pub struct LmbFilter {
     keep_predicted: bool,
     /// The predicted particle sets of the last step (births as drawn), when kept.
     predicted: Vec<(Label, ParticleSet)>,
+    /// Per-track upper bounds on the particle count, set by the caller
+    /// ([`LmbFilter::set_particle_caps`]).
+    particle_caps: HashMap<Label, usize>,
 }
 
 impl std::fmt::Debug for LmbFilter {
@@ -403,6 +408,17 @@ impl LmbFilter {
         if !on {
             self.predicted.clear();
         }
+    }
+
+    /// Caps the particle count of the tracks named in `caps` (label → at most that many
+    /// particles, at least one) from the next resampling on, replacing earlier caps; tracks
+    /// not named keep the configured count. For a caller that knows some tracks need less
+    /// accuracy than others, e.g. confirmed objects it does not report. A capped track is
+    /// resampled to its cap when it holds more than twice as many particles, and back to its
+    /// configured count when the cap is lifted and it holds fewer than half of that. The
+    /// caps only change how densities are sampled, never the model.
+    pub fn set_particle_caps(&mut self, caps: HashMap<Label, usize>) {
+        self.particle_caps = caps;
     }
 
     /// The predicted particle set of track `label` in the last step (the density the update
@@ -783,15 +799,23 @@ impl LmbFilter {
     /// Returns for every track whether it was resampled.
     fn resample(&mut self, seed: u64) -> Vec<bool> {
         let cfg = &self.config;
+        let caps = &self.particle_caps;
         self.tracks
             .par_iter_mut()
             .map(|t| {
                 let n = t.particles.len();
-                let (target, off) = match cfg.min_particles {
-                    None => (cfg.particles, n != cfg.particles),
-                    Some(min) => {
-                        let scaled = (t.existence * cfg.particles as f64).ceil();
-                        let target = (scaled as usize).max(min).min(cfg.particles);
+                let cap = caps.get(&t.label).map(|&c| c.max(1));
+                let (target, off) = match (cfg.min_particles, cap) {
+                    (None, None) => (cfg.particles, n != cfg.particles),
+                    (min, cap) => {
+                        let target = match min {
+                            None => cfg.particles,
+                            Some(min) => {
+                                let scaled = (t.existence * cfg.particles as f64).ceil();
+                                (scaled as usize).max(min).min(cfg.particles)
+                            }
+                        };
+                        let target = cap.map_or(target, |c| target.min(c));
                         (target, 2 * n < target || n > 2 * target)
                     }
                 };

@@ -149,6 +149,12 @@ pub struct ClusterTuning {
     pub birth_velocity: f64,
     /// Vertical velocity spread of a new cluster (m/s). Default 0.3.
     pub birth_vertical: f64,
+    /// Particles kept for a confirmed cluster that is not reported (static clutter of class
+    /// `Other`), instead of `filter.particles`. Its filtered position and speed only decide
+    /// whether it stays clutter; when it turns into a road user it gets its full count back at
+    /// the next resampling. `None` (or `--all-clusters`) carries every track at full count.
+    /// Default 400.
+    pub clutter_particles: Option<usize>,
 }
 
 impl Default for ClusterTuning {
@@ -163,6 +169,7 @@ impl Default for ClusterTuning {
             birth_position: 0.3,
             birth_velocity: 4.0,
             birth_vertical: 0.3,
+            clutter_particles: Some(400),
         }
     }
 }
@@ -316,6 +323,12 @@ impl TrackingConfig {
         self.planes.validate()?;
         ensure_positive("tracking config field dt", self.dt)?;
         ensure_probability("tracking config field birth.survival", self.birth.survival)?;
+        if self.cluster.clutter_particles == Some(0) {
+            return Err(Error::invalid(
+                "tracking config field cluster.clutter_particles",
+                "must be at least 1 (leave it out to keep every track at full count)",
+            ));
+        }
         let c = &self.clusters;
         for (name, v) in [
             ("clusters.tolerance", c.tolerance),

@@ -62,6 +62,8 @@ pub struct DriveTracker {
     road_users: HashMap<Label, RoadUserState>,
     class_model: ClassModel,
     all_clusters: bool,
+    /// Particle cap of unreported static clutter (`ClusterTuning::clutter_particles`).
+    clutter_particles: Option<usize>,
 }
 
 impl std::fmt::Debug for DriveTracker {
@@ -138,6 +140,7 @@ impl DriveTracker {
             road_users: HashMap::new(),
             class_model: ClassModel::default(),
             all_clusters: config.all_clusters,
+            clutter_particles: c.clutter_particles,
         })
     }
 
@@ -303,6 +306,10 @@ impl DriveTracker {
         }
         let ego_yaw = yaw_of(pose);
         let mut out_clusters = Vec::with_capacity(clusters.len());
+        // Static clutter that is not reported is carried with fewer particles (see
+        // `ClusterTuning::clutter_particles`).
+        let clutter_particles = self.clutter_particles;
+        let mut caps = HashMap::new();
         for ((e, w), m) in clusters.iter().zip(cluster_match) {
             let velocity = [e.state[1], e.state[3], e.state[5]];
             let speed = velocity[0].hypot(velocity[1]);
@@ -325,6 +332,9 @@ impl DriveTracker {
             let state = self.road_users.get(&e.label);
             let road_user = state.is_none_or(|st| st.is_road_user(speed));
             if !road_user && !self.all_clusters {
+                if let Some(n) = clutter_particles {
+                    caps.insert(e.label, n);
+                }
                 continue;
             }
             let s = inv * w;
@@ -382,6 +392,7 @@ impl DriveTracker {
         if !self.all_clusters {
             out_clusters.retain(|c| c.road_user);
         }
+        self.filter.set_particle_caps(caps);
         Ok((out_planes, out_clusters))
     }
 }
