@@ -131,9 +131,11 @@ pub(super) fn one_round(
     let mut fitted: Option<Plane> = None;
     let mut inliers: Vec<u32> = Vec::new();
     for _ in 0..2 {
-        let residuals = residuals_chunked(pts, active, &plane);
+        // The threshold never exceeds `max_threshold`, and residuals above it do not enter the
+        // MSSE scale: only the points within it are kept, in pool order.
+        let (near, residuals) = near_points(pts, active, &plane, config.max_threshold);
         let tau = msse_threshold(&residuals, config);
-        inliers = active
+        inliers = near
             .iter()
             .zip(&residuals)
             .filter(|(_, &r)| r <= tau)
@@ -198,17 +200,35 @@ impl Columns {
     }
 }
 
-/// Absolute residuals of the points `idx` to `plane`, in the order of `idx`.
-fn residuals_chunked(pts: &[[f32; 3]], idx: &[u32], plane: &PlaneF32) -> Vec<f32> {
-    let mut out = vec![0.0f32; idx.len()];
-    out.par_chunks_mut(CHUNK)
-        .zip(idx.par_chunks(CHUNK))
-        .for_each(|(o, ix)| {
-            for (r, &i) in o.iter_mut().zip(ix) {
+/// The points of `idx` whose absolute residual to `plane` is at most `max` (compared in f64,
+/// as [`msse_threshold`] does), with those residuals, both in the order of `idx`.
+fn near_points(pts: &[[f32; 3]], idx: &[u32], plane: &PlaneF32, max: f64) -> (Vec<u32>, Vec<f32>) {
+    let parts: Vec<(Vec<u32>, Vec<f32>)> = idx
+        .par_chunks(CHUNK)
+        .map(|ix| {
+            let mut all = [0.0f32; CHUNK];
+            for (r, &i) in all.iter_mut().zip(ix) {
                 *r = plane.residual(&pts[i as usize]);
             }
-        });
-    out
+            let mut near = Vec::new();
+            let mut res = Vec::new();
+            for (&r, &i) in all.iter().zip(ix) {
+                if r as f64 <= max {
+                    near.push(i);
+                    res.push(r);
+                }
+            }
+            (near, res)
+        })
+        .collect();
+    let total = parts.iter().map(|(n, _)| n.len()).sum();
+    let mut near = Vec::with_capacity(total);
+    let mut res = Vec::with_capacity(total);
+    for (n, r) in parts {
+        near.extend_from_slice(&n);
+        res.extend_from_slice(&r);
+    }
+    (near, res)
 }
 
 /// Inlier threshold from the MSSE scale of the sorted residuals (see the module docs).
