@@ -1,7 +1,8 @@
 //! Object classes of lidar clusters: a per-frame class likelihood from a fitted box (its
 //! footprint sides, its height above the ground), the point count against the count expected
-//! at that range for an object of that class, and optionally the speed; and [`ClassBelief`],
-//! the categorical posterior a track keeps and updates each frame.
+//! at that range for an object of that class, and optionally the speed and the angle between
+//! the seen long side and the direction of travel; and [`ClassBelief`], the categorical
+//! posterior a track keeps and updates each frame.
 //!
 //! Every number below states its source. Class sizes are the mean KITTI label dimensions
 //! (length, width, height) of the object benchmark's training set as used for the size
@@ -147,6 +148,10 @@ pub struct ClassFeatures {
     pub points: usize,
     /// Speed over ground (m/s), when a tracker knows it.
     pub speed: Option<f64>,
+    /// Angle (rad, in [0, π/2]) between the fitted footprint's longer side and the direction
+    /// of travel, when a tracker knows that direction and the footprint is elongated (see
+    /// the private `travel_ll`).
+    pub travel_angle: Option<f64>,
 }
 
 impl ClassFeatures {
@@ -161,6 +166,7 @@ impl ClassFeatures {
             range: fit.range,
             points: fit.points,
             speed,
+            travel_angle: None,
         }
     }
 }
@@ -264,6 +270,14 @@ impl ClassModel {
         if let Some(s) = f.speed {
             ensure_non_negative("class feature speed", s)?;
         }
+        if let Some(a) = f.travel_angle {
+            if !(0.0..=std::f64::consts::FRAC_PI_2).contains(&a) {
+                return Err(Error::invalid(
+                    "class feature travel_angle",
+                    format!("{a} (must lie in [0, π/2])"),
+                ));
+            }
+        }
         if f.points == 0 {
             return Err(Error::invalid(
                 "class feature points",
@@ -281,6 +295,9 @@ impl ClassModel {
             ll += ln_seen_or_partial(ln_n, expected.ln(), self.log_count_sigma, 0.5);
             if let Some(v) = f.speed {
                 ll += speed_ll(ObjectClass::ALL[k], v);
+            }
+            if let Some(a) = f.travel_angle {
+                ll += travel_ll(ObjectClass::ALL[k], a);
             }
             out[k] = ll;
         }
@@ -300,6 +317,9 @@ impl ClassModel {
         };
         if let Some(v) = f.speed {
             other += speed_ll(ObjectClass::Other, v);
+        }
+        if let Some(a) = f.travel_angle {
+            other += travel_ll(ObjectClass::Other, a);
         }
         out[ObjectClass::Other.index()] = other;
         Ok(out)
@@ -331,6 +351,29 @@ fn speed_ll(class: ObjectClass, v: f64) -> f64 {
         ObjectClass::Cyclist => ln_half_normal(v, 5.0),
         ObjectClass::Other => ln_half_normal(v, 1.0),
     }
+}
+
+/// Spread of the angle between a footprint's seen long side and the side it lies along
+/// (rad): the L-shape heading's error on a partly seen object, about 15°.
+const TRAVEL_SIGMA: f64 = 15.0 * PI / 180.0;
+
+/// ln p(travel angle | class), the angle `a` ∈ [0, π/2] between the seen footprint's longer
+/// side and the direction of travel. A cyclist's long side is its length, along its travel:
+/// half-normal about 0 with [`TRAVEL_SIGMA`], and a tenth uniform for odd fits. A vehicle
+/// shows its length (a side in view, about 0) or only its width (seen end-on, about π/2),
+/// half and half. A pedestrian's footprint has no long side to speak of and `Other` no
+/// travel: uniform.
+fn travel_ll(class: ObjectClass, a: f64) -> f64 {
+    let uniform = FRAC_2_PI;
+    let near = |x: f64| ln_half_normal(x, TRAVEL_SIGMA).exp();
+    let p = match class {
+        ObjectClass::Cyclist => 0.9 * near(a) + 0.1 * uniform,
+        ObjectClass::Car | ObjectClass::Van | ObjectClass::Truck => {
+            0.5 * near(a) + 0.5 * near(std::f64::consts::FRAC_PI_2 - a)
+        }
+        ObjectClass::Pedestrian | ObjectClass::Other => uniform,
+    };
+    p.max(f64::MIN_POSITIVE).ln()
 }
 
 /// Prior class probabilities: the road users in the proportions of KITTI's object training
@@ -446,6 +489,7 @@ mod tests {
             range,
             points,
             speed: None,
+            travel_angle: None,
         }
     }
 
@@ -549,6 +593,46 @@ mod tests {
             best(&features(1.6, 0.15, 1.45, 10.0, 900)),
             ObjectClass::Car
         );
+    }
+
+    #[test]
+    fn travel_across_the_long_side_is_no_cyclist() {
+        // The travel densities by hand (σ = 15° = 0.261799 rad): a half-normal's peak is
+        // 2 / (σ √(2π)) = 3.047695, its value at π/2 (6σ) e^{-18} of that, negligible.
+        // Across (π/2): vehicles 0.5 × 3.047695 = 1.523848, cyclists 0.1 × 2/π = 0.063662.
+        // Along (0): vehicles 1.523848, cyclists 0.9 × 3.047695 + 0.063662 = 2.806588.
+        let m = ClassModel::default();
+        let f = features(1.8, 0.3, 1.4, 30.0, 120);
+        let plain = m.log_likelihoods(&f).unwrap();
+        let (car, cyc, ped) = (
+            ObjectClass::Car.index(),
+            ObjectClass::Cyclist.index(),
+            ObjectClass::Pedestrian.index(),
+        );
+        for (angle, vehicle, cyclist) in [
+            (std::f64::consts::FRAC_PI_2, 1.523848, 0.063662),
+            (0.0, 1.523848, 2.806588),
+        ] {
+            let with = m
+                .log_likelihoods(&ClassFeatures {
+                    travel_angle: Some(angle),
+                    ..f
+                })
+                .unwrap();
+            let d = |k: usize| with[k] - plain[k];
+            assert!((d(car) - f64::ln(vehicle)).abs() < 1e-5, "{}", d(car));
+            assert!((d(cyc) - f64::ln(cyclist)).abs() < 1e-5, "{}", d(cyc));
+            assert!((d(ped) - FRAC_2_PI.ln()).abs() < 1e-12);
+        }
+        for bad in [-0.1, 1.6, f64::NAN] {
+            let err = m
+                .log_likelihoods(&ClassFeatures {
+                    travel_angle: Some(bad),
+                    ..f
+                })
+                .unwrap_err();
+            assert!(err.to_string().contains("travel_angle"), "{err}");
+        }
     }
 
     #[test]

@@ -8,7 +8,10 @@
 //!   the sensor. That centre, not the centroid of the visible points, is what the filter
 //!   measures.
 //! * A track keeps a categorical class posterior ([`ClassBelief`]) updated with every matched
-//!   detection's class likelihood (its speed included, from the track), a box size averaged
+//!   detection's class likelihood (its speed included, from the track, and, once the track
+//!   is [`TRAVEL_AGE`] frames old and faster than [`TRAVEL_SPEED`], the angle between the
+//!   detection's seen long side and the direction of travel: a car seen end-on shows a
+//!   cyclist's 1.8 m side, but across its travel, where no cyclist has one), a box size averaged
 //!   over its detections, and a heading in the world frame: the matched box's, turned by π
 //!   towards the direction of travel once the track moves.
 //! * A confirmed cluster is a road user unless its class is `Other` and it moves slower than
@@ -119,6 +122,42 @@ pub fn shape_of(
     })
 }
 
+/// Speed (m/s) from which a track's direction of travel enters its class likelihood: well
+/// above the velocity noise of a static track (see [`STATIC_SPEED`]).
+pub const TRAVEL_SPEED: f64 = 3.0;
+
+/// Frames a track must have lived before its direction of travel is trusted: a young track's
+/// velocity is mostly its birth spread.
+pub const TRAVEL_AGE: u32 = 5;
+
+/// Footprints less elongated than this (longer over shorter side) have no long side whose
+/// direction means anything.
+const TRAVEL_ELONGATION: f64 = 1.5;
+
+/// The direction of travel (rad, in the frame the velocity is given in) of a track of `age`
+/// steps moving with `velocity`, when it is fast and old enough to trust it.
+pub fn travel_direction(velocity: [f64; 2], age: u32) -> Option<f64> {
+    let speed = velocity[0].hypot(velocity[1]);
+    (speed >= TRAVEL_SPEED && age >= TRAVEL_AGE).then(|| velocity[1].atan2(velocity[0]))
+}
+
+/// Angle in [0, π/2] between the longer footprint side of `fitted` and the direction
+/// `travel` (same frame), or `None` for a footprint that is not elongated.
+fn travel_angle(fitted: &Box3, travel: f64) -> Option<f64> {
+    let [a, b, _] = fitted.size;
+    let (long, short) = (a.max(b), a.min(b));
+    if !(long.is_finite() && short.is_finite()) || long < TRAVEL_ELONGATION * short {
+        return None;
+    }
+    let axis = if a >= b {
+        fitted.yaw
+    } else {
+        fitted.yaw + PI / 2.0
+    };
+    let d = wrap_angle(axis - travel).abs();
+    Some(d.min(PI - d))
+}
+
 /// What a cluster track remembers of its detections' shapes.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RoadUserState {
@@ -142,18 +181,22 @@ impl RoadUserState {
             size: shape.bbox.size,
             yaw: world_yaw,
         };
-        s.observe_class(shape, speed, model)?;
+        s.observe_class(shape, speed, None, model)?;
         Ok(s)
     }
 
+    /// `travel`: the direction of travel in the detection's (sensor) frame, when the track
+    /// knows it (see [`travel_direction`]).
     fn observe_class(
         &mut self,
         shape: &ClusterShape,
         speed: f64,
+        travel: Option<f64>,
         model: &ClassModel,
     ) -> Result<()> {
         let features = ClassFeatures {
             speed: Some(speed),
+            travel_angle: travel.and_then(|t| travel_angle(&shape.fitted, t)),
             ..shape.features
         };
         self.belief
@@ -166,9 +209,10 @@ impl RoadUserState {
         shape: &ClusterShape,
         world_yaw: f64,
         speed: f64,
+        travel: Option<f64>,
         model: &ClassModel,
     ) -> Result<()> {
-        self.observe_class(shape, speed, model)?;
+        self.observe_class(shape, speed, travel, model)?;
         for (s, d) in self.size.iter_mut().zip(shape.bbox.size) {
             *s += SIZE_GAIN * (d - *s);
         }
@@ -285,6 +329,32 @@ mod tests {
     }
 
     #[test]
+    fn travel_angle_is_taken_from_the_long_side_of_elongated_footprints() {
+        // A 1.8 × 0.3 m face along x (yaw 0); the same face given as 0.3 × 1.8 at yaw π/2.
+        let along_x = Box3::new(Point3::new(20.0, 0.0, 0.0), [1.8, 0.3, 1.4], 0.0);
+        let turned = Box3::new(Point3::new(20.0, 0.0, 0.0), [0.3, 1.8, 1.4], PI / 2.0);
+        for b in [along_x, turned] {
+            // Travel along −x runs along the long side, along −y across it.
+            let along = travel_angle(&b, PI).unwrap();
+            assert!(along.abs() < 1e-12, "{along}");
+            let a = travel_angle(&b, -PI / 2.0).unwrap();
+            assert!((a - PI / 2.0).abs() < 1e-12, "{a}");
+            let a = travel_angle(&b, 0.3).unwrap();
+            assert!((a - 0.3).abs() < 1e-12, "{a}");
+            let a = travel_angle(&b, PI - 0.3).unwrap();
+            assert!((a - 0.3).abs() < 1e-12, "{a}");
+        }
+        // A pedestrian's 0.7 × 0.6 footprint has no long side.
+        let square = Box3::new(Point3::new(20.0, 0.0, 0.0), [0.7, 0.6, 1.7], 0.4);
+        assert_eq!(travel_angle(&square, 0.0), None);
+        // The direction only of a track fast and old enough.
+        assert_eq!(travel_direction([1.0, 1.0], 20), None);
+        assert_eq!(travel_direction([0.0, 5.0], TRAVEL_AGE - 1), None);
+        let t = travel_direction([0.0, -5.0], TRAVEL_AGE).unwrap();
+        assert!((t + PI / 2.0).abs() < 1e-12);
+    }
+
+    #[test]
     fn heading_follows_the_direction_of_travel_and_static_other_is_not_a_road_user() {
         // A 4 m pole: no road user is that thin and tall.
         let b = Box3::new(Point3::new(10.0, 0.0, 0.3), [0.3, 0.3, 4.0], 0.0);
@@ -298,13 +368,14 @@ mod tests {
                 range: 10.0,
                 points: 300,
                 speed: None,
+                travel_angle: None,
             },
             class: ObjectClass::Other,
         };
         let model = ClassModel::default();
         let mut s = RoadUserState::new(&shape, 0.1, 0.0, &model).unwrap();
         for _ in 0..5 {
-            s.update(&shape, 0.1, 0.0, &model).unwrap();
+            s.update(&shape, 0.1, 0.0, None, &model).unwrap();
         }
         assert_eq!(s.class().0, ObjectClass::Other);
         assert!(!s.is_road_user(0.2));

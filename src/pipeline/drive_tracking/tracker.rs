@@ -13,7 +13,7 @@
 
 use super::detect::FrameDetections;
 use super::output::{OrientedBox, StageTimes, TrackedCluster, TrackedFrame, TrackedPlane};
-use super::road_users::{contained_in_others, RoadUserState};
+use super::road_users::{contained_in_others, travel_direction, RoadUserState};
 use super::{EgoModel, TrackingConfig};
 use crate::cloud::classes::ClassModel;
 use crate::error::Result;
@@ -320,7 +320,11 @@ impl DriveTracker {
                 if let Some(shape) = &c.shape {
                     let world_yaw = wrap_angle(shape.bbox.yaw + ego_yaw);
                     match self.road_users.get_mut(&e.label) {
-                        Some(state) => state.update(shape, world_yaw, speed, &self.class_model)?,
+                        Some(state) => {
+                            let travel = travel_direction([velocity[0], velocity[1]], e.age)
+                                .map(|t| wrap_angle(t - ego_yaw));
+                            state.update(shape, world_yaw, speed, travel, &self.class_model)?
+                        }
                         None => {
                             let state =
                                 RoadUserState::new(shape, world_yaw, speed, &self.class_model)?;
