@@ -37,6 +37,7 @@
 //! between the scans (0 when none lies within its association gate).
 
 use crate::error::{Error, Result};
+use crate::numerics::sym2::symmetric2_eigenvalues;
 use nalgebra::{Matrix3, Vector3};
 
 /// Number of features.
@@ -117,9 +118,7 @@ pub fn segment_features(points: &[[f64; 2]], context: &SegmentContext) -> Result
     let mad = points.iter().map(|&p| dist(p, median)).sum::<f64>() / nf;
     let width = dist(points[0], points[n - 1]);
     // Smallest eigenvalue of the scatter matrix = residual sum of squares of the TLS line.
-    let half_trace = 0.5 * (cxx + cyy);
-    let det_term = (0.25 * (cxx - cyy).powi(2) + cxy * cxy).sqrt();
-    let linearity = (half_trace - det_term).max(0.0);
+    let linearity = symmetric2_eigenvalues(cxx, cxy, cyy).0.max(0.0);
     let (radius, circularity) = if n < 3 {
         (0.5 * width, 0.0)
     } else {

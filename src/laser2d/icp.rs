@@ -17,10 +17,11 @@
 //! Not for: choosing which scans to match (the moving-object detector does that), global
 //! registration from a poor initial guess, or point-to-line refinement.
 
-use super::nearest::{symmetric2_eigenvalues, PlanarGrid};
+use super::nearest::PlanarGrid;
 use crate::error::{Error, Result};
 use crate::geometry::pose2::{compose, transform_point};
 use crate::geometry::Pose2;
+use crate::numerics::sym2::symmetric2_eigenvalues;
 
 /// ICP parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -15,6 +15,7 @@
 //! the points and cells), or k nearest neighbours.
 
 use crate::numerics::floor::floor_i64;
+use crate::numerics::sym2::symmetric2_eigenvalues;
 
 /// A uniform grid over a fixed planar point set; see the module docs.
 #[derive(Clone, Debug)]
@@ -322,14 +323,6 @@ impl PlanarGrid {
             }
         }
     }
-}
-
-/// The eigenvalues (smaller, larger) of the symmetric 2 × 2 matrix [[a, b], [b, c]]: the
-/// mean of the diagonal ∓ the root.
-pub(crate) fn symmetric2_eigenvalues(a: f64, b: f64, c: f64) -> (f64, f64) {
-    let mean = 0.5 * (a + c);
-    let root = (0.25 * (a - c) * (a - c) + b * b).sqrt();
-    (mean - root, mean + root)
 }
 
 /// One query's state: the best point so far and the squared distance a point must not exceed.
