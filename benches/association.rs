@@ -60,7 +60,7 @@ fn murty(c: &mut Criterion) {
         );
     }
     let groups = mixed();
-    let murty = MurtyAssociator { k: 200 };
+    let murty = MurtyAssociator::default();
     g.bench_function("mixed", |b| {
         b.iter(|| {
             let mut rng = seeded(0);

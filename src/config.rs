@@ -28,7 +28,7 @@
 //! position_std = 1.0
 //! velocity_std = 2.0
 //! [association]
-//! method = "lbp"                # or "murty" (k), "gibbs" (samples)
+//! method = "lbp"                # or "murty" (k, min_weight), "gibbs" (samples)
 //! ```
 //!
 //! Static birth terms (`model = "static"`) are sampled near the step's measurements that no

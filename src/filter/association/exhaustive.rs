@@ -40,7 +40,10 @@ impl Associator for ExhaustiveAssociator {
         };
         match enumerate(&table, self.max_hypotheses) {
             Some(m) => m,
-            None => murty::marginals_of_table(&table, MurtyAssociator::default().k),
+            None => {
+                let murty = MurtyAssociator::default();
+                murty::marginals_of_table(&table, murty.k, murty.min_weight)
+            }
         }
     }
 }

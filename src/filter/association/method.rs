@@ -23,6 +23,10 @@ pub enum AssociationMethod {
         /// Number of best hypotheses kept (default 200).
         #[serde(default = "default_murty_k")]
         k: usize,
+        /// Hypotheses lighter than this fraction of the best are not ranked (default 10⁻⁹;
+        /// 0 ranks exactly `k`).
+        #[serde(default = "default_murty_min_weight")]
+        min_weight: f64,
     },
     /// Gibbs sampling of hypotheses ([`GibbsAssociator`]).
     Gibbs {
@@ -45,6 +49,9 @@ pub enum AssociationMethod {
 
 fn default_murty_k() -> usize {
     MurtyAssociator::default().k
+}
+fn default_murty_min_weight() -> f64 {
+    MurtyAssociator::default().min_weight
 }
 fn default_gibbs_samples() -> usize {
     GibbsAssociator::default().samples
@@ -91,7 +98,16 @@ impl AssociationMethod {
             Ok(())
         };
         match *self {
-            AssociationMethod::Murty { k } => bounded("k", k, MAX_MURTY_K),
+            AssociationMethod::Murty { k, min_weight } => {
+                bounded("k", k, MAX_MURTY_K)?;
+                if !(0.0..1.0).contains(&min_weight) {
+                    return Err(crate::Error::invalid(
+                        "association min_weight",
+                        format!("{min_weight} (must be in [0, 1))"),
+                    ));
+                }
+                Ok(())
+            }
             AssociationMethod::Gibbs { samples } => bounded("samples", samples, MAX_GIBBS_SAMPLES),
             AssociationMethod::Lbp {
                 max_iterations,
@@ -114,7 +130,9 @@ impl AssociationMethod {
 impl Associator for AssociationMethod {
     fn marginals(&self, problem: &AssociationProblem, rng: &mut FilterRng) -> Marginals {
         match *self {
-            AssociationMethod::Murty { k } => MurtyAssociator { k }.marginals(problem, rng),
+            AssociationMethod::Murty { k, min_weight } => {
+                MurtyAssociator { k, min_weight }.marginals(problem, rng)
+            }
             AssociationMethod::Gibbs { samples } => {
                 GibbsAssociator { samples }.marginals(problem, rng)
             }
@@ -137,7 +155,8 @@ impl FromStr for AssociationMethod {
     type Err = crate::Error;
 
     /// Parses `murty`, `gibbs`, `lbp` or `exhaustive` (case-insensitive), each with its
-    /// defaults (k = 200, 1000 samples, 100 iterations with tolerance 10⁻⁹), optionally
+    /// defaults (k = 200 with the weight floor 10⁻⁹, 1000 samples, 100 iterations with
+    /// tolerance 10⁻⁹), optionally
     /// followed by `:N` to set k, the number of samples or the iteration cap, e.g. `murty:500`.
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         let s = s.trim().to_ascii_lowercase();
@@ -156,6 +175,7 @@ impl FromStr for AssociationMethod {
         let method = match name {
             "murty" => Ok(AssociationMethod::Murty {
                 k: number(arg, MurtyAssociator::default().k)?,
+                min_weight: MurtyAssociator::default().min_weight,
             }),
             "gibbs" => Ok(AssociationMethod::Gibbs {
                 samples: number(arg, GibbsAssociator::default().samples)?,
@@ -195,6 +215,13 @@ mod tests {
             assert!(err.contains("outside 1..="), "{bad}: {err}");
         }
         assert!("murty:100000".parse::<AssociationMethod>().is_ok());
+        for w in [-1e-3, 1.0, f64::NAN] {
+            let m = AssociationMethod::Murty {
+                k: 10,
+                min_weight: w,
+            };
+            assert!(m.validate().unwrap_err().to_string().contains("min_weight"));
+        }
         let lbp = AssociationMethod::Lbp {
             max_iterations: 10,
             tolerance: f64::NAN,
@@ -211,7 +238,10 @@ mod tests {
     fn parse_names_and_defaults() {
         assert_eq!(
             "murty".parse::<AssociationMethod>().unwrap(),
-            AssociationMethod::Murty { k: 200 }
+            AssociationMethod::Murty {
+                k: 200,
+                min_weight: 1e-9
+            }
         );
         assert_eq!(
             " Gibbs ".parse::<AssociationMethod>().unwrap(),
@@ -230,7 +260,10 @@ mod tests {
         );
         assert_eq!(
             "murty:500".parse::<AssociationMethod>().unwrap(),
-            AssociationMethod::Murty { k: 500 }
+            AssociationMethod::Murty {
+                k: 500,
+                min_weight: 1e-9
+            }
         );
         assert!("hungarian".parse::<AssociationMethod>().is_err());
         assert!("murty:x".parse::<AssociationMethod>().is_err());
@@ -239,11 +272,22 @@ mod tests {
 
     #[test]
     fn serde_round_trip_uses_method_tag() {
-        let m = AssociationMethod::Murty { k: 7 };
+        let m = AssociationMethod::Murty {
+            k: 7,
+            min_weight: 0.0,
+        };
         let s = serde_json::to_string(&m).unwrap();
-        assert_eq!(s, r#"{"method":"murty","k":7}"#);
+        assert_eq!(s, r#"{"method":"murty","k":7,"min_weight":0.0}"#);
         let back: AssociationMethod = serde_json::from_str(&s).unwrap();
         assert_eq!(back, m);
+        let floor: AssociationMethod = serde_json::from_str(r#"{"method":"murty","k":7}"#).unwrap();
+        assert_eq!(
+            floor,
+            AssociationMethod::Murty {
+                k: 7,
+                min_weight: 1e-9
+            }
+        );
         let e: AssociationMethod = serde_json::from_str(r#"{"method":"exhaustive"}"#).unwrap();
         assert_eq!(e, AssociationMethod::Exhaustive);
         let l: AssociationMethod =

@@ -29,30 +29,62 @@ use super::problem::Accumulator;
 use super::problem::{AssociationProblem, Associator, Hypothesis, Marginals};
 use super::tables::{prepare, LogTable, Prepared};
 use crate::assignment;
+use crate::filter::groups::partition;
 use crate::rng::FilterRng;
 use std::cmp::Ordering;
 use std::collections::VecDeque;
 
 /// Marginals from the `k` most probable hypotheses (Murty's ranked assignment), normalised
-/// over those hypotheses. Exact when `k` is at least the number of admissible hypotheses.
+/// over those hypotheses, leaving out those whose weight is below `min_weight` times the best
+/// one's. Exact when `k` is at least the number of admissible hypotheses and `min_weight` is 0.
+///
+/// The weight floor does two things:
+/// - a measurement entry lighter than `min_weight` times its track's miss entry is left
+///   out, and tracks that then share no measurement are ranked apart, `k` hypotheses each
+///   (independent parts multiply: their joint ranking would spend `k` on combinations);
+///   this moves a marginal by at most about `2·n·m·min_weight` for n tracks and m
+///   measurements;
+/// - the ranking stops once the next hypothesis is lighter than `min_weight` times the best,
+///   which moves a marginal by less than `k · min_weight`.
+///
+/// At the default 10⁻⁹ both are far below the truncation to `k` hypotheses itself.
+/// [`MurtyAssociator::exact`] turns the floor off.
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct MurtyAssociator {
     /// Number of best hypotheses kept (0 is treated as 1).
     pub k: usize,
+    /// Hypotheses lighter than this fraction of the best one are not ranked (0: rank `k`).
+    pub min_weight: f64,
 }
+
+/// Default [`MurtyAssociator::min_weight`]: 10⁻⁹, the same order as LBP's message tolerance.
+pub const DEFAULT_MURTY_MIN_WEIGHT: f64 = 1e-9;
 
 impl Default for MurtyAssociator {
     /// k = 200: every hypothesis of up to 3 tracks and 5 measurements (136 of them at most),
-    /// and the dominant ones of the larger groups the filter usually sees.
+    /// and the dominant ones of the larger groups the filter usually sees; hypotheses below
+    /// 10⁻⁹ of the best are not ranked.
     fn default() -> Self {
-        Self { k: 200 }
+        Self {
+            k: 200,
+            min_weight: DEFAULT_MURTY_MIN_WEIGHT,
+        }
     }
 }
 
 impl MurtyAssociator {
-    /// The `k` best hypotheses, best first (see [`ranked_hypotheses`]).
+    /// Murty with `k` hypotheses and no weight floor: exactly the `k` best.
+    pub fn exact(k: usize) -> Self {
+        Self { k, min_weight: 0.0 }
+    }
+
+    /// The `k` best hypotheses above the weight floor, best first (see
+    /// [`ranked_hypotheses`]).
     pub fn ranked(&self, problem: &AssociationProblem) -> Vec<Hypothesis> {
-        ranked_hypotheses(problem, self.k)
+        let Some(table) = LogTable::new(problem) else {
+            return Vec::new();
+        };
+        hypotheses(problem, ranked(&table, self.k, max_gap(self.min_weight)))
     }
 }
 
@@ -60,9 +92,29 @@ impl Associator for MurtyAssociator {
     fn marginals(&self, problem: &AssociationProblem, _rng: &mut FilterRng) -> Marginals {
         match prepare(problem) {
             Prepared::Done(m) => m,
-            Prepared::Table(t) => marginals_of_table(&t, self.k),
+            Prepared::Table(t) => marginals_of_table(&t, self.k, self.min_weight),
         }
     }
+}
+
+/// The largest cost above the best one that a ranked hypothesis may have: −ln `min_weight`
+/// (+∞ for a floor of 0 or less).
+fn max_gap(min_weight: f64) -> f64 {
+    if min_weight > 0.0 {
+        -min_weight.min(1.0).ln()
+    } else {
+        f64::INFINITY
+    }
+}
+
+fn hypotheses(problem: &AssociationProblem, ranked: Vec<(Vec<usize>, f64)>) -> Vec<Hypothesis> {
+    ranked
+        .into_iter()
+        .map(|(theta, _)| Hypothesis {
+            log_weight: problem.log_weight(&theta),
+            assignment: theta,
+        })
+        .collect()
 }
 
 /// The `k` most probable admissible hypotheses of `problem`, in order of non-increasing
@@ -73,22 +125,80 @@ pub fn ranked_hypotheses(problem: &AssociationProblem, k: usize) -> Vec<Hypothes
     let Some(table) = LogTable::new(problem) else {
         return Vec::new();
     };
-    ranked(&table, k)
-        .into_iter()
-        .map(|(theta, _)| Hypothesis {
-            log_weight: problem.log_weight(&theta),
-            assignment: theta,
-        })
-        .collect()
+    hypotheses(problem, ranked(&table, k, f64::INFINITY))
 }
 
-/// Marginals from the `k` best hypotheses of a table.
-pub(crate) fn marginals_of_table(table: &LogTable, k: usize) -> Marginals {
-    let mut acc = Accumulator::new(table.n, table.m);
-    for (theta, lw) in ranked(table, k.max(1)) {
-        acc.add(&theta, lw);
+/// Marginals from the `k` best hypotheses of a table above the weight floor `min_weight`.
+///
+/// With a floor, a measurement entry lighter than `min_weight` times its track's miss entry
+/// is left out first (every hypothesis using it is lighter than that fraction of the same
+/// hypothesis with the track missed), and the tracks that no longer share a measurement are
+/// ranked apart, `k` hypotheses each: the marginals of independent parts are those of each
+/// part. Left out, such entries move a marginal by at most about `2·n·m·min_weight`.
+pub(crate) fn marginals_of_table(table: &LogTable, k: usize, min_weight: f64) -> Marginals {
+    let k = k.max(1);
+    if min_weight.is_nan() || min_weight <= 0.0 {
+        let mut acc = Accumulator::new(table.n, table.m);
+        for (theta, lw) in ranked(table, k, f64::INFINITY) {
+            acc.add(&theta, lw);
+        }
+        return acc.finish();
     }
-    acc.finish()
+    let (n, m) = (table.n, table.m);
+    let log_floor = min_weight.min(1.0).ln();
+    let kept = |i: usize, j: usize| {
+        let row = table.row(i);
+        row[j + 1] > f64::NEG_INFINITY && row[j + 1] >= row[0] + log_floor
+    };
+    let gated: Vec<Vec<usize>> = (0..n)
+        .map(|i| (0..m).filter(|&j| kept(i, j)).collect())
+        .collect();
+    let mut out = Marginals {
+        n_tracks: n,
+        n_meas: m,
+        miss: vec![0.0; n],
+        detect: vec![0.0; n * m],
+    };
+    for part in partition(&gated, m) {
+        let (rows, cols) = (&part.tracks, &part.measurements);
+        let sub_m = cols.len();
+        let mut w = Vec::with_capacity(rows.len() * (sub_m + 1));
+        for &i in rows {
+            let row = table.row(i);
+            w.push(row[0]);
+            w.extend(cols.iter().map(|&j| {
+                if kept(i, j) {
+                    row[j + 1]
+                } else {
+                    f64::NEG_INFINITY
+                }
+            }));
+        }
+        let sub = LogTable {
+            n: rows.len(),
+            m: sub_m,
+            w,
+        };
+        let mut acc = Accumulator::new(sub.n, sub_m);
+        if sub.n == 1 {
+            acc.add(&[0], sub.w[0]);
+            for j in 1..=sub_m {
+                acc.add(&[j], sub.w[j]);
+            }
+        } else {
+            for (theta, lw) in ranked(&sub, k, max_gap(min_weight)) {
+                acc.add(&theta, lw);
+            }
+        }
+        let mg = acc.finish();
+        for (a, &i) in rows.iter().enumerate() {
+            out.miss[i] = mg.miss[a];
+            for (b, &j) in cols.iter().enumerate() {
+                out.detect[i * m + j] = mg.detect[a * sub_m + b];
+            }
+        }
+    }
+    out
 }
 
 /// The n × (m + n) cost matrix of a table (+∞ = forbidden).
@@ -393,8 +503,9 @@ fn bound(cost: &[f64], cols: usize, node: &Node, r: usize, avail: &[bool]) -> f6
 /// order of (cost, creation), and a child is never cheaper than its parent and always newer,
 /// so a node that is behind that many others can never be ranked; nor can its descendants.
 /// Such a child is dropped once solved, and its search is abandoned as soon as the path
-/// length shows it cannot beat the last kept node.
-pub(crate) fn ranked(table: &LogTable, k: usize) -> Vec<(Vec<usize>, f64)> {
+/// length shows it cannot beat the last kept node. A child costing more than `max_gap` above
+/// the best hypothesis is dropped the same way, as if the queue were full at that cost.
+pub(crate) fn ranked(table: &LogTable, k: usize, max_gap: f64) -> Vec<(Vec<usize>, f64)> {
     let (n, m) = (table.n, table.m);
     let cols = m + n;
     let mut out = Vec::new();
@@ -428,6 +539,7 @@ pub(crate) fn ranked(table: &LogTable, k: usize) -> Vec<(Vec<usize>, f64)> {
         })
         .sum();
     let tol = 1e-7 * (1.0 + scale);
+    let ceiling = root_cost + max_gap;
     let mut seq = 0u64;
     // Sorted by (cost, seq): the front is the next hypothesis, the back the first to drop.
     let mut queue: VecDeque<Node> = VecDeque::new();
@@ -462,7 +574,8 @@ pub(crate) fn ranked(table: &LogTable, k: usize) -> Vec<(Vec<usize>, f64)> {
             let limit = match queue.back() {
                 Some(worst) if queue.len() >= room => worst.cost - node.cost + tol,
                 _ => f64::INFINITY,
-            };
+            }
+            .min(ceiling - node.cost + tol);
             if limit < f64::INFINITY && bound(&cost, cols, &node, r, &s.avail) > limit {
                 s.avail[col_r] = false;
                 continue;
@@ -491,6 +604,7 @@ pub(crate) fn ranked(table: &LogTable, k: usize) -> Vec<(Vec<usize>, f64)> {
                 // The child is newer than every queued node, so it must be strictly cheaper
                 // than the last one to displace it.
                 let keep = c.is_finite()
+                    && c <= ceiling
                     && (!full || queue.back().is_some_and(|w| w.cost.total_cmp(&c).is_gt()));
                 if keep {
                     if full {
@@ -744,7 +858,7 @@ mod tests {
             prop_assert!(ranked_hypotheses(p, k).is_empty());
             return Ok(());
         };
-        let new = ranked(&table, k);
+        let new = ranked(&table, k, f64::INFINITY);
         let old = ranked_reference(&table, k + 1);
         let kept = old.len().min(k);
         prop_assert_eq!(new.len(), kept);
@@ -812,7 +926,7 @@ mod tests {
         .unwrap();
         let r = ranked_hypotheses(&p, 2000);
         assert_eq!(r.len(), brute_hypotheses(&p).len());
-        let mg = MurtyAssociator { k: 2000 }.marginals(&p, &mut seeded(0));
+        let mg = MurtyAssociator::exact(2000).marginals(&p, &mut seeded(0));
         assert!(max_diff(&mg, &brute_marginals(&p).unwrap()) < 1e-12);
     }
 
@@ -831,7 +945,7 @@ mod tests {
             // Integer weights sum exactly: whatever the tie-breaking, the weights agree.
             let table = LogTable::new(&p);
             if let Some(table) = table {
-                let a: Vec<u64> = ranked(&table, k).iter().map(|h| h.1.to_bits()).collect();
+                let a: Vec<u64> = ranked(&table, k, f64::INFINITY).iter().map(|h| h.1.to_bits()).collect();
                 let b: Vec<u64> =
                     ranked_reference(&table, k).iter().map(|h| h.1.to_bits()).collect();
                 prop_assert_eq!(a, b);
@@ -839,9 +953,49 @@ mod tests {
         }
 
         #[test]
+        fn weight_floor_keeps_the_heavy_prefix(
+            p in problems(8, 10, -12.0, 2.0, 3, true),
+            k in 1usize..300,
+            floor_exp in 0.3f64..12.0,
+        ) {
+            let min_weight = (-floor_exp).exp();
+            let Some(table) = LogTable::new(&p) else { return Ok(()); };
+            let floored = ranked(&table, k, max_gap(min_weight));
+            let exact = ranked_reference(&table, k);
+            if exact.is_empty() {
+                prop_assert!(floored.is_empty());
+                return Ok(());
+            }
+            // The floored list is the exact list's prefix of hypotheses heavier than the floor
+            // (up to rounding at the floor itself).
+            let best = exact[0].1;
+            let above = |tol: f64| exact.iter().filter(|h| h.1 >= best - floor_exp + tol).count();
+            prop_assert!(floored.len() >= above(1e-9) && floored.len() <= above(-1e-9),
+                "{} kept, {}..={} expected", floored.len(), above(1e-9), above(-1e-9));
+            for (a, b) in floored.iter().zip(&exact) {
+                prop_assert!((a.1 - b.1).abs() <= 1e-9 * (1.0 + b.1.abs()));
+            }
+        }
+
+        #[test]
+        fn weight_floor_marginals_are_near_the_exhaustive_ones(
+            p in problems(5, 5, -10.0, 3.0, 4, true),
+            floor_exp in 3.0f64..14.0,
+        ) {
+            let min_weight = (-floor_exp).exp();
+            let mut rng = seeded(0);
+            let mg = MurtyAssociator { k: 100_000, min_weight }.marginals(&p, &mut rng);
+            let ex = ExhaustiveAssociator::default().marginals(&p, &mut rng);
+            assert_valid(&p, &mg);
+            let (n, m) = (p.n_tracks as f64, p.n_meas as f64);
+            let bound = 2.0 * ((1.0 + min_weight * m).powf(n) - 1.0) + 1e-12;
+            prop_assert!(max_diff(&mg, &ex) <= bound, "{} > {}", max_diff(&mg, &ex), bound);
+        }
+
+        #[test]
         fn large_k_equals_exhaustive(p in problems(4, 4, -8.0, 4.0, 4, true)) {
             let mut rng = seeded(0);
-            let mg = MurtyAssociator { k: 1000 }.marginals(&p, &mut rng);
+            let mg = MurtyAssociator::exact(1000).marginals(&p, &mut rng);
             let ex = ExhaustiveAssociator::default().marginals(&p, &mut rng);
             assert_valid(&p, &mg);
             prop_assert!(max_diff(&mg, &ex) < 1e-12, "{:?} vs {:?}", mg, ex);

@@ -11,7 +11,10 @@ use proptest::prelude::*;
 
 fn all_methods() -> Vec<AssociationMethod> {
     vec![
-        AssociationMethod::Murty { k: 1000 },
+        AssociationMethod::Murty {
+            k: 1000,
+            min_weight: 0.0,
+        },
         AssociationMethod::Gibbs { samples: 500 },
         AssociationMethod::default(),
         AssociationMethod::Exhaustive,
