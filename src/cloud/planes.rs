@@ -41,7 +41,9 @@
 //! the sensor, small RMS, plumb relative to the ground; see [`WallQuality`]). A wall's patch
 //! is its upright bounding rectangle ([`PlanePatch::upright_from_points`]: sides horizontal
 //! and up the wall), so a ragged visible outline does not turn the rectangle from scan to
-//! scan. Everything else is reported in [`PlaneSegmentation::rejected`] with a
+//! scan, with its bottom edge lowered to the ground plane ([`PlaneConfig::walls_to_ground`]):
+//! the lowest inliers lie above the ground clearance, and higher wherever parked cars hide
+//! the foot of the wall. Everything else is reported in [`PlaneSegmentation::rejected`] with a
 //! [`RejectReason`].
 //!
 //! # Determinism
@@ -233,6 +235,7 @@ pub fn extract_planes(
     let up = ground_idx
         .map(|g| extracted[g].0.normal)
         .unwrap_or_else(nalgebra::Vector3::z);
+    let ground_plane = ground_idx.map(|g| extracted[g].0);
     let mut assigned = vec![false; pts.len()];
     let patch_of = |plane: &Plane, idx: &[u32]| -> Result<PlanePatch> {
         PlanePatch::from_points(*plane, &hull_candidates(plane, idx, &pts))
@@ -349,6 +352,10 @@ pub fn extract_planes(
                 for &i in &piece {
                     assigned[i as usize] = true;
                 }
+                let patch = match ground_plane {
+                    Some(g) if config.walls_to_ground => patch.lowered_to(&g),
+                    _ => patch,
+                };
                 out.walls.push(PlaneDetection {
                     rms,
                     patch,
@@ -490,9 +497,24 @@ mod tests {
         );
         let (len, h) = wx[0].patch.extent;
         assert!(
-            (len - 20.0).abs() < 1.0 && (h - 6.0).abs() < 0.6,
+            (len - 20.0).abs() < 1.0 && (h - 6.0).abs() < 0.15,
             "{len} {h}"
         );
+        // Its inliers start `ground_clearance` above the road; its rectangle on the ground.
+        for v in &wx[0].patch.vertices[..2] {
+            assert!((v.z - H).abs() < 0.05, "{v}");
+        }
+        let no_foot = PlaneConfig {
+            walls_to_ground: false,
+            ..PlaneConfig::default()
+        };
+        let seg2 = extract_planes(&cloud, &no_foot, &mut seeded(5)).unwrap();
+        let lowest = seg2
+            .walls
+            .iter()
+            .map(|w| w.patch.vertices[0].z)
+            .fold(f64::MAX, f64::min);
+        assert!(lowest > H + 0.25, "{lowest}");
         let wy = find(Vector3::y());
         assert_eq!(wy.len(), 1, "{:?}", seg.walls);
         assert!((wy[0].patch.plane.offset - 8.0).abs() < 0.05);

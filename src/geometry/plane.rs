@@ -305,6 +305,34 @@ impl PlanePatch {
         })
     }
 
+    /// An upright patch (see [`PlanePatch::upright_from_points`]) with its bottom edge lowered
+    /// along the patch's up direction to where the edge's midpoint meets `ground`. Unchanged
+    /// when the bottom already reaches the ground or the patch's sides are parallel to it.
+    pub fn lowered_to(&self, ground: &Plane) -> PlanePatch {
+        let [v0, v1, v2, v3] = self.vertices;
+        let (length, height) = self.extent;
+        if height.is_nan() || height <= 0.0 {
+            return self.clone();
+        }
+        let up = (v3 - v0) / height;
+        let along = ground.normal.dot(&up);
+        if along.abs() < 1e-6 {
+            return self.clone();
+        }
+        let mid = Point3::from((v0.coords + v1.coords) / 2.0);
+        let t = -ground.signed_distance(&mid) / along;
+        if t.is_nan() || t >= 0.0 {
+            return self.clone();
+        }
+        let height = height - t;
+        PlanePatch {
+            plane: self.plane,
+            vertices: [v0 + up * t, v1 + up * t, v2, v3],
+            area: length * height,
+            extent: (length, height),
+        }
+    }
+
     /// Centroid of the four vertices (the rectangle's centre).
     pub fn centre(&self) -> Point3<f64> {
         let s = self
@@ -504,6 +532,33 @@ mod tests {
             }
         }
         pts
+    }
+
+    #[test]
+    fn lowered_patch_reaches_the_ground_below_its_bottom_edge() {
+        // Wall y = 5 seen from z = 0.3 to 3 over x in [0, 10]; the ground z = −0.2 + 0.01 x
+        // (a 1 % slope along the wall) meets the bottom edge's midpoint (x = 5) at z = −0.15.
+        let pts: Vec<_> = (0..=10)
+            .flat_map(|i| [0.3, 3.0].map(|z| Point3::new(i as f64, 5.0, z)))
+            .collect();
+        let plane = Plane::from_points(&pts).unwrap();
+        let patch = PlanePatch::upright_from_points(plane, &pts).unwrap();
+        let n = Vector3::new(-0.01, 0.0, 1.0);
+        let ground = Plane::new(n, 0.2).unwrap();
+        let low = patch.lowered_to(&ground);
+        assert_abs_diff_eq!(low.extent.0, 10.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(low.extent.1, 3.15, epsilon = 1e-9);
+        assert_abs_diff_eq!(low.area, 31.5, epsilon = 1e-9);
+        for k in [0, 1] {
+            assert_abs_diff_eq!(low.vertices[k].z, -0.15, epsilon = 1e-9);
+            assert_abs_diff_eq!(low.vertices[k].x, patch.vertices[k].x, epsilon = 1e-9);
+        }
+        assert_eq!(low.vertices[2], patch.vertices[2]);
+        assert_eq!(low.vertices[3], patch.vertices[3]);
+        // A bottom already at or below the ground, or a ground parallel to the sides: as is.
+        let high_ground = Plane::new(Vector3::z(), -1.0).unwrap();
+        assert_eq!(patch.lowered_to(&high_ground), patch);
+        assert_eq!(patch.lowered_to(&plane), patch);
     }
 
     #[test]

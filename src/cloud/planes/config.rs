@@ -55,6 +55,11 @@ pub struct PlaneConfig {
     /// Walls: facade test on top of the size limits (default [`WallQuality::BUILDING`];
     /// `None`: every building-scale vertical piece is a wall).
     pub wall_quality: Option<WallQuality>,
+    /// Walls: lower each wall's rectangle to the ground plane (when one is found). A wall's
+    /// lowest inliers lie `ground_clearance` or more above the road, and higher where parked
+    /// cars or hedges hide its foot, which changes from scan to scan; a facade stands on the
+    /// ground, so its rectangle's bottom edge is put there.
+    pub walls_to_ground: bool,
 }
 
 /// A facade test for wall pieces that already pass the size limits, so that parked cars,
@@ -118,6 +123,7 @@ impl Default for PlaneConfig {
             grid_cell: 1.0,
             min_cell_points: 3,
             wall_quality: Some(WallQuality::BUILDING),
+            walls_to_ground: true,
         }
     }
 }
