@@ -186,7 +186,13 @@ pub(crate) fn marginals_of_table(table: &LogTable, k: usize, min_weight: f64) ->
                 acc.add(&[j], sub.w[j]);
             }
         } else {
-            for (theta, lw) in ranked(&sub, k, max_gap(min_weight)) {
+            let hyps = ranked(&sub, k, max_gap(min_weight));
+            if hyps.is_empty() {
+                // An infeasible part (tracks that may not be missed competing for too few
+                // measurements) makes the whole problem infeasible.
+                return Marginals::all_missed(n, m);
+            }
+            for (theta, lw) in hyps {
                 acc.add(&theta, lw);
             }
         }
@@ -912,6 +918,24 @@ mod tests {
         }
         assert_eq!(ranked_hypotheses(&p, 2).len(), 2);
         assert!(ranked_hypotheses(&p, 0).is_empty());
+    }
+
+    #[test]
+    fn an_infeasible_part_makes_the_whole_problem_infeasible() {
+        // Track 0 must take z0 (alone in its part); tracks 2 and 3 may not be missed and
+        // both need z1: no hypothesis is admissible, so every track is missed.
+        let ninf = f64::NEG_INFINITY;
+        let p = AssociationProblem::new(
+            4,
+            2,
+            vec![ninf, 0.0, ninf, ninf],
+            vec![0.0, ninf, ninf, ninf, ninf, 0.0, ninf, 0.0],
+        )
+        .unwrap();
+        let mg = MurtyAssociator::default().marginals(&p, &mut seeded(0));
+        assert_eq!(mg, Marginals::all_missed(4, 2));
+        let ex = ExhaustiveAssociator::default().marginals(&p, &mut seeded(0));
+        assert_eq!(mg, ex);
     }
 
     #[test]

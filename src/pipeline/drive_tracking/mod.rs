@@ -216,7 +216,7 @@ pub enum ClusterMethod {
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ClusterDetectionConfig {
-    /// Clustering method. Default `range_image`.
+    /// Clustering method. Default `euclidean`.
     pub method: ClusterMethod,
     /// Neighbour distance of the Euclidean clustering; the range-image clustering joins image
     /// neighbours within it whatever their angle, and up to twice it when the angle criterion
