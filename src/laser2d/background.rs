@@ -40,7 +40,7 @@
 //! All state is structure-of-arrays per beam, double-buffered for the propagation; after the
 //! first scan nothing is allocated.
 
-use super::scan::Scan;
+use super::scan::{nearest_beam, Scan};
 use crate::error::{ensure_positive, Error, Result};
 use crate::geometry::pose2::{inverse, transform_point};
 use crate::geometry::Pose2;
@@ -198,10 +198,8 @@ impl BackgroundMap {
         self.next_range.resize(n, f32::NAN);
         self.next_weight.clear();
         self.next_weight.resize(n, 1);
-        let beam_of = |bearing: f64| -> Option<usize> {
-            let j = ((bearing - self.angle_min) / self.angle_increment).round();
-            (j >= 0.0 && j < n as f64).then_some(j as usize)
-        };
+        // Bearings modulo a full turn: a 360° scanner's points cross its seam.
+        let beam_of = |bearing: f64| nearest_beam(self.angle_min, self.angle_increment, n, bearing);
         // Finite background points first (nearest wins), then "no return" directions into
         // beams nothing finite reached.
         for l in 0..n {
@@ -227,8 +225,7 @@ impl BackgroundMap {
                 continue;
             }
             let phi = self.angle_min + l as f64 * self.angle_increment - motion.theta;
-            let wrapped = crate::geometry::wrap_angle(phi - self.angle_min) + self.angle_min;
-            if let Some(j) = beam_of(wrapped).or_else(|| beam_of(phi)) {
+            if let Some(j) = beam_of(phi) {
                 if self.next_range[j].is_nan() {
                     self.next_range[j] = f32::INFINITY;
                     self.next_weight[j] = self.weight[l];
@@ -537,6 +534,37 @@ mod tests {
         map.update(&s0, &[]).unwrap();
         assert_eq!(map.weights()[90], 20);
         assert!((map.ranges()[90] - 5.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn a_full_turn_scanner_keeps_its_background_across_the_seam() {
+        // 360 beams 1° apart from bearing 0, inside a round room of radius 5 m: atan2's
+        // bearings in (−π, 0) belong to beams 181–359, and a turn carries beams over the seam.
+        let inc = 1f64.to_radians();
+        let scan = Scan::new(0.0, 0.0, inc, vec![5.0; 360], 0.0, 30.0).unwrap();
+        let mut map = BackgroundMap::new(BackgroundConfig::default()).unwrap();
+        map.classify(&scan).unwrap();
+        map.update(&scan, &[]).unwrap();
+        for turn in [0.0, 10.0, -25.0] {
+            map.propagate(Pose2::new(0.0, 0.0, f64::to_radians(turn)))
+                .unwrap();
+            assert!(
+                map.ranges().iter().all(|r| (r - 5.0).abs() < 1e-4),
+                "turn {turn}°: {:?}",
+                map.ranges()
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, r)| r.is_nan() || (*r - 5.0).abs() >= 1e-4)
+                    .take(5)
+                    .collect::<Vec<_>>()
+            );
+            assert!(map
+                .classify(&scan)
+                .unwrap()
+                .iter()
+                .all(|c| *c == BeamClass::Background));
+            map.update(&scan, &[]).unwrap();
+        }
     }
 
     #[test]

@@ -152,18 +152,12 @@ impl Scan {
     /// outside the scan's beams or for a zero or non-finite increment. A return at `p` came
     /// from this beam: the scan reports its bearings without noise.
     pub fn beam_of(&self, p: [f64; 2]) -> Option<usize> {
-        let inc = self.angle_increment;
-        if inc == 0.0 || !inc.is_finite() {
-            return None;
-        }
-        let tau = std::f64::consts::TAU;
-        let from_first = (p[1].atan2(p[0]) - self.angle_min) * inc.signum();
-        let steps = (from_first.rem_euclid(tau) / inc.abs()).round();
-        let wrapped = ((from_first.rem_euclid(tau) - tau) / inc.abs()).round();
-        [steps, wrapped]
-            .into_iter()
-            .find(|s| *s >= 0.0 && (*s as usize) < self.len())
-            .map(|s| s as usize)
+        nearest_beam(
+            self.angle_min,
+            self.angle_increment,
+            self.len(),
+            p[1].atan2(p[0]),
+        )
     }
 
     /// Bearing of the last beam (rad).
@@ -232,6 +226,30 @@ pub fn attach_odometry(scans: &mut [Scan], odometry: &[OdometryRecord]) {
             scan.odometry = Some(sorted[after - 1].pose);
         }
     }
+}
+
+/// The beam, of `len` beams at `angle_min + i·angle_increment`, whose bearing is nearest
+/// `bearing` (rad, taken modulo a full turn: a scanner whose beams start anywhere on the
+/// circle, or go round it whole, is served across the seam); `None` outside the beams or for
+/// a zero or non-finite increment.
+pub fn nearest_beam(
+    angle_min: f64,
+    angle_increment: f64,
+    len: usize,
+    bearing: f64,
+) -> Option<usize> {
+    let inc = angle_increment;
+    if inc == 0.0 || !inc.is_finite() {
+        return None;
+    }
+    let tau = std::f64::consts::TAU;
+    let from_first = ((bearing - angle_min) * inc.signum()).rem_euclid(tau);
+    let steps = (from_first / inc.abs()).round();
+    let wrapped = ((from_first - tau) / inc.abs()).round();
+    [steps, wrapped]
+        .into_iter()
+        .find(|s| *s >= 0.0 && (*s as usize) < len)
+        .map(|s| s as usize)
 }
 
 #[cfg(test)]
