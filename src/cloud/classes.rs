@@ -334,17 +334,6 @@ impl ClassModel {
     }
 }
 
-/// ln p(speed | class) for every class, in [`ObjectClass::ALL`] order (the speed term of
-/// [`ClassModel::log_likelihoods`] alone). A tracker's speed is a filtered estimate that
-/// sums up all the frames so far, so it is evidence to be counted once, with the current
-/// speed, not again with every frame (see
-/// [`RoadUserState`](crate::pipeline::drive_tracking::road_users::RoadUserState)). Fails on a
-/// negative or non-finite speed.
-pub fn speed_log_likelihoods(v: f64) -> Result<[f64; CLASS_COUNT]> {
-    ensure_non_negative("class feature speed", v)?;
-    Ok(ObjectClass::ALL.map(|c| speed_ll(c, v)))
-}
-
 /// ln p(speed | class). Vehicles: uniform on [0, 40 m/s] (parked to motorway). Pedestrians:
 /// half-normal, σ = 1.5 m/s (walking 1.2–1.5 m/s, running ≈ 4 m/s at 2.7σ). Cyclists:
 /// half-normal, σ = 5 m/s (cruising 4–7 m/s). Other: half-normal, σ = 1 m/s (static; the

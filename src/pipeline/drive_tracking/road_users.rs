@@ -8,14 +8,10 @@
 //!   the sensor. That centre, not the centroid of the visible points, is what the filter
 //!   measures.
 //! * A track keeps a categorical class posterior ([`ClassBelief`]) updated with every matched
-//!   detection's class likelihood (its box and point count and, once the track is
-//!   [`TRAVEL_AGE`] frames old and faster than [`TRAVEL_SPEED`], the angle between the
+//!   detection's class likelihood (its speed included, from the track, and, once the track
+//!   is [`TRAVEL_AGE`] frames old and faster than [`TRAVEL_SPEED`], the angle between the
 //!   detection's seen long side and the direction of travel: a car seen end-on shows a
-//!   cyclist's 1.8 m side, but across its travel, where no cyclist has one). The track's speed
-//!   enters once, when the class is read, with the speed of that moment: it is the filter's
-//!   summary of every frame so far, and folded in with each frame it would count the same
-//!   evidence fifty times over (a parked car, standing still like clutter, would turn into
-//!   clutter however car-like its every box). A box size averaged
+//!   cyclist's 1.8 m side, but across its travel, where no cyclist has one), a box size averaged
 //!   over its detections, and a heading in the world frame: the matched box's, turned by π
 //!   towards the direction of travel once the track moves.
 //! * A confirmed cluster is a road user unless its class is `Other` and it moves slower than
@@ -29,8 +25,8 @@
 
 use crate::cloud::boxes::{fit_box_of, BoxFitParams, BoxScratch};
 use crate::cloud::classes::{
-    default_prior, speed_log_likelihoods, ClassBelief, ClassFeatures, ClassModel, ObjectClass,
-    CLASS_COUNT, DEFAULT_FORGETTING,
+    default_prior, ClassBelief, ClassFeatures, ClassModel, ObjectClass, CLASS_COUNT,
+    DEFAULT_FORGETTING,
 };
 use crate::cloud::PointCloud;
 use crate::error::Result;
@@ -174,13 +170,18 @@ pub struct RoadUserState {
 impl RoadUserState {
     /// The state after the first matched detection `shape`, whose box heading in the world
     /// frame is `world_yaw`.
-    pub fn new(shape: &ClusterShape, world_yaw: f64, model: &ClassModel) -> Result<Self> {
+    pub fn new(
+        shape: &ClusterShape,
+        world_yaw: f64,
+        speed: f64,
+        model: &ClassModel,
+    ) -> Result<Self> {
         let mut s = RoadUserState {
             belief: ClassBelief::new(default_prior())?,
             size: shape.bbox.size,
             yaw: world_yaw,
         };
-        s.observe_class(shape, None, model)?;
+        s.observe_class(shape, speed, None, model)?;
         Ok(s)
     }
 
@@ -189,11 +190,12 @@ impl RoadUserState {
     fn observe_class(
         &mut self,
         shape: &ClusterShape,
+        speed: f64,
         travel: Option<f64>,
         model: &ClassModel,
     ) -> Result<()> {
         let features = ClassFeatures {
-            speed: None,
+            speed: Some(speed),
             travel_angle: travel.and_then(|t| travel_angle(&shape.fitted, t)),
             ..shape.features
         };
@@ -206,10 +208,11 @@ impl RoadUserState {
         &mut self,
         shape: &ClusterShape,
         world_yaw: f64,
+        speed: f64,
         travel: Option<f64>,
         model: &ClassModel,
     ) -> Result<()> {
-        self.observe_class(shape, travel, model)?;
+        self.observe_class(shape, speed, travel, model)?;
         for (s, d) in self.size.iter_mut().zip(shape.bbox.size) {
             *s += SIZE_GAIN * (d - *s);
         }
@@ -217,24 +220,15 @@ impl RoadUserState {
         Ok(())
     }
 
-    /// The belief with the track's current `speed` (m/s) folded in once.
-    fn belief_at(&self, speed: f64) -> Result<ClassBelief> {
-        let mut b = self.belief;
-        b.update(&speed_log_likelihoods(speed)?, 0.0)?;
-        Ok(b)
+    /// The most likely class and its probability.
+    pub fn class(&self) -> (ObjectClass, f64) {
+        let c = self.belief.most_likely();
+        (c, self.belief.probability(c))
     }
 
-    /// The most likely class and its probability for a track moving at `speed` (m/s). Fails
-    /// on a negative or non-finite speed.
-    pub fn class(&self, speed: f64) -> Result<(ObjectClass, f64)> {
-        let b = self.belief_at(speed)?;
-        let c = b.most_likely();
-        Ok((c, b.probability(c)))
-    }
-
-    /// The class probabilities in [`ObjectClass::ALL`] order for a track moving at `speed`.
-    pub fn probabilities(&self, speed: f64) -> Result<[f64; CLASS_COUNT]> {
-        Ok(self.belief_at(speed)?.probabilities())
+    /// The class probabilities in [`ObjectClass::ALL`] order.
+    pub fn probabilities(&self) -> [f64; CLASS_COUNT] {
+        self.belief.probabilities()
     }
 
     /// Box size (length, width, height, m).
@@ -259,8 +253,8 @@ impl RoadUserState {
     }
 
     /// Whether a confirmed track of this state moving at `speed` is a road user.
-    pub fn is_road_user(&self, speed: f64) -> Result<bool> {
-        Ok(self.class(speed)?.0 != ObjectClass::Other || speed >= STATIC_SPEED)
+    pub fn is_road_user(&self, speed: f64) -> bool {
+        self.class().0 != ObjectClass::Other || speed >= STATIC_SPEED
     }
 }
 
@@ -362,73 +356,33 @@ mod tests {
 
     #[test]
     fn heading_follows_the_direction_of_travel_and_static_other_is_not_a_road_user() {
-        // A pole at 10 m, seen up to the scanner's top beam (+2°: 2.1 m above the road).
-        let b = Box3::new(Point3::new(10.0, 0.0, -0.73), [0.3, 0.3, 2.0], 0.0);
+        // A 4 m pole: no road user is that thin and tall.
+        let b = Box3::new(Point3::new(10.0, 0.0, 0.3), [0.3, 0.3, 4.0], 0.0);
         let shape = ClusterShape {
             bbox: b,
             fitted: b,
             features: ClassFeatures {
                 length: 0.3,
                 width: 0.3,
-                height: 2.0,
+                height: 4.0,
                 range: 10.0,
-                points: 200,
+                points: 300,
                 speed: None,
                 travel_angle: None,
             },
             class: ObjectClass::Other,
         };
         let model = ClassModel::default();
-        let mut s = RoadUserState::new(&shape, 0.1, &model).unwrap();
+        let mut s = RoadUserState::new(&shape, 0.1, 0.0, &model).unwrap();
         for _ in 0..5 {
-            s.update(&shape, 0.1, None, &model).unwrap();
+            s.update(&shape, 0.1, 0.0, None, &model).unwrap();
         }
-        assert_eq!(s.class(0.0).unwrap().0, ObjectClass::Other);
-        assert!(!s.is_road_user(0.2).unwrap());
-        assert!(s.is_road_user(STATIC_SPEED + 0.5).unwrap());
-        assert!(s.class(-1.0).is_err() && s.is_road_user(f64::NAN).is_err());
+        assert_eq!(s.class().0, ObjectClass::Other);
+        assert!(!s.is_road_user(0.2));
+        assert!(s.is_road_user(STATIC_SPEED + 0.5));
         // Moving backwards along the box axis: the heading turns by π; slow: it stays.
         assert!((wrap_angle(s.heading([-3.0, -0.2]) - (0.1 - PI))).abs() < 1e-12);
         assert_eq!(s.heading([0.1, 0.0]), 0.1);
         assert_eq!(s.heading([3.0, 0.2]), 0.1);
-    }
-
-    #[test]
-    fn a_parked_car_stays_a_car_because_its_speed_counts_once() {
-        // A car's box at 15 m with its expected point count, seen standing still 60 times.
-        let b = Box3::new(Point3::new(15.0, 0.0, -0.98), [3.9, 1.6, 1.5], 0.0);
-        let model = ClassModel::default();
-        let points = model.expected_points([3.9, 1.6, 1.5], 15.0).round() as usize;
-        let shape = ClusterShape {
-            bbox: b,
-            fitted: b,
-            features: ClassFeatures {
-                length: 3.9,
-                width: 1.6,
-                height: 1.5,
-                range: 15.0,
-                points,
-                speed: None,
-                travel_angle: None,
-            },
-            class: ObjectClass::Car,
-        };
-        // ln P(Car)/P(Other) at speed 0 minus the same at 10 m/s: only Other's half-normal
-        // (σ = 1 m/s) depends on the speed below 40 m/s, so the difference is −10²/2 = −50
-        // by hand, after 5 frames as after 60 (counted with every frame it would grow).
-        let log_odds = |s: &RoadUserState, v: f64| {
-            let p = s.probabilities(v).unwrap();
-            (p[ObjectClass::Car.index()] / p[ObjectClass::Other.index()]).ln()
-        };
-        let mut s = RoadUserState::new(&shape, 0.0, &model).unwrap();
-        for n in 2..=60 {
-            s.update(&shape, 0.0, None, &model).unwrap();
-            if n == 5 || n == 60 {
-                let shift = log_odds(&s, 0.0) - log_odds(&s, 10.0);
-                assert!((shift + 50.0).abs() < 1e-6, "{n} frames: {shift}");
-            }
-        }
-        assert_eq!(s.class(0.0).unwrap().0, ObjectClass::Car);
-        assert!(s.is_road_user(0.0).unwrap());
     }
 }

@@ -323,20 +323,18 @@ impl DriveTracker {
                         Some(state) => {
                             let travel = travel_direction([velocity[0], velocity[1]], e.age)
                                 .map(|t| wrap_angle(t - ego_yaw));
-                            state.update(shape, world_yaw, travel, &self.class_model)?
+                            state.update(shape, world_yaw, speed, travel, &self.class_model)?
                         }
                         None => {
-                            let state = RoadUserState::new(shape, world_yaw, &self.class_model)?;
+                            let state =
+                                RoadUserState::new(shape, world_yaw, speed, &self.class_model)?;
                             self.road_users.insert(e.label, state);
                         }
                     }
                 }
             }
             let state = self.road_users.get(&e.label);
-            let road_user = match state {
-                Some(st) => st.is_road_user(speed)?,
-                None => true,
-            };
+            let road_user = state.is_none_or(|st| st.is_road_user(speed));
             if !road_user && !self.all_clusters {
                 if let Some(n) = clutter_particles {
                     caps.insert(e.label, n);
@@ -346,7 +344,7 @@ impl DriveTracker {
             let s = inv * w;
             let (class, class_probability, box_world, box_sensor) = match state {
                 Some(st) => {
-                    let (class, p) = st.class(speed)?;
+                    let (class, p) = st.class();
                     let yaw = st.heading([velocity[0], velocity[1]]);
                     let world = OrientedBox {
                         center: [w.x, w.y, w.z],
