@@ -90,6 +90,7 @@ fn plane_config(options: Option<&Bound<'_, PyDict>>) -> PyResult<PlaneConfig> {
             min_wall_area,
             min_wall_length,
             min_wall_height,
+            walls_to_ground,
             grid_cell,
             min_cell_points
         );

@@ -32,13 +32,19 @@ def test_ground_and_facade_are_found_where_they_were_built():
     # The facade x = 10 is n = (−1, 0, 0), d = 10.
     np.testing.assert_allclose(w["normal"], [-1, 0, 0], atol=2e-3)
     assert w["offset"] == pytest.approx(10.0, abs=0.01)
-    # Wall inliers are taken from 0.3 m above the road up (ground_clearance), so the patch
-    # spans 20 m × (7.7 − 0.3) m and holds about 7.4 / 7.7 of the facade's 8000 points.
-    assert w["area"] == pytest.approx(20 * 7.4, rel=0.02)
+    # Wall inliers are taken from 0.3 m above the road up (ground_clearance): they hold about
+    # 7.4 / 7.7 of the facade's 8000 points, and the patch, lowered to the road, spans
+    # 20 m × 7.7 m.
+    assert w["area"] == pytest.approx(20 * 7.7, rel=0.02)
     assert w["rms"] == pytest.approx(0.01, rel=0.2)
     assert np.all(w["inliers"] >= 20000)
     assert len(w["inliers"]) == pytest.approx(8000 * 7.4 / 7.7, rel=0.02)
     assert seg["skipped"] == 0
+    # Without lowering, the patch ends at the lowest inlier, 0.3 m above the road.
+    high = smc_lmb.extract_planes(street(), seed=1, walls_to_ground=False)["walls"][0]
+    assert high["area"] == pytest.approx(20 * 7.4, rel=0.02)
+    assert min(v[2] for v in high["vertices"]) == pytest.approx(-1.4, abs=0.05)
+    assert min(v[2] for v in w["vertices"]) == pytest.approx(-1.7, abs=0.02)
 
 
 def test_segmentation_repeats_for_a_seed_and_options_apply():

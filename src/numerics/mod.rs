@@ -10,4 +10,5 @@
 pub(crate) mod atan;
 pub(crate) mod exp;
 pub(crate) mod floor;
+#[cfg(feature = "laser2d")]
 pub(crate) mod sym2;
