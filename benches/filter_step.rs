@@ -13,8 +13,8 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Through
 use smc_lmb::filter::birth::BirthEvidence;
 use smc_lmb::filter::StepContext;
 use smc_lmb::filter::{
-    BirthModel, BirthTrack, FixedLagSmoother, Frame, LmbConfig, LmbFilter, Measurements,
-    StaticBirth,
+    AssociationMethod, BirthModel, BirthTrack, FixedLagSmoother, Frame, LmbConfig, LmbFilter,
+    Measurements, StaticBirth,
 };
 use smc_lmb::models::{ConstantDetection, ConstantVelocity, PositionMeasurement, UniformClutter};
 use smc_lmb::rng::seeded;
@@ -113,7 +113,9 @@ fn whole_run(scenario: &Scenario, sim: &SimRun, particles: usize, lag: usize) ->
         smoothing_lag: lag,
         ..LmbConfig::default()
     };
-    let mut f = scenario.filter(config, Default::default()).unwrap();
+    let mut f = scenario
+        .filter(config, AssociationMethod::default())
+        .unwrap();
     let mut smoother = FixedLagSmoother::new(lag);
     let mut rng = seeded(3);
     let mut handed = 0;

@@ -13,12 +13,17 @@
 
 use anyhow::{Context, Result};
 use clap::Parser;
+use smc_lmb::filter::association::{AssociationProblem, Marginals};
 use smc_lmb::filter::{
-    AssociationMethod, Estimate, FixedLagSmoother, Frame, Jitter, LmbConfig, Measurements,
+    AssociationMethod, Associator, Estimate, FixedLagSmoother, Frame, Jitter, LmbConfig,
+    Measurements,
 };
 use smc_lmb::metrics::{cardinality_error, gospa, ospa};
 use smc_lmb::rng::seeded;
 use smc_lmb::sim::{DynamicsSpec, Scenario};
+use smc_lmb::FilterRng;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
 #[derive(Parser, Debug)]
@@ -70,6 +75,11 @@ struct RunResult {
     gospa: Vec<f64>,
     card: Vec<f64>,
     ms: Vec<f64>,
+    /// Per step: time spent in the associator (summed over its calls, whichever thread), and
+    /// the tracks and particles the filter holds after the step.
+    association_ms: Vec<f64>,
+    tracks: Vec<f64>,
+    particles: Vec<f64>,
     /// Where the OSPA comes from (`--breakdown`).
     parts: Breakdown,
     /// Per step: OSPA of the fixed-lag smoothed estimates, its localisation and cardinality
@@ -97,6 +107,22 @@ struct Breakdown {
     young_steps: usize,
 }
 
+/// An associator that adds the time of every call to a shared counter (nanoseconds).
+struct Timed {
+    inner: AssociationMethod,
+    nanos: Arc<AtomicU64>,
+}
+
+impl Associator for Timed {
+    fn marginals(&self, problem: &AssociationProblem, rng: &mut FilterRng) -> Marginals {
+        let t0 = Instant::now();
+        let m = self.inner.marginals(problem, rng);
+        let dt = t0.elapsed().as_nanos() as u64;
+        self.nanos.fetch_add(dt, Ordering::Relaxed);
+        m
+    }
+}
+
 fn run_once(
     scenario: &Scenario,
     associator: &AssociationMethod,
@@ -104,7 +130,12 @@ fn run_once(
     seed: u64,
 ) -> Result<RunResult> {
     let sim = scenario.generate(seed)?;
-    let mut filter = scenario.filter(config.clone(), *associator)?;
+    let nanos = Arc::new(AtomicU64::new(0));
+    let timed = Timed {
+        inner: *associator,
+        nanos: Arc::clone(&nanos),
+    };
+    let mut filter = scenario.filter(config.clone(), timed)?;
     let mut rng = seeded(seed ^ 0x5EED);
     let (c, p) = (scenario.ospa_cutoff, scenario.ospa_order);
     let mut out = RunResult {
@@ -112,6 +143,9 @@ fn run_once(
         gospa: vec![],
         card: vec![],
         ms: vec![],
+        association_ms: vec![],
+        tracks: vec![],
+        particles: vec![],
         parts: Breakdown::default(),
         smoothed: vec![],
     };
@@ -130,6 +164,16 @@ fn run_once(
         let t0 = Instant::now();
         let est = filter.step(&frame, &mut rng)?;
         out.ms.push(t0.elapsed().as_secs_f64() * 1e3);
+        out.association_ms
+            .push(nanos.swap(0, Ordering::Relaxed) as f64 * 1e-6);
+        out.tracks.push(filter.tracks().len() as f64);
+        out.particles.push(
+            filter
+                .tracks()
+                .iter()
+                .map(|t| t.particles.len() as f64)
+                .sum(),
+        );
         if lag > 0 {
             if let Some(late) = smoother.push(&filter, est.clone())? {
                 let o = ospa(&truth_at(k - lag), &position(&late), c, p)?;
@@ -328,6 +372,12 @@ fn main() -> Result<()> {
     let gospa_k = per_step(|r| &r.gospa);
     let card_k = per_step(|r| &r.card);
     let all_ms: Vec<f64> = runs.iter().flat_map(|r| r.ms.iter().copied()).collect();
+    let all = |f: fn(&RunResult) -> &Vec<f64>| -> Vec<f64> {
+        runs.iter().flat_map(|r| f(r).iter().copied()).collect()
+    };
+    let assoc_ms = all(|r| &r.association_ms);
+    let tracks = all(|r| &r.tracks);
+    let particles = all(|r| &r.particles);
     let summary = serde_json::json!({
         "scenario": args.scenario,
         "runs": args.runs,
@@ -344,6 +394,10 @@ fn main() -> Result<()> {
         "mean_card_error": mean(&card_k),
         "ms_per_step_median": median(&all_ms),
         "ms_per_step_mean": mean(&all_ms),
+        "association_ms_per_step_median": median(&assoc_ms),
+        "association_ms_per_step_mean": mean(&assoc_ms),
+        "tracks_per_step": mean(&tracks),
+        "particles_per_step": mean(&particles),
         "ospa_per_run": runs.iter().map(|r| mean(&r.ospa)).collect::<Vec<_>>(),
         "smoothing_lag": args.smooth_lag,
         "smoothed_mean_ospa": (args.smooth_lag > 0).then(|| smoothed_mean(&runs, |s| s.0)),
@@ -397,6 +451,13 @@ fn main() -> Result<()> {
         "time per step: median {:.3} ms, mean {:.3} ms",
         median(&all_ms),
         mean(&all_ms)
+    );
+    println!(
+        "association per step: median {:.3} ms, mean {:.3} ms; {:.1} tracks and {:.0} particles after a step",
+        median(&assoc_ms),
+        mean(&assoc_ms),
+        mean(&tracks),
+        mean(&particles)
     );
     Ok(())
 }

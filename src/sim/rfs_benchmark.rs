@@ -21,7 +21,7 @@
 use crate::error::{
     ensure_finite, ensure_non_negative, ensure_positive, ensure_probability, Error, Result,
 };
-use crate::filter::{AssociationMethod, BirthTerm, LmbConfig, LmbFilter, StaticBirth};
+use crate::filter::{Associator, BirthTerm, LmbConfig, LmbFilter, StaticBirth};
 use crate::filter::{
     ClutterModel, ConstantSurvival, DetectionModel, MeasurementModel, StepContext, SurvivalModel,
     TransitionModel,
@@ -608,8 +608,12 @@ impl Scenario {
 
     /// The particle LMB filter the scenario prescribes: its [`models`](Self::models), the birth
     /// terms as a static birth sampled with `config.particles` particles each, the given tuning
-    /// and association method.
-    pub fn filter(&self, config: LmbConfig, associator: AssociationMethod) -> Result<LmbFilter> {
+    /// and associator (an [`AssociationMethod`](crate::filter::AssociationMethod) or a user's own).
+    pub fn filter(
+        &self,
+        config: LmbConfig,
+        associator: impl Associator + 'static,
+    ) -> Result<LmbFilter> {
         let m = self.models()?;
         LmbFilter::builder()
             .transition(m.transition)
