@@ -353,6 +353,72 @@ fn speed_ll(class: ObjectClass, v: f64) -> f64 {
     }
 }
 
+/// ln p(speed | class) for every class, in [`ObjectClass::ALL`] order, when the speed is
+/// known only through weighted samples of its posterior (`(speed, weight)` pairs, e.g. a
+/// track's particles): ln of the weighted mean of each class's speed density over the
+/// samples (see the private `speed_ll`), the evidence the track's measurements give about
+/// the class through its motion when the filter's velocity prior is broad. A young track's
+/// velocity is mostly its birth spread and a few noisy box centres, so its mean speed can
+/// be several m/s for a static object; the density at that mean would call it a mover with
+/// certainty, while the average over the posterior keeps the static hypothesis as likely as
+/// the samples near zero make it. One sample of weight 1 gives the density at that speed.
+/// Fails on an empty sample, a non-finite or negative speed, or weights that do not sum to a
+/// positive finite value.
+pub fn speed_log_likelihoods(
+    samples: impl IntoIterator<Item = (f64, f64)>,
+) -> Result<[f64; CLASS_COUNT]> {
+    let mut sum = [0.0; CLASS_COUNT];
+    let mut total = 0.0;
+    for (v, w) in samples {
+        if !(v >= 0.0 && v.is_finite()) {
+            return Err(Error::invalid(
+                "speed sample",
+                format!("{v} (must be finite and non-negative)"),
+            ));
+        }
+        if !(w >= 0.0 && w.is_finite()) {
+            return Err(Error::invalid(
+                "speed sample weight",
+                format!("{w} (must be finite and non-negative)"),
+            ));
+        }
+        if w == 0.0 {
+            continue;
+        }
+        total += w;
+        for (k, d) in speed_densities(v).iter().enumerate() {
+            sum[k] += w * d;
+        }
+    }
+    if !(total > 0.0 && total.is_finite()) {
+        return Err(Error::invalid(
+            "speed samples",
+            format!("total weight {total} (need a positive finite sum)"),
+        ));
+    }
+    Ok(sum.map(|x| (x / total).max(f64::MIN_POSITIVE).ln()))
+}
+
+/// p(speed | class) for every class at speed `v` ≥ 0: the densities of [`speed_ll`]
+/// without the logarithm (three exponentials for the six classes).
+fn speed_densities(v: f64) -> [f64; CLASS_COUNT] {
+    let half_normal = |sigma: f64| {
+        let z = v / sigma;
+        (2.0 / (sigma * (2.0 * PI).sqrt())) * (-0.5 * z * z).exp()
+    };
+    let vehicle = if v <= 40.0 { 1.0 / 40.0 } else { 0.0 };
+    let mut d = [0.0; CLASS_COUNT];
+    for (k, c) in ObjectClass::ALL.iter().enumerate() {
+        d[k] = match c {
+            ObjectClass::Car | ObjectClass::Van | ObjectClass::Truck => vehicle,
+            ObjectClass::Pedestrian => half_normal(1.5),
+            ObjectClass::Cyclist => half_normal(5.0),
+            ObjectClass::Other => half_normal(1.0),
+        };
+    }
+    d
+}
+
 /// Spread of the angle between a footprint's seen long side and the side it lies along
 /// (rad): the L-shape heading's error on a partly seen object, about 15°.
 const TRAVEL_SIGMA: f64 = 15.0 * PI / 180.0;
@@ -569,6 +635,47 @@ mod tests {
         let ratio =
             m.expected_points([4.0, 2.0, 1.5], 10.0) / m.expected_points([4.0, 2.0, 1.5], 20.0);
         assert!((ratio - 4.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn speed_evidence_averages_the_class_densities_over_the_samples() {
+        // Reference values by hand: half-normal 2·N(v; 0, σ), vehicles uniform on [0, 40].
+        let idx = |c: ObjectClass| c.index();
+        let one = speed_log_likelihoods([(2.0, 1.0)]).unwrap();
+        for (c, want) in [
+            (ObjectClass::Other, -2.2257913526447273),
+            (ObjectClass::Pedestrian, -1.5201453496417807),
+            (ObjectClass::Cyclist, -1.9152292650788278),
+            (ObjectClass::Car, -3.6888794541139363),
+            (ObjectClass::Truck, -3.6888794541139363),
+        ] {
+            assert!((one[idx(c)] - want).abs() < 1e-12, "{c}: {}", one[idx(c)]);
+        }
+        // Half the posterior standing, half at 6 m/s: the mean speed (3 m/s) would make
+        // `Other` (2·N(3; 0, 1), ln = −4.726) less likely than a vehicle (ln 1/40 = −3.689);
+        // averaged over the samples, standing still keeps it the more likely.
+        let split = speed_log_likelihoods([(0.0, 0.5), (6.0, 0.5)]).unwrap();
+        assert!((split[idx(ObjectClass::Other)] - -0.9189385179746931).abs() < 1e-12);
+        assert!((split[idx(ObjectClass::Pedestrian)] - -1.324068234939941).abs() < 1e-12);
+        assert!((split[idx(ObjectClass::Cyclist)] - -2.1317823986585487).abs() < 1e-12);
+        assert!(split[idx(ObjectClass::Other)] > split[idx(ObjectClass::Van)]);
+        // Weights are normalised; zero-weight samples are left out.
+        let scaled = speed_log_likelihoods([(0.0, 3.0), (6.0, 3.0), (30.0, 0.0)]).unwrap();
+        for (a, b) in scaled.iter().zip(&split) {
+            assert!((a - b).abs() < 1e-12);
+        }
+        // The densities are those of the plug-in log-likelihood.
+        for v in [0.0, 0.7, 3.0, 12.0, 30.0] {
+            for (k, c) in ObjectClass::ALL.iter().enumerate() {
+                let (d, l) = (speed_densities(v)[k], speed_ll(*c, v));
+                assert!((d.ln() - l).abs() < 1e-9, "{c} at {v}: {d} vs e^{l}");
+            }
+        }
+        assert!(speed_log_likelihoods([]).is_err());
+        assert!(speed_log_likelihoods([(f64::NAN, 1.0)]).is_err());
+        assert!(speed_log_likelihoods([(-1.0, 1.0)]).is_err());
+        assert!(speed_log_likelihoods([(1.0, -1.0)]).is_err());
+        assert!(speed_log_likelihoods([(1.0, 0.0)]).is_err());
     }
 
     #[test]

@@ -8,7 +8,8 @@
 //!   the sensor. That centre, not the centroid of the visible points, is what the filter
 //!   measures.
 //! * A track keeps a categorical class posterior ([`ClassBelief`]) updated with every matched
-//!   detection's class likelihood (its speed included, from the track, and, once the track
+//!   detection's class likelihood (its speed included: the class speed densities averaged
+//!   over the track's velocity particles, [`speed_evidence`]; and, once the track
 //!   is [`TRAVEL_AGE`] frames old and faster than [`TRAVEL_SPEED`], the angle between the
 //!   detection's seen long side and the direction of travel: a car seen end-on shows a
 //!   cyclist's 1.8 m side, but across its travel, where no cyclist has one), a box size averaged
@@ -25,11 +26,12 @@
 
 use crate::cloud::boxes::{fit_box_of, BoxFitParams, BoxScratch};
 use crate::cloud::classes::{
-    default_prior, ClassBelief, ClassFeatures, ClassModel, ObjectClass, CLASS_COUNT,
-    DEFAULT_FORGETTING,
+    default_prior, speed_log_likelihoods, ClassBelief, ClassFeatures, ClassModel, ObjectClass,
+    CLASS_COUNT, DEFAULT_FORGETTING,
 };
 use crate::cloud::PointCloud;
 use crate::error::Result;
+use crate::filter::ParticleSet;
 use crate::geometry::box3::bev_intersection_area;
 use crate::geometry::{wrap_angle, Box3};
 use std::f64::consts::PI;
@@ -141,6 +143,28 @@ pub fn travel_direction(velocity: [f64; 2], age: u32) -> Option<f64> {
     (speed >= TRAVEL_SPEED && age >= TRAVEL_AGE).then(|| velocity[1].atan2(velocity[0]))
 }
 
+/// Most particles [`speed_evidence`] looks at, evenly strided over the set: the average of
+/// a smooth density needs no more, and ~150 tracks a frame keep its cost small.
+pub const SPEED_SAMPLES: usize = 64;
+
+/// A cluster track's speed evidence per class ([`speed_log_likelihoods`]): the class speed
+/// densities averaged over its particles' speeds in the ground plane (state components 1 and
+/// 3, the x and y velocity), with their weights; at most [`SPEED_SAMPLES`] particles, evenly
+/// strided.
+pub fn speed_evidence(particles: &ParticleSet) -> Result<[f64; CLASS_COUNT]> {
+    let (vx, vy, w) = (
+        particles.component(1),
+        particles.component(3),
+        particles.weights(),
+    );
+    let step = particles.len().div_ceil(SPEED_SAMPLES).max(1);
+    speed_log_likelihoods(
+        (0..particles.len())
+            .step_by(step)
+            .map(|i| (vx[i].hypot(vy[i]), w[i])),
+    )
+}
+
 /// Angle in [0, π/2] between the longer footprint side of `fitted` and the direction
 /// `travel` (same frame), or `None` for a footprint that is not elongated.
 fn travel_angle(fitted: &Box3, travel: f64) -> Option<f64> {
@@ -169,11 +193,12 @@ pub struct RoadUserState {
 
 impl RoadUserState {
     /// The state after the first matched detection `shape`, whose box heading in the world
-    /// frame is `world_yaw`.
+    /// frame is `world_yaw`; `speed_ll` is the track's speed evidence per class
+    /// ([`speed_log_likelihoods`] over its velocity posterior).
     pub fn new(
         shape: &ClusterShape,
         world_yaw: f64,
-        speed: f64,
+        speed_ll: &[f64; CLASS_COUNT],
         model: &ClassModel,
     ) -> Result<Self> {
         let mut s = RoadUserState {
@@ -181,7 +206,7 @@ impl RoadUserState {
             size: shape.bbox.size,
             yaw: world_yaw,
         };
-        s.observe_class(shape, speed, None, model)?;
+        s.observe_class(shape, speed_ll, None, model)?;
         Ok(s)
     }
 
@@ -190,17 +215,20 @@ impl RoadUserState {
     fn observe_class(
         &mut self,
         shape: &ClusterShape,
-        speed: f64,
+        speed_ll: &[f64; CLASS_COUNT],
         travel: Option<f64>,
         model: &ClassModel,
     ) -> Result<()> {
         let features = ClassFeatures {
-            speed: Some(speed),
+            speed: None,
             travel_angle: travel.and_then(|t| travel_angle(&shape.fitted, t)),
             ..shape.features
         };
-        self.belief
-            .update(&model.log_likelihoods(&features)?, DEFAULT_FORGETTING)
+        let mut ll = model.log_likelihoods(&features)?;
+        for (l, s) in ll.iter_mut().zip(speed_ll) {
+            *l += s;
+        }
+        self.belief.update(&ll, DEFAULT_FORGETTING)
     }
 
     /// Folds in one more matched detection.
@@ -208,11 +236,11 @@ impl RoadUserState {
         &mut self,
         shape: &ClusterShape,
         world_yaw: f64,
-        speed: f64,
+        speed_ll: &[f64; CLASS_COUNT],
         travel: Option<f64>,
         model: &ClassModel,
     ) -> Result<()> {
-        self.observe_class(shape, speed, travel, model)?;
+        self.observe_class(shape, speed_ll, travel, model)?;
         for (s, d) in self.size.iter_mut().zip(shape.bbox.size) {
             *s += SIZE_GAIN * (d - *s);
         }
@@ -373,9 +401,10 @@ mod tests {
             class: ObjectClass::Other,
         };
         let model = ClassModel::default();
-        let mut s = RoadUserState::new(&shape, 0.1, 0.0, &model).unwrap();
+        let standing = speed_log_likelihoods([(0.0, 1.0)]).unwrap();
+        let mut s = RoadUserState::new(&shape, 0.1, &standing, &model).unwrap();
         for _ in 0..5 {
-            s.update(&shape, 0.1, 0.0, None, &model).unwrap();
+            s.update(&shape, 0.1, &standing, None, &model).unwrap();
         }
         assert_eq!(s.class().0, ObjectClass::Other);
         assert!(!s.is_road_user(0.2));

@@ -13,11 +13,12 @@
 
 use super::detect::FrameDetections;
 use super::output::{OrientedBox, StageTimes, TrackedCluster, TrackedFrame, TrackedPlane};
-use super::road_users::{contained_in_others, travel_direction, RoadUserState};
+use super::road_users::{contained_in_others, speed_evidence, travel_direction, RoadUserState};
 use super::{EgoModel, TrackingConfig};
+use crate::cloud::classes::speed_log_likelihoods;
 use crate::cloud::classes::ClassModel;
 use crate::error::Result;
-use crate::filter::{AdaptiveBirth, Estimate, Frame, Label, LmbFilter};
+use crate::filter::{AdaptiveBirth, Estimate, Frame, Label, LmbFilter, Track};
 use crate::geometry::wrap_angle;
 use crate::geometry::Plane;
 use crate::models::plane::{canonical_plane, plane_residual};
@@ -310,6 +311,20 @@ impl DriveTracker {
         // `ClusterTuning::clutter_particles`).
         let clutter_particles = self.clutter_particles;
         let mut caps = HashMap::new();
+        // The speed evidence of the tracks whose class is updated below.
+        let tracks: HashMap<Label, &Track> =
+            self.filter.tracks().iter().map(|t| (t.label, t)).collect();
+        let mut speed_lls = HashMap::new();
+        for ((e, _), m) in clusters.iter().zip(&cluster_match) {
+            if m.is_some() {
+                let ll = match tracks.get(&e.label) {
+                    Some(t) => speed_evidence(&t.particles)?,
+                    None => speed_log_likelihoods([(e.state[1].hypot(e.state[3]), 1.0)])?,
+                };
+                speed_lls.insert(e.label, ll);
+            }
+        }
+        drop(tracks);
         for ((e, w), m) in clusters.iter().zip(cluster_match) {
             let velocity = [e.state[1], e.state[3], e.state[5]];
             let speed = velocity[0].hypot(velocity[1]);
@@ -319,15 +334,16 @@ impl DriveTracker {
                     .insert(e.label, std::array::from_fn(|a| c.max[a] - c.min[a]));
                 if let Some(shape) = &c.shape {
                     let world_yaw = wrap_angle(shape.bbox.yaw + ego_yaw);
+                    let speed_ll = &speed_lls[&e.label];
                     match self.road_users.get_mut(&e.label) {
                         Some(state) => {
                             let travel = travel_direction([velocity[0], velocity[1]], e.age)
                                 .map(|t| wrap_angle(t - ego_yaw));
-                            state.update(shape, world_yaw, speed, travel, &self.class_model)?
+                            state.update(shape, world_yaw, speed_ll, travel, &self.class_model)?
                         }
                         None => {
                             let state =
-                                RoadUserState::new(shape, world_yaw, speed, &self.class_model)?;
+                                RoadUserState::new(shape, world_yaw, speed_ll, &self.class_model)?;
                             self.road_users.insert(e.label, state);
                         }
                     }
