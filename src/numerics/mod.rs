@@ -1,7 +1,7 @@
-//! Numerical kernels the per-particle and per-point loops share: a slice exponential on vector
-//! lanes ([`exp`]), a full-precision `atan2` for whole slices ([`atan`]) and an integer floor
-//! without a libm call ([`floor`]), and the eigenvalues of a symmetric 2 × 2 matrix
-//! ([`sym2`]). The first three are exact replacements of the standard library's
+//! Numerical kernels the per-particle and per-point loops share: a slice exponential and a
+//! slice logarithm on vector lanes ([`exp`], [`ln`]), a full-precision `atan2` for whole
+//! slices ([`atan`]) and an integer floor without a libm call ([`floor`]), and the eigenvalues
+//! of a symmetric 2 × 2 matrix ([`sym2`]). The first four are exact replacements of the standard library's
 //! functions (within their documented error), written so that the compiler inlines or
 //! vectorises them.
 //!
@@ -10,5 +10,6 @@
 pub(crate) mod atan;
 pub(crate) mod exp;
 pub(crate) mod floor;
+pub(crate) mod ln;
 #[cfg(feature = "laser2d")]
 pub(crate) mod sym2;

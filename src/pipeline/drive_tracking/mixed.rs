@@ -52,6 +52,8 @@ use crate::filter::{
 };
 use crate::models::plane::{canonical_plane, EgoSource};
 use crate::models::{ConstantVelocity, ExtendedConstantTurn, PlaneMeasurement, PlaneTransition};
+use crate::numerics::exp::exp_in_place;
+use crate::numerics::ln::ln_in_place;
 use crate::rng::FilterRng;
 use rand_distr::{Distribution, StandardNormal};
 use std::sync::{Arc, RwLock};
@@ -232,6 +234,8 @@ pub struct MixedMeasurement {
     plane: PlaneMeasurement,
     cluster_sigma: f64,
     cluster_gate: f64,
+    /// Weight ε and scale k of the wide component of the cluster likelihood (ε = 0: none).
+    cluster_outliers: (f64, f64),
 }
 
 impl MixedMeasurement {
@@ -244,7 +248,31 @@ impl MixedMeasurement {
             plane,
             cluster_sigma,
             cluster_gate,
+            cluster_outliers: (0.0, 1.0),
         })
+    }
+
+    /// Scores cluster centres by a contaminated Gaussian instead: (1 − `weight`) of the
+    /// isotropic Gaussian of σ and `weight` of one of `scale`·σ, so that a box centre now and
+    /// then metres off (a class change of the box's visible-face extension, two objects
+    /// merged for a frame, part of an object hidden) lowers a track's weight instead of
+    /// handing its detection to a newborn track. Fails unless `weight` ∈ [0, 1) and `scale`
+    /// ≥ 1.
+    pub fn with_cluster_outliers(mut self, weight: f64, scale: f64) -> Result<Self> {
+        if !(0.0..1.0).contains(&weight) {
+            return Err(Error::invalid(
+                "cluster outlier weight",
+                format!("{weight} (must lie in [0, 1))"),
+            ));
+        }
+        if !(scale >= 1.0 && scale.is_finite()) {
+            return Err(Error::invalid(
+                "cluster outlier scale",
+                format!("{scale} (must be finite and at least 1)"),
+            ));
+        }
+        self.cluster_outliers = (weight, scale);
+        Ok(self)
     }
 
     /// World → sensor transform of the step (identity without a platform pose).
@@ -282,20 +310,46 @@ impl MeasurementModel for MixedMeasurement {
         let r = inv.rotation.to_rotation_matrix().into_inner();
         let t = inv.translation.vector;
         let s2 = self.cluster_sigma * self.cluster_sigma;
-        let norm = -1.5 * (2.0 * std::f64::consts::PI * s2).ln();
-        let half_inv = 0.5 / s2;
+        let ln_normal = |var: f64| -1.5 * (2.0 * std::f64::consts::PI * var).ln();
         let (x, y, zc) = (
             particles.component(0),
             particles.component(2),
             particles.component(4),
         );
         let (z0, z1, z2) = (z[0], z[1], z[2]);
-        for i in 0..n {
+        let d2 = |i: usize| {
             let sx = r[(0, 0)] * x[i] + r[(0, 1)] * y[i] + r[(0, 2)] * zc[i] + t.x - z0;
             let sy = r[(1, 0)] * x[i] + r[(1, 1)] * y[i] + r[(1, 2)] * zc[i] + t.y - z1;
             let sz = r[(2, 0)] * x[i] + r[(2, 1)] * y[i] + r[(2, 2)] * zc[i] + t.z - z2;
-            let l = norm - half_inv * (sx * sx + sy * sy + sz * sz);
-            out[i] = if l.is_nan() { f64::NEG_INFINITY } else { l };
+            sx * sx + sy * sy + sz * sz
+        };
+        let (weight, scale) = self.cluster_outliers;
+        let out = &mut out[..n];
+        if weight == 0.0 {
+            let (norm, half_inv) = (ln_normal(s2), 0.5 / s2);
+            for (i, o) in out.iter_mut().enumerate() {
+                let l = norm - half_inv * d2(i);
+                *o = if l.is_nan() { f64::NEG_INFINITY } else { l };
+            }
+            return;
+        }
+        // ln((1 − ε) N(d; σ) + ε N(d; kσ)) = b + ln(1 + e^(a − b)), a and b the two terms'
+        // logarithms; a − b ≤ ln((1 − ε)/ε) + 3 ln k, so e^(a − b) stays finite. Three passes
+        // over the particles, the transcendental ones on vector lanes.
+        let w2 = s2 * scale * scale;
+        let (norm_a, half_a) = (ln_normal(s2) + (1.0 - weight).ln(), 0.5 / s2);
+        let (norm_b, half_b) = (ln_normal(w2) + weight.ln(), 0.5 / w2);
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = (norm_a - norm_b) - (half_a - half_b) * d2(i);
+        }
+        exp_in_place(out);
+        for o in out.iter_mut() {
+            *o += 1.0;
+        }
+        ln_in_place(out);
+        for (i, o) in out.iter_mut().enumerate() {
+            let l = *o + norm_b - half_b * d2(i);
+            *o = if l.is_nan() { f64::NEG_INFINITY } else { l };
         }
     }
 
@@ -550,6 +604,50 @@ mod tests {
         // one σ off along the sensor's y axis costs ½
         m.log_likelihood(&cluster_measurement([5.0, 0.5, 0.0]), &set, &c, &mut out);
         assert!((out[0] - (peak - 0.5)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn contaminated_cluster_likelihood_matches_the_mixture_by_hand() {
+        let c = ctx(Isometry3::identity());
+        let rows: Vec<Vec<f64>> = [0.0, 0.3, 1.0, 2.5, 8.0]
+            .iter()
+            .map(|&d| vec![5.0 + d, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0])
+            .collect();
+        let set = ParticleSet::from_rows(&rows, &[1.0; 5]).unwrap();
+        let plane = PlaneMeasurement::new(0.05, 0.2).unwrap();
+        let m = MixedMeasurement::new(plane, 0.3, 4.0)
+            .unwrap()
+            .with_cluster_outliers(0.1, 4.0)
+            .unwrap();
+        let mut out = [0.0; 5];
+        m.log_likelihood(&cluster_measurement([5.0, 0.0, 0.0]), &set, &c, &mut out);
+        // (1 − ε)·N₃(d; 0.3²) + ε·N₃(d; 1.2²), the isotropic 3-D normal written out.
+        let n3 = |d: f64, s: f64| {
+            (-0.5 * d * d / (s * s)).exp() / (2.0 * std::f64::consts::PI * s * s).powf(1.5)
+        };
+        for (k, d) in [0.0, 0.3, 1.0, 2.5, 8.0].into_iter().enumerate() {
+            let want = (0.9 * n3(d, 0.3) + 0.1 * n3(d, 1.2)).ln();
+            assert!(
+                (out[k] - want).abs() < 1e-12,
+                "d = {d}: {} vs {want}",
+                out[k]
+            );
+        }
+        // Far out the wide component carries the likelihood: 8 m off is e^−29 of the peak
+        // instead of the narrow Gaussian's e^−356.
+        assert!(out[4] - out[0] > -30.0);
+        // Without outliers it is the plain Gaussian.
+        let plain = MixedMeasurement::new(plane, 0.3, 4.0).unwrap();
+        plain.log_likelihood(&cluster_measurement([5.0, 0.0, 0.0]), &set, &c, &mut out);
+        assert!((out[1] - n3(0.3, 0.3).ln()).abs() < 1e-12);
+        assert!(MixedMeasurement::new(plane, 0.3, 4.0)
+            .unwrap()
+            .with_cluster_outliers(1.0, 4.0)
+            .is_err());
+        assert!(MixedMeasurement::new(plane, 0.3, 4.0)
+            .unwrap()
+            .with_cluster_outliers(0.1, 0.5)
+            .is_err());
     }
 
     #[test]

@@ -137,6 +137,14 @@ pub struct ClusterTuning {
     pub sigma: f64,
     /// Gate width in multiples of (σ + spread). Default 4.
     pub gate: f64,
+    /// Weight of the wide component of the measurement likelihood: a box centre is scored by
+    /// (1 − this) of a Gaussian of σ and this much of one of `outlier_scale`·σ, so that a
+    /// centre now and then metres off (the box's visible-face extension changing with the
+    /// frame's class, two objects merged for a frame) does not cost the track its detection.
+    /// 0 turns it off. Default 0.1.
+    pub outlier_weight: f64,
+    /// Standard deviation of the wide component in multiples of σ. Default 4.
+    pub outlier_scale: f64,
     /// Detection probability. Default 0.8.
     pub detection: f64,
     /// Expected false clusters per frame. Default 2.
@@ -163,6 +171,8 @@ impl Default for ClusterTuning {
             sigma_accel: 4.0,
             sigma: 0.3,
             gate: 4.0,
+            outlier_weight: 0.1,
+            outlier_scale: 4.0,
             detection: 0.8,
             clutter_rate: 2.0,
             clutter_volume: 80.0 * 80.0 * 4.0,
@@ -323,6 +333,20 @@ impl TrackingConfig {
         self.planes.validate()?;
         ensure_positive("tracking config field dt", self.dt)?;
         ensure_probability("tracking config field birth.survival", self.birth.survival)?;
+        let w = self.cluster.outlier_weight;
+        if !(0.0..1.0).contains(&w) {
+            return Err(Error::invalid(
+                "tracking config field cluster.outlier_weight",
+                format!("{w} (must lie in [0, 1); 0 turns the wide component off)"),
+            ));
+        }
+        let k = self.cluster.outlier_scale;
+        if !(k >= 1.0 && k.is_finite()) {
+            return Err(Error::invalid(
+                "tracking config field cluster.outlier_scale",
+                format!("{k} (must be finite and at least 1)"),
+            ));
+        }
         if self.cluster.clutter_particles == Some(0) {
             return Err(Error::invalid(
                 "tracking config field cluster.clutter_particles",

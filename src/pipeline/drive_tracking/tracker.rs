@@ -119,7 +119,10 @@ impl DriveTracker {
         birth.min_existence = config.filter.prune_threshold.max(birth.min_existence);
         let filter = LmbFilter::builder()
             .transition(transition)
-            .measurement(MixedMeasurement::new(plane_meas, c.sigma, c.gate)?)
+            .measurement(
+                MixedMeasurement::new(plane_meas, c.sigma, c.gate)?
+                    .with_cluster_outliers(c.outlier_weight, c.outlier_scale)?,
+            )
             .detection(MixedDetection::new(p.detection, c.detection)?)
             .clutter(MixedClutter::new(
                 p.clutter_rate,
