@@ -283,6 +283,25 @@ impl MixedMeasurement {
     }
 }
 
+/// A particle's world position seen from the sensor, less a measured position: R p + t − z.
+struct SensorOffset {
+    r: [[f64; 3]; 3],
+    t: [f64; 3],
+    z: [f64; 3],
+}
+
+impl SensorOffset {
+    /// |R p + t − z|², summed in a fixed order (the same value on every path).
+    #[inline(always)]
+    fn squared(&self, p: [f64; 3]) -> f64 {
+        let [a, b, c] = self.r;
+        let sx = a[0] * p[0] + a[1] * p[1] + a[2] * p[2] + self.t[0] - self.z[0];
+        let sy = b[0] * p[0] + b[1] * p[1] + b[2] * p[2] + self.t[1] - self.z[1];
+        let sz = c[0] * p[0] + c[1] * p[1] + c[2] * p[2] + self.t[2] - self.z[2];
+        sx * sx + sy * sy + sz * sz
+    }
+}
+
 impl MeasurementModel for MixedMeasurement {
     fn measurement_dim(&self) -> usize {
         MEASUREMENT_DIM
@@ -312,23 +331,26 @@ impl MeasurementModel for MixedMeasurement {
         let s2 = self.cluster_sigma * self.cluster_sigma;
         let ln_normal = |var: f64| -1.5 * (2.0 * std::f64::consts::PI * var).ln();
         let (x, y, zc) = (
-            particles.component(0),
-            particles.component(2),
-            particles.component(4),
+            &particles.component(0)[..n],
+            &particles.component(2)[..n],
+            &particles.component(4)[..n],
         );
-        let (z0, z1, z2) = (z[0], z[1], z[2]);
-        let d2 = |i: usize| {
-            let sx = r[(0, 0)] * x[i] + r[(0, 1)] * y[i] + r[(0, 2)] * zc[i] + t.x - z0;
-            let sy = r[(1, 0)] * x[i] + r[(1, 1)] * y[i] + r[(1, 2)] * zc[i] + t.y - z1;
-            let sz = r[(2, 0)] * x[i] + r[(2, 1)] * y[i] + r[(2, 2)] * zc[i] + t.z - z2;
-            sx * sx + sy * sy + sz * sz
+        let c = SensorOffset {
+            r: [
+                [r[(0, 0)], r[(0, 1)], r[(0, 2)]],
+                [r[(1, 0)], r[(1, 1)], r[(1, 2)]],
+                [r[(2, 0)], r[(2, 1)], r[(2, 2)]],
+            ],
+            t: [t.x, t.y, t.z],
+            z: [z[0], z[1], z[2]],
         };
         let (weight, scale) = self.cluster_outliers;
         let out = &mut out[..n];
+        let points = || x.iter().zip(y).zip(zc).map(|((&a, &b), &c)| [a, b, c]);
         if weight == 0.0 {
             let (norm, half_inv) = (ln_normal(s2), 0.5 / s2);
-            for (i, o) in out.iter_mut().enumerate() {
-                let l = norm - half_inv * d2(i);
+            for (o, p) in out.iter_mut().zip(points()) {
+                let l = norm - half_inv * c.squared(p);
                 *o = if l.is_nan() { f64::NEG_INFINITY } else { l };
             }
             return;
@@ -339,16 +361,16 @@ impl MeasurementModel for MixedMeasurement {
         let w2 = s2 * scale * scale;
         let (norm_a, half_a) = (ln_normal(s2) + (1.0 - weight).ln(), 0.5 / s2);
         let (norm_b, half_b) = (ln_normal(w2) + weight.ln(), 0.5 / w2);
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = (norm_a - norm_b) - (half_a - half_b) * d2(i);
+        for (o, p) in out.iter_mut().zip(points()) {
+            *o = (norm_a - norm_b) - (half_a - half_b) * c.squared(p);
         }
         exp_in_place(out);
         for o in out.iter_mut() {
             *o += 1.0;
         }
         ln_in_place(out);
-        for (i, o) in out.iter_mut().enumerate() {
-            let l = *o + norm_b - half_b * d2(i);
+        for (o, p) in out.iter_mut().zip(points()) {
+            let l = *o + norm_b - half_b * c.squared(p);
             *o = if l.is_nan() { f64::NEG_INFINITY } else { l };
         }
     }
