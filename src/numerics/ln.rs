@@ -92,15 +92,9 @@ fn ln_lane(x: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    use super::super::ulps;
     use super::*;
     use proptest::prelude::*;
-
-    fn ulps(a: f64, b: f64) -> f64 {
-        if a == b {
-            return 0.0;
-        }
-        (a - b).abs() / (b.abs() * f64::EPSILON)
-    }
 
     fn one(x: f64) -> f64 {
         let mut v = [x];

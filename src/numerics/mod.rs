@@ -13,3 +13,12 @@ pub(crate) mod floor;
 pub(crate) mod ln;
 #[cfg(feature = "laser2d")]
 pub(crate) mod sym2;
+
+/// How many units in the last place of `b` the value `a` is from it (tests of the kernels).
+#[cfg(test)]
+fn ulps(a: f64, b: f64) -> f64 {
+    if a == b {
+        return 0.0;
+    }
+    (a - b).abs() / (b.abs() * f64::EPSILON)
+}
