@@ -150,14 +150,19 @@ pub const SPEED_SAMPLES: usize = 64;
 /// A cluster track's speed evidence per class ([`speed_log_likelihoods`]): the class speed
 /// densities averaged over its particles' speeds in the ground plane (state components 1 and
 /// 3, the x and y velocity), with their weights; at most [`SPEED_SAMPLES`] particles, evenly
-/// strided.
+/// strided (all of them if the strided ones carry no weight). Fails on an empty set or one
+/// without weight.
 pub fn speed_evidence(particles: &ParticleSet) -> Result<[f64; CLASS_COUNT]> {
     let (vx, vy, w) = (
         particles.component(1),
         particles.component(3),
         particles.weights(),
     );
-    let step = particles.len().div_ceil(SPEED_SAMPLES).max(1);
+    let mut step = particles.len().div_ceil(SPEED_SAMPLES).max(1);
+    // Weights concentrated on particles between the strided ones: take them all.
+    if w.iter().step_by(step).all(|&x| x == 0.0) {
+        step = 1;
+    }
     speed_log_likelihoods(
         (0..particles.len())
             .step_by(step)
@@ -288,6 +293,34 @@ impl RoadUserState {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn speed_evidence_reads_the_velocity_particles_and_their_weights() {
+        use crate::filter::ParticleSet;
+        // 1024 particles standing still, 1024 at 5 m/s along y; the moving ones carry all the
+        // weight but only on odd indices, which the stride of 32 never visits.
+        let rows: Vec<Vec<f64>> = (0..2048)
+            .map(|i| {
+                let vy = if i >= 1024 { 5.0 } else { 0.0 };
+                vec![0.0, 0.0, 0.0, vy, 0.0, 0.0]
+            })
+            .collect();
+        let weights: Vec<f64> = (0..2048)
+            .map(|i| if i >= 1024 && i % 2 == 1 { 1.0 } else { 0.0 })
+            .collect();
+        let set = ParticleSet::from_rows(&rows, &weights).unwrap();
+        let moving = speed_log_likelihoods([(5.0, 1.0)]).unwrap();
+        let got = speed_evidence(&set).unwrap();
+        for (a, b) in got.iter().zip(&moving) {
+            assert!((a - b).abs() < 1e-12, "{got:?} vs {moving:?}");
+        }
+        // Equal weights: the strided half-and-half sample averages the two densities.
+        let even = ParticleSet::from_rows(&rows, &[1.0; 2048]).unwrap();
+        let half = speed_log_likelihoods([(0.0, 1.0), (5.0, 1.0)]).unwrap();
+        for (a, b) in speed_evidence(&even).unwrap().iter().zip(&half) {
+            assert!((a - b).abs() < 1e-12);
+        }
+    }
+
     #[test]
     fn a_fragment_inside_a_van_is_dropped_and_neighbours_are_kept() {
         use super::contained_in_others;
