@@ -10,6 +10,7 @@
 pub(crate) mod atan;
 pub(crate) mod exp;
 pub(crate) mod floor;
+#[cfg(feature = "kitti")]
 pub(crate) mod ln;
 #[cfg(feature = "laser2d")]
 pub(crate) mod sym2;
