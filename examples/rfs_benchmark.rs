@@ -371,10 +371,10 @@ fn main() -> Result<()> {
     let ospa_k = per_step(|r| &r.ospa);
     let gospa_k = per_step(|r| &r.gospa);
     let card_k = per_step(|r| &r.card);
-    let all_ms: Vec<f64> = runs.iter().flat_map(|r| r.ms.iter().copied()).collect();
     let all = |f: fn(&RunResult) -> &Vec<f64>| -> Vec<f64> {
         runs.iter().flat_map(|r| f(r).iter().copied()).collect()
     };
+    let all_ms = all(|r| &r.ms);
     let assoc_ms = all(|r| &r.association_ms);
     let tracks = all(|r| &r.tracks);
     let particles = all(|r| &r.particles);

@@ -334,22 +334,39 @@ impl ClassModel {
     }
 }
 
-/// ln p(speed | class). Vehicles: uniform on [0, 40 m/s] (parked to motorway). Pedestrians:
-/// half-normal, σ = 1.5 m/s (walking 1.2–1.5 m/s, running ≈ 4 m/s at 2.7σ). Cyclists:
-/// half-normal, σ = 5 m/s (cruising 4–7 m/s). Other: half-normal, σ = 1 m/s (static; the
-/// scale allows for the tracker's velocity noise).
-fn speed_ll(class: ObjectClass, v: f64) -> f64 {
+/// A class's density of speed over ground (m/s).
+#[derive(Copy, Clone, Debug)]
+enum SpeedModel {
+    /// Uniform on [0, max].
+    Uniform(f64),
+    /// Half-normal with this scale.
+    HalfNormal(f64),
+}
+
+/// The speed model of each class. Vehicles: uniform on [0, 40 m/s] (parked to motorway).
+/// Pedestrians: half-normal, σ = 1.5 m/s (walking 1.2–1.5 m/s, running ≈ 4 m/s at 2.7σ).
+/// Cyclists: half-normal, σ = 5 m/s (cruising 4–7 m/s). Other: half-normal, σ = 1 m/s
+/// (static; the scale allows for the tracker's velocity noise).
+fn speed_model(class: ObjectClass) -> SpeedModel {
     match class {
-        ObjectClass::Car | ObjectClass::Van | ObjectClass::Truck => {
-            if v <= 40.0 {
-                -(40f64.ln())
+        ObjectClass::Car | ObjectClass::Van | ObjectClass::Truck => SpeedModel::Uniform(40.0),
+        ObjectClass::Pedestrian => SpeedModel::HalfNormal(1.5),
+        ObjectClass::Cyclist => SpeedModel::HalfNormal(5.0),
+        ObjectClass::Other => SpeedModel::HalfNormal(1.0),
+    }
+}
+
+/// ln p(speed | class) of [`speed_model`] (−1000 above a uniform's range).
+fn speed_ll(class: ObjectClass, v: f64) -> f64 {
+    match speed_model(class) {
+        SpeedModel::Uniform(max) => {
+            if v <= max {
+                -(max.ln())
             } else {
                 -1e3
             }
         }
-        ObjectClass::Pedestrian => ln_half_normal(v, 1.5),
-        ObjectClass::Cyclist => ln_half_normal(v, 5.0),
-        ObjectClass::Other => ln_half_normal(v, 1.0),
+        SpeedModel::HalfNormal(sigma) => ln_half_normal(v, sigma),
     }
 }
 
@@ -370,18 +387,8 @@ pub fn speed_log_likelihoods(
     let mut sum = [0.0; CLASS_COUNT];
     let mut total = 0.0;
     for (v, w) in samples {
-        if !(v >= 0.0 && v.is_finite()) {
-            return Err(Error::invalid(
-                "speed sample",
-                format!("{v} (must be finite and non-negative)"),
-            ));
-        }
-        if !(w >= 0.0 && w.is_finite()) {
-            return Err(Error::invalid(
-                "speed sample weight",
-                format!("{w} (must be finite and non-negative)"),
-            ));
-        }
+        ensure_non_negative("speed sample", v)?;
+        ensure_non_negative("speed sample weight", w)?;
         if w == 0.0 {
             continue;
         }
@@ -399,24 +406,22 @@ pub fn speed_log_likelihoods(
     Ok(sum.map(|x| (x / total).max(f64::MIN_POSITIVE).ln()))
 }
 
-/// p(speed | class) for every class at speed `v` ≥ 0: the densities of [`speed_ll`]
-/// without the logarithm (three exponentials for the six classes).
+/// p(speed | class) of [`speed_model`] for every class at speed `v` ≥ 0, in
+/// [`ObjectClass::ALL`] order: the densities of [`speed_ll`] without the logarithm.
 fn speed_densities(v: f64) -> [f64; CLASS_COUNT] {
-    let half_normal = |sigma: f64| {
-        let z = v / sigma;
-        (2.0 / (sigma * (2.0 * PI).sqrt())) * (-0.5 * z * z).exp()
-    };
-    let vehicle = if v <= 40.0 { 1.0 / 40.0 } else { 0.0 };
-    let mut d = [0.0; CLASS_COUNT];
-    for (k, c) in ObjectClass::ALL.iter().enumerate() {
-        d[k] = match c {
-            ObjectClass::Car | ObjectClass::Van | ObjectClass::Truck => vehicle,
-            ObjectClass::Pedestrian => half_normal(1.5),
-            ObjectClass::Cyclist => half_normal(5.0),
-            ObjectClass::Other => half_normal(1.0),
-        };
-    }
-    d
+    ObjectClass::ALL.map(|c| match speed_model(c) {
+        SpeedModel::Uniform(max) => {
+            if v <= max {
+                1.0 / max
+            } else {
+                0.0
+            }
+        }
+        SpeedModel::HalfNormal(sigma) => {
+            let z = v / sigma;
+            (2.0 / (sigma * (2.0 * PI).sqrt())) * (-0.5 * z * z).exp()
+        }
+    })
 }
 
 /// Spread of the angle between a footprint's seen long side and the side it lies along
