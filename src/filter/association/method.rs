@@ -23,7 +23,7 @@ pub enum AssociationMethod {
         /// Number of best hypotheses kept (default 200).
         #[serde(default = "default_murty_k")]
         k: usize,
-        /// Hypotheses lighter than this fraction of the best are not ranked (default 10⁻⁹;
+        /// Hypotheses lighter than this fraction of the best are not ranked (default 10⁻⁵;
         /// 0 ranks exactly `k`).
         #[serde(default = "default_murty_min_weight")]
         min_weight: f64,
@@ -155,7 +155,7 @@ impl FromStr for AssociationMethod {
     type Err = crate::Error;
 
     /// Parses `murty`, `gibbs`, `lbp` or `exhaustive` (case-insensitive), each with its
-    /// defaults (k = 200 with the weight floor 10⁻⁹, 1000 samples, 100 iterations with
+    /// defaults (k = 200 with the weight floor 10⁻⁵, 1000 samples, 100 iterations with
     /// tolerance 10⁻⁹), optionally
     /// followed by `:N` to set k, the number of samples or the iteration cap, e.g. `murty:500`.
     fn from_str(s: &str) -> Result<Self, Self::Err> {
@@ -240,7 +240,7 @@ mod tests {
             "murty".parse::<AssociationMethod>().unwrap(),
             AssociationMethod::Murty {
                 k: 200,
-                min_weight: 1e-9
+                min_weight: 1e-5
             }
         );
         assert_eq!(
@@ -262,7 +262,7 @@ mod tests {
             "murty:500".parse::<AssociationMethod>().unwrap(),
             AssociationMethod::Murty {
                 k: 500,
-                min_weight: 1e-9
+                min_weight: 1e-5
             }
         );
         assert!("hungarian".parse::<AssociationMethod>().is_err());
@@ -285,7 +285,7 @@ mod tests {
             floor,
             AssociationMethod::Murty {
                 k: 7,
-                min_weight: 1e-9
+                min_weight: 1e-5
             }
         );
         let e: AssociationMethod = serde_json::from_str(r#"{"method":"exhaustive"}"#).unwrap();

@@ -47,7 +47,10 @@ use std::collections::VecDeque;
 /// - the ranking stops once the next hypothesis is lighter than `min_weight` times the best,
 ///   which moves a marginal by less than `k · min_weight`.
 ///
-/// At the default 10⁻⁹ both are far below the truncation to `k` hypotheses itself.
+/// At the default 10⁻⁵, on the nonlinear benchmark's groups of six or more tracks, the
+/// marginals lie within 1.2·10⁻⁵ (median; 90th percentile 6.5·10⁻⁵) of a ranking with
+/// k = 20,000, three to four orders below loopy belief propagation's error on the same
+/// groups (90th percentile 0.09); the truncation to `k` hypotheses itself costs up to 10⁻².
 /// [`MurtyAssociator::exact`] turns the floor off.
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct MurtyAssociator {
@@ -57,13 +60,14 @@ pub struct MurtyAssociator {
     pub min_weight: f64,
 }
 
-/// Default [`MurtyAssociator::min_weight`]: 10⁻⁹, the same order as LBP's message tolerance.
-pub const DEFAULT_MURTY_MIN_WEIGHT: f64 = 1e-9;
+/// Default [`MurtyAssociator::min_weight`]: 10⁻⁵ (see [`MurtyAssociator`] for what it costs
+/// in accuracy).
+pub const DEFAULT_MURTY_MIN_WEIGHT: f64 = 1e-5;
 
 impl Default for MurtyAssociator {
     /// k = 200: every hypothesis of up to 3 tracks and 5 measurements (136 of them at most),
     /// and the dominant ones of the larger groups the filter usually sees; hypotheses below
-    /// 10⁻⁹ of the best are not ranked.
+    /// 10⁻⁵ of the best are not ranked.
     fn default() -> Self {
         Self {
             k: 200,
