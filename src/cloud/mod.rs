@@ -11,6 +11,7 @@
 pub mod boxes;
 pub mod classes;
 pub mod cluster;
+pub mod fragments;
 pub mod kitti_bin;
 pub mod las_io;
 pub mod odometry;

@@ -8,7 +8,9 @@
 //! Euclidean clustering, or the angle criterion on the scan's range image
 //! ([`range_image_clusters`], linear in the points, `tolerance` the gap always joined). Every cluster within `max_range` of the sensor whose axis-aligned box is
 //! object-sized (`max_footprint`, `max_height`) is a detection, nearest first: there is no cap
-//! on their number, the size and range limits bound the filter's work. Each detection then gets
+//! on their number, the size and range limits bound the filter's work. Before that, a face seen
+//! at a grazing angle that the clustering left apart from its object is given back to it
+//! ([`crate::cloud::fragments`], `merge_fragments`). Each detection then gets
 //! its oriented box and class evidence ([`super::road_users::shape_of`]); its measured
 //! position is the box's centre.
 //!
@@ -18,6 +20,7 @@ use super::{ClusterMethod, TrackingConfig};
 use crate::cloud::boxes::BoxScratch;
 use crate::cloud::classes::ClassModel;
 use crate::cloud::cluster::{euclidean_clusters_of, ClusterParams};
+use crate::cloud::fragments::merge_grazing_fragments;
 use crate::cloud::planes::extract_planes;
 use crate::cloud::range_image::{
     range_image_clusters, ImageClusterParams, RangeImage, RangeImageConfig,
@@ -186,6 +189,11 @@ fn detect_here(
             };
             range_image_clusters(&image, cloud, &candidates, &params)?
         }
+    };
+    let found = if c.merge_fragments {
+        merge_grazing_fragments(cloud, found, &c.fragments)?
+    } else {
+        found
     };
     let mut clusters: Vec<ClusterDetection> = found
         .into_iter()

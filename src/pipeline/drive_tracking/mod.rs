@@ -39,6 +39,7 @@ pub use repeatability::tracked_wall_pairs;
 pub use source::RecordingSource;
 pub use tracker::DriveTracker;
 
+use crate::cloud::fragments::FragmentParams;
 use crate::cloud::odometry::{LidarOdometry, OdometryConfig};
 use crate::cloud::planes::PlaneConfig;
 use crate::cloud::PointCloud;
@@ -252,6 +253,11 @@ pub struct ClusterDetectionConfig {
     pub max_footprint: f64,
     /// Largest box height (m). Default 4.
     pub max_height: f64,
+    /// Give a face seen at a grazing angle, clustered apart from its object, back to the
+    /// cluster at its near end ([`crate::cloud::fragments`]). Default true.
+    pub merge_fragments: bool,
+    /// When a cluster is such a fragment.
+    pub fragments: FragmentParams,
 }
 
 impl Default for ClusterDetectionConfig {
@@ -268,6 +274,8 @@ impl Default for ClusterDetectionConfig {
             max_range: 40.0,
             max_footprint: 8.0,
             max_height: 4.0,
+            merge_fragments: true,
+            fragments: FragmentParams::default(),
         }
     }
 }
@@ -354,6 +362,7 @@ impl TrackingConfig {
             ));
         }
         let c = &self.clusters;
+        c.fragments.validate()?;
         for (name, v) in [
             ("clusters.tolerance", c.tolerance),
             ("clusters.max_range", c.max_range),
