@@ -335,7 +335,13 @@ fn kdtree_components(points: &[[f32; 3]], tolerance: f32) -> Vec<u32> {
     labels
 }
 
-fn summarise(indices: impl Iterator<Item = u32>, xs: &[f32], ys: &[f32], zs: &[f32]) -> Cluster {
+/// The cluster of the points `indices` (in that order): their centroid and axis-aligned extent.
+pub(crate) fn summarise(
+    indices: impl Iterator<Item = u32>,
+    xs: &[f32],
+    ys: &[f32],
+    zs: &[f32],
+) -> Cluster {
     let mut min = [f32::INFINITY; 3];
     let mut max = [f32::NEG_INFINITY; 3];
     let mut sum = [0.0f64; 3];

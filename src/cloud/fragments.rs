@@ -10,7 +10,7 @@
 //!
 //! [`merge_grazing_fragments`] gives such a fragment back to the cluster at its near end: a
 //! cluster at least [`FragmentParams::min_elongation`] times as long as wide, whose long axis
-//! lies within [`FragmentParams::max_angle`] of the line of sight, is joined to the nearest
+//! lies within [`FragmentParams::max_angle_deg`] of the line of sight, is joined to the nearest
 //! other cluster with a point within the sampling gap of its near end
 //! (`gap_factor`·r·Δφ / sin β, at most `max_gap`), when both stand at least `min_height` tall
 //! and their union fits a vehicle (`max_diagonal`, `max_height`). Thin clutter lying low (kerbs,
@@ -18,7 +18,7 @@
 //!
 //! Not for: the clustering itself (see [`super::cluster`]) or splitting merged objects.
 
-use super::cluster::Cluster;
+use super::cluster::{summarise, Cluster};
 use super::PointCloud;
 use crate::error::{Error, Result};
 
@@ -220,30 +220,20 @@ pub fn merge_grazing_fragments(
             joined[a].append(&mut clusters[b].indices);
         }
     }
-    let mut out = Vec::with_capacity(clusters.len());
-    for (mut c, extra) in clusters.into_iter().zip(joined) {
-        if c.indices.is_empty() {
-            continue;
-        }
-        if !extra.is_empty() {
-            c.indices.extend(extra);
-            c.indices.sort_unstable();
-            let mut sum = [0.0f64; 3];
-            for &i in &c.indices {
-                let p = [xs[i as usize], ys[i as usize], zs[i as usize]];
-                for k in 0..3 {
-                    c.min[k] = c.min[k].min(p[k]);
-                    c.max[k] = c.max[k].max(p[k]);
-                    sum[k] += p[k] as f64;
-                }
+    Ok(clusters
+        .into_iter()
+        .zip(joined)
+        .filter(|(c, _)| !c.indices.is_empty())
+        .map(|(c, extra)| {
+            if extra.is_empty() {
+                return c;
             }
-            let n = c.indices.len() as f64;
-            c.centroid = sum.map(|s| s / n);
-            c.count = c.indices.len();
-        }
-        out.push(c);
-    }
-    Ok(out)
+            let mut indices = c.indices;
+            indices.extend(extra);
+            indices.sort_unstable();
+            summarise(indices.into_iter(), xs, ys, zs)
+        })
+        .collect())
 }
 
 #[cfg(test)]
