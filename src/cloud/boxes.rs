@@ -99,7 +99,7 @@ pub struct BoxFit {
 /// the object when known (bottom of the estimated box); `prior` the plausible footprint of
 /// the object's kind (see the module notes). `scratch` is reused between calls (one buffer of
 /// 2 × points values). Fails on empty or differently long slices, non-finite coordinates or
-/// settings.
+/// settings. The same as [`BoxOutline::of`] followed by [`BoxOutline::fit`].
 pub fn fit_box(
     xs: &[f32],
     ys: &[f32],
@@ -109,90 +109,147 @@ pub fn fit_box(
     params: &BoxFitParams,
     scratch: &mut Vec<f64>,
 ) -> Result<BoxFit> {
-    let n = xs.len();
-    if n == 0 || ys.len() != n || zs.len() != n {
-        return Err(Error::invalid(
-            "box fit points",
-            format!(
-                "{} x, {} y, {} z values (need the same number, at least one)",
-                n,
-                ys.len(),
-                zs.len()
-            ),
-        ));
-    }
-    check_settings(ground_z, prior, params)?;
-    // Centre the x–y coordinates on their mean (keeps the projections' rounding small).
-    let (mut mx, mut my) = (0.0f64, 0.0f64);
-    let (mut z_lo, mut z_hi, mut z_sum) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
-    for i in 0..n {
-        let (x, y, z) = (xs[i] as f64, ys[i] as f64, zs[i] as f64);
-        if !(x.is_finite() && y.is_finite() && z.is_finite()) {
+    BoxOutline::of(xs, ys, zs, ground_z, params, scratch)?.fit(prior)
+}
+
+/// What a box fit knows of its points before a size prior enters: the heading the L-shape
+/// search chose, the points' bounding rectangle at that heading and their heights. One
+/// outline gives the [`BoxFit`] for any number of priors ([`BoxOutline::fit`]) without
+/// searching the heading again.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BoxOutline {
+    /// The points' x–y mean, which the rectangle is given about.
+    mean: [f64; 2],
+    theta: f64,
+    rect: Rect,
+    z_lo: f64,
+    z_hi: f64,
+    z_sum: f64,
+    n: usize,
+    ground_z: Option<f64>,
+    azimuth_step: f64,
+}
+
+impl BoxOutline {
+    /// Searches the heading of the points `(xs[i], ys[i], zs[i])` and bounds them (see
+    /// [`fit_box`] for the arguments and the errors).
+    pub fn of(
+        xs: &[f32],
+        ys: &[f32],
+        zs: &[f32],
+        ground_z: Option<f64>,
+        params: &BoxFitParams,
+        scratch: &mut Vec<f64>,
+    ) -> Result<Self> {
+        let n = xs.len();
+        if n == 0 || ys.len() != n || zs.len() != n {
             return Err(Error::invalid(
                 "box fit points",
-                format!("point {i} is ({x}, {y}, {z}) (must be finite)"),
+                format!(
+                    "{} x, {} y, {} z values (need the same number, at least one)",
+                    n,
+                    ys.len(),
+                    zs.len()
+                ),
             ));
         }
-        mx += x;
-        my += y;
-        z_lo = z_lo.min(z);
-        z_hi = z_hi.max(z);
-        z_sum += z;
-    }
-    mx /= n as f64;
-    my /= n as f64;
-    scratch.clear();
-    scratch.reserve(2 * n);
-    for i in 0..n {
-        scratch.push(xs[i] as f64 - mx);
-        scratch.push(ys[i] as f64 - my);
-    }
-    let theta = if params.search_cell > 0.0 {
-        one_point_per_cell(scratch, 2 * n, params.search_cell);
-        lshape_heading(&scratch[2 * n..], params)
-    } else {
-        lshape_heading(scratch, params)
-    };
-    scratch.truncate(2 * n);
-    let rect = Rect::bounding(scratch, theta);
-    // The sensor (origin) in the centred frame, projected on the rectangle axes.
-    let (s, c) = theta.sin_cos();
-    let sensor = [-(c * mx + s * my), -(-s * mx + c * my)];
-    let length_axis = choose_length_axis(&rect, prior);
-    let bottom = ground_z.unwrap_or(z_lo);
-    let to_box = |r: &Rect, z0: f64| {
-        let [a, b] = r.centre();
-        let centre_xy = [mx + c * a - s * b, my + s * a + c * b];
-        let (l, w, yaw) = if length_axis == 0 {
-            (r.extent(0), r.extent(1), theta)
-        } else {
-            (r.extent(1), r.extent(0), theta + FRAC_PI_2)
-        };
-        Box3::new(
-            Point3::new(centre_xy[0], centre_xy[1], (z0 + z_hi) / 2.0),
-            [l, w, (z_hi - z0).max(0.0)],
-            heading_mod_pi(yaw),
-        )
-    };
-    let fitted = to_box(&rect, z_lo);
-    let estimated = match prior {
-        Some(p) => {
-            let mut target = [p.length, p.width];
-            if length_axis == 1 {
-                target.swap(0, 1);
+        check_settings(ground_z, None, params)?;
+        // Centre the x–y coordinates on their mean (keeps the projections' rounding small).
+        let (mut mx, mut my) = (0.0f64, 0.0f64);
+        let (mut z_lo, mut z_hi, mut z_sum) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
+        for i in 0..n {
+            let (x, y, z) = (xs[i] as f64, ys[i] as f64, zs[i] as f64);
+            if !(x.is_finite() && y.is_finite() && z.is_finite()) {
+                return Err(Error::invalid(
+                    "box fit points",
+                    format!("point {i} is ({x}, {y}, {z}) (must be finite)"),
+                ));
             }
-            let extended = rect.extended_away(sensor, target, params.azimuth_step);
-            to_box(&extended, bottom)
+            mx += x;
+            my += y;
+            z_lo = z_lo.min(z);
+            z_hi = z_hi.max(z);
+            z_sum += z;
         }
-        None => to_box(&rect, bottom),
-    };
-    Ok(BoxFit {
-        fitted,
-        estimated,
-        points: n,
-        mass_height: z_sum / n as f64 - bottom,
-        range: fitted.center.x.hypot(fitted.center.y),
-    })
+        mx /= n as f64;
+        my /= n as f64;
+        scratch.clear();
+        scratch.reserve(2 * n);
+        for i in 0..n {
+            scratch.push(xs[i] as f64 - mx);
+            scratch.push(ys[i] as f64 - my);
+        }
+        let theta = if params.search_cell > 0.0 {
+            one_point_per_cell(scratch, 2 * n, params.search_cell);
+            lshape_heading(&scratch[2 * n..], params)
+        } else {
+            lshape_heading(scratch, params)
+        };
+        scratch.truncate(2 * n);
+        let rect = Rect::bounding(scratch, theta);
+        Ok(BoxOutline {
+            mean: [mx, my],
+            theta,
+            rect,
+            z_lo,
+            z_hi,
+            z_sum,
+            n,
+            ground_z,
+            azimuth_step: params.azimuth_step,
+        })
+    }
+
+    /// The boxes of these points for the footprint `prior` (none: the fitted box alone).
+    /// Fails on a negative prior side.
+    pub fn fit(&self, prior: Option<&SizePrior>) -> Result<BoxFit> {
+        if let Some(p) = prior {
+            crate::error::ensure_non_negative("size prior length", p.length)?;
+            crate::error::ensure_non_negative("size prior width", p.width)?;
+        }
+        let [mx, my] = self.mean;
+        let theta = self.theta;
+        let rect = &self.rect;
+        // The sensor (origin) in the centred frame, projected on the rectangle axes.
+        let (s, c) = theta.sin_cos();
+        let sensor = [-(c * mx + s * my), -(-s * mx + c * my)];
+        let length_axis = choose_length_axis(rect, prior);
+        let bottom = self.ground_z.unwrap_or(self.z_lo);
+        let z_hi = self.z_hi;
+        let to_box = |r: &Rect, z0: f64| {
+            let [a, b] = r.centre();
+            let centre_xy = [mx + c * a - s * b, my + s * a + c * b];
+            let (l, w, yaw) = if length_axis == 0 {
+                (r.extent(0), r.extent(1), theta)
+            } else {
+                (r.extent(1), r.extent(0), theta + FRAC_PI_2)
+            };
+            Box3::new(
+                Point3::new(centre_xy[0], centre_xy[1], (z0 + z_hi) / 2.0),
+                [l, w, (z_hi - z0).max(0.0)],
+                heading_mod_pi(yaw),
+            )
+        };
+        let fitted = to_box(rect, self.z_lo);
+        let estimated = match prior {
+            Some(p) => {
+                let mut target = [p.length, p.width];
+                if length_axis == 1 {
+                    target.swap(0, 1);
+                }
+                let extended = rect.extended_away(sensor, target, self.azimuth_step);
+                to_box(&extended, bottom)
+            }
+            None => to_box(rect, bottom),
+        };
+        Ok(BoxFit {
+            fitted,
+            estimated,
+            points: self.n,
+            mass_height: self.z_sum / self.n as f64 - bottom,
+            range: fitted.center.x.hypot(fitted.center.y),
+        })
+    }
 }
 
 /// [`fit_box`] on the points `indices` of `cloud`, gathered into `scratch` (reused storage;
@@ -205,6 +262,18 @@ pub fn fit_box_of(
     params: &BoxFitParams,
     scratch: &mut BoxScratch,
 ) -> Result<BoxFit> {
+    outline_of(cloud, indices, ground_z, params, scratch)?.fit(prior)
+}
+
+/// [`BoxOutline::of`] on the points `indices` of `cloud`, gathered into `scratch` (reused
+/// storage; fails on an index past the cloud's end).
+pub fn outline_of(
+    cloud: &PointCloud,
+    indices: &[u32],
+    ground_z: Option<f64>,
+    params: &BoxFitParams,
+    scratch: &mut BoxScratch,
+) -> Result<BoxOutline> {
     let (xs, ys, zs, _) = cloud.columns();
     scratch.xs.clear();
     scratch.ys.clear();
@@ -221,12 +290,11 @@ pub fn fit_box_of(
         scratch.ys.push(ys[i]);
         scratch.zs.push(zs[i]);
     }
-    fit_box(
+    BoxOutline::of(
         &scratch.xs,
         &scratch.ys,
         &scratch.zs,
         ground_z,
-        prior,
         params,
         &mut scratch.centred,
     )
@@ -659,6 +727,39 @@ mod tests {
         let one = fit_box_of(&cloud, &[0], None, None, &p, &mut bs).unwrap();
         assert_eq!(one.fitted.size, [0.0, 0.0, 0.0]);
         assert!((one.fitted.center.x - 1.0).abs() < 1e-12);
+        let outline = outline_of(&cloud, &[0], None, &p, &mut bs).unwrap();
+        let negative = SizePrior {
+            length: -1.0,
+            width: 1.0,
+        };
+        let msg = outline.fit(Some(&negative)).unwrap_err().to_string();
+        assert!(msg.contains("size prior length"), "{msg}");
+    }
+
+    #[test]
+    fn one_outline_gives_the_boxes_of_every_prior() {
+        // A car seen from its corner, fitted bare and with two priors from one heading search.
+        let b = Box3::new(Point3::new(12.0, 5.0, -0.9), [4.5, 1.8, 1.5], 0.3);
+        let [xs, ys, zs] = visible_faces(&b, 40.0, 0.02, 5);
+        let p = BoxFitParams::default();
+        let mut scratch = Vec::new();
+        let outline = BoxOutline::of(&xs, &ys, &zs, Some(-1.73), &p, &mut scratch).unwrap();
+        let van = SizePrior {
+            length: 5.1,
+            width: 1.9,
+        };
+        for prior in [None, Some(&CAR), Some(&van)] {
+            let alone = fit_box(&xs, &ys, &zs, Some(-1.73), prior, &p, &mut scratch).unwrap();
+            assert_eq!(outline.fit(prior).unwrap(), alone);
+        }
+        // The van's footprint pushes the far faces out: a longer box, centred further away.
+        let (car, van) = (
+            outline.fit(Some(&CAR)).unwrap(),
+            outline.fit(Some(&van)).unwrap(),
+        );
+        assert!(van.estimated.size[0] > car.estimated.size[0] + 0.5);
+        let r = |f: &BoxFit| f.estimated.center.x.hypot(f.estimated.center.y);
+        assert!(r(&van) > r(&car));
     }
 
     /// The closeness criterion of Zhang et al. (Algorithm 4) at heading `theta`, computed as

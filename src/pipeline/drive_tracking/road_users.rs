@@ -2,9 +2,9 @@
 //! detection, and what a cluster track remembers of them from frame to frame.
 //!
 //! * A detection's box is fitted to its points ([`crate::cloud::boxes`]: L-shape heading,
-//!   bottom on the ground plane) and classed for this frame ([`crate::cloud::classes`]); it
-//!   is fitted again with the footprint of the frame's most likely road-user class (whatever
-//!   the likelihood of `Other`) and the visible-face model moves the box's centre away from
+//!   bottom on the ground plane) and classed for this frame ([`crate::cloud::classes`]); the
+//!   same outline (one heading search) is boxed again with the footprint of the frame's most
+//!   likely road-user class (whatever the likelihood of `Other`): the visible-face model moves the box's centre away from
 //!   the sensor. That centre, not the centroid of the visible points, is what the filter
 //!   measures.
 //! * A track keeps a categorical class posterior ([`ClassBelief`]) updated with every matched
@@ -24,7 +24,7 @@
 //!
 //! Not for: clustering (see [`super::detect`]) or the filter (see [`super::tracker`]).
 
-use crate::cloud::boxes::{fit_box_of, BoxFitParams, BoxScratch};
+use crate::cloud::boxes::{outline_of, BoxFitParams, BoxScratch};
 use crate::cloud::classes::{
     default_prior, speed_log_likelihoods, ClassBelief, ClassFeatures, ClassModel, ObjectClass,
     CLASS_COUNT, DEFAULT_FORGETTING,
@@ -101,7 +101,8 @@ pub fn shape_of(
     scratch: &mut BoxScratch,
 ) -> Result<ClusterShape> {
     let params = BoxFitParams::default();
-    let fit = fit_box_of(cloud, indices, ground_z, None, &params, scratch)?;
+    let outline = outline_of(cloud, indices, ground_z, &params, scratch)?;
+    let fit = outline.fit(None)?;
     let features = ClassFeatures::from_fit(&fit, None);
     let class = model.classify(&features, &default_prior())?;
     // The box takes the footprint of the most likely road user even when the frame's most
@@ -112,7 +113,7 @@ pub fn shape_of(
     road_user_prior[ObjectClass::Other.index()] = 0.0;
     let shape_class = model.classify(&features, &road_user_prior)?;
     let bbox = match shape_class.size_prior() {
-        Some(prior) => fit_box_of(cloud, indices, ground_z, Some(&prior), &params, scratch)?,
+        Some(prior) => outline.fit(Some(&prior))?,
         None => fit,
     }
     .estimated;
