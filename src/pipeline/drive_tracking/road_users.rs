@@ -4,9 +4,9 @@
 //! * A detection's box is fitted to its points ([`crate::cloud::boxes`]: L-shape heading,
 //!   bottom on the ground plane) and classed for this frame ([`crate::cloud::classes`]); the
 //!   same outline (one heading search) is boxed again with the footprint of the frame's most
-//!   likely road-user class (whatever the likelihood of `Other`): the visible-face model moves the box's centre away from
-//!   the sensor. That centre, not the centroid of the visible points, is what the filter
-//!   measures.
+//!   likely road-user class (whatever the likelihood of `Other`): the visible-face model
+//!   moves the box's centre away from the sensor. That centre, not the centroid of the
+//!   visible points, is what the filter measures.
 //! * A track keeps a categorical class posterior ([`ClassBelief`]) updated with every matched
 //!   detection's class likelihood (its speed included: the class speed densities averaged
 //!   over the track's velocity particles, [`speed_evidence`]; and, once the track
