@@ -8,13 +8,18 @@
 //!   moves the box's centre away from the sensor. That centre, not the centroid of the
 //!   visible points, is what the filter measures.
 //! * A track keeps a categorical class posterior ([`ClassBelief`]) updated with every matched
-//!   detection's class likelihood (its speed included: the class speed densities averaged
-//!   over the track's velocity particles, [`speed_evidence`]; and, once the track
-//!   is [`TRAVEL_AGE`] frames old and faster than [`TRAVEL_SPEED`], the angle between the
-//!   detection's seen long side and the direction of travel: a car seen end-on shows a
-//!   cyclist's 1.8 m side, but across its travel, where no cyclist has one), a box size averaged
-//!   over its detections, and a heading in the world frame: the matched box's, turned by π
-//!   towards the direction of travel once the track moves.
+//!   detection's shape likelihood (and, once the track is [`TRAVEL_AGE`] frames old and
+//!   faster than [`TRAVEL_SPEED`], the angle between the detection's seen long side and the
+//!   direction of travel: a car seen end-on shows a cyclist's 1.8 m side, but across its
+//!   travel, where no cyclist has one), each frame weighted by [`FRAME_EVIDENCE_WEIGHT`]
+//!   since consecutive scans of one object are alike; a box size averaged over its
+//!   detections; and a heading in the world frame: the matched box's, turned by π towards
+//!   the direction of travel once the track moves.
+//! * The speed enters the class once, when the class is read: the class speed densities
+//!   averaged over the track's velocity particles ([`speed_evidence`]) at its last matched
+//!   detection. The velocity posterior already sums up every frame; multiplying its
+//!   evidence in again each frame would count a standing object's stillness (or a car's
+//!   speed) once per frame.
 //! * A confirmed cluster is a road user unless its class is `Other` and it moves slower than
 //!   [`STATIC_SPEED`]; parked cars are road users.
 //! * Two road users cannot stand in one place: a road user whose footprint lies mostly
@@ -27,7 +32,7 @@
 use crate::cloud::boxes::{outline_of, BoxFitParams, BoxScratch};
 use crate::cloud::classes::{
     default_prior, speed_log_likelihoods, ClassBelief, ClassFeatures, ClassModel, ObjectClass,
-    CLASS_COUNT, DEFAULT_FORGETTING,
+    CLASS_COUNT, DEFAULT_FORGETTING, FRAME_EVIDENCE_WEIGHT,
 };
 use crate::cloud::PointCloud;
 use crate::error::Result;
@@ -191,7 +196,10 @@ fn travel_angle(fitted: &Box3, travel: f64) -> Option<f64> {
 /// What a cluster track remembers of its detections' shapes.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RoadUserState {
+    /// The class belief from the shape evidence of every matched frame.
     belief: ClassBelief,
+    /// The speed evidence at the last matched frame, combined with `belief` when read.
+    speed_ll: [f64; CLASS_COUNT],
     size: [f64; 3],
     /// Heading of the box's length axis in the world frame (rad).
     yaw: f64,
@@ -209,6 +217,7 @@ impl RoadUserState {
     ) -> Result<Self> {
         let mut s = RoadUserState {
             belief: ClassBelief::new(default_prior())?,
+            speed_ll: [0.0; CLASS_COUNT],
             size: shape.bbox.size,
             yaw: world_yaw,
         };
@@ -230,10 +239,16 @@ impl RoadUserState {
             travel_angle: travel.and_then(|t| travel_angle(&shape.fitted, t)),
             ..shape.features
         };
-        let mut ll = model.log_likelihoods(&features)?;
-        for (l, s) in ll.iter_mut().zip(speed_ll) {
-            *l += s;
+        if speed_ll.iter().any(|v| v.is_nan() || *v == f64::INFINITY) {
+            return Err(crate::error::Error::invalid(
+                "class speed log-likelihoods",
+                format!("{speed_ll:?} (NaN or +∞)"),
+            ));
         }
+        let ll = model
+            .log_likelihoods(&features)?
+            .map(|l| FRAME_EVIDENCE_WEIGHT * l);
+        self.speed_ll = *speed_ll;
         self.belief.update(&ll, DEFAULT_FORGETTING)
     }
 
@@ -256,13 +271,30 @@ impl RoadUserState {
 
     /// The most likely class and its probability.
     pub fn class(&self) -> (ObjectClass, f64) {
-        let c = self.belief.most_likely();
-        (c, self.belief.probability(c))
+        let p = self.probabilities();
+        let best = (1..CLASS_COUNT).fold(0, |b, k| if p[k] > p[b] { k } else { b });
+        (ObjectClass::ALL[best], p[best])
     }
 
-    /// The class probabilities in [`ObjectClass::ALL`] order.
+    /// The class probabilities in [`ObjectClass::ALL`] order: the shape belief times the
+    /// last speed evidence, normalised.
     pub fn probabilities(&self) -> [f64; CLASS_COUNT] {
-        self.belief.probabilities()
+        let b = self.belief.probabilities();
+        let top = self
+            .speed_ll
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max);
+        if top == f64::NEG_INFINITY {
+            return b;
+        }
+        let p: [f64; CLASS_COUNT] = std::array::from_fn(|k| b[k] * (self.speed_ll[k] - top).exp());
+        let sum: f64 = p.iter().sum();
+        if sum > 0.0 {
+            p.map(|v| v / sum)
+        } else {
+            b
+        }
     }
 
     /// Box size (length, width, height, m).
@@ -414,6 +446,59 @@ mod tests {
         assert_eq!(travel_direction([0.0, 5.0], TRAVEL_AGE - 1), None);
         let t = travel_direction([0.0, -5.0], TRAVEL_AGE).unwrap();
         assert!((t + PI / 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn shape_evidence_is_weighted_and_speed_evidence_counts_once() {
+        let cloud = car_points();
+        let idx: Vec<u32> = (0..cloud.len() as u32).collect();
+        let model = ClassModel::default();
+        let shape = shape_of(
+            &cloud,
+            &idx,
+            Some(-1.73),
+            &model,
+            &mut BoxScratch::default(),
+        )
+        .unwrap();
+        let ll = model.log_likelihoods(&shape.features).unwrap();
+        let none = [0.0; CLASS_COUNT];
+        let standing = speed_log_likelihoods([(0.0, 1.0)]).unwrap();
+        let normalise = |v: [f64; CLASS_COUNT]| {
+            let sum: f64 = v.iter().sum();
+            v.map(|x| x / sum)
+        };
+        // One frame from the prior: prior · exp(w · shape) · exp(speed).
+        let prior = default_prior();
+        let one = RoadUserState::new(&shape, 0.0, &standing, &model).unwrap();
+        let expected = normalise(std::array::from_fn(|k| {
+            prior[k] * (FRAME_EVIDENCE_WEIGHT * ll[k] + standing[k]).exp()
+        }));
+        for (a, b) in one.probabilities().iter().zip(&expected) {
+            assert!(
+                (a - b).abs() < 1e-9,
+                "{:?} vs {expected:?}",
+                one.probabilities()
+            );
+        }
+        // Ten frames with the same speed evidence equal ten without it, times it once.
+        let (mut with, mut without) = (one.clone(), {
+            RoadUserState::new(&shape, 0.0, &none, &model).unwrap()
+        });
+        for _ in 0..9 {
+            with.update(&shape, 0.0, &standing, None, &model).unwrap();
+            without.update(&shape, 0.0, &none, None, &model).unwrap();
+        }
+        let b = without.probabilities();
+        let expected = normalise(std::array::from_fn(|k| b[k] * standing[k].exp()));
+        for (a, e) in with.probabilities().iter().zip(&expected) {
+            assert!((a - e).abs() < 1e-9);
+        }
+        assert_eq!(with.class().0, ObjectClass::Car);
+        // A speed evidence holding NaN is an error, not a belief.
+        let mut bad = standing;
+        bad[0] = f64::NAN;
+        assert!(with.update(&shape, 0.0, &bad, None, &model).is_err());
     }
 
     #[test]
