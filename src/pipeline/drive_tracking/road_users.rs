@@ -11,10 +11,10 @@
 //!   detection's shape likelihood (and, once the track is [`TRAVEL_AGE`] frames old and
 //!   faster than [`TRAVEL_SPEED`], the angle between the detection's seen long side and the
 //!   direction of travel: a car seen end-on shows a cyclist's 1.8 m side, but across its
-//!   travel, where no cyclist has one), each frame weighted by [`FRAME_EVIDENCE_WEIGHT`]
-//!   since consecutive scans of one object are alike; a box size averaged over its
-//!   detections; and a heading in the world frame: the matched box's, turned by π towards
-//!   the direction of travel once the track moves.
+//!   travel, where no cyclist has one), the first frame in full and each later one weighted
+//!   by [`FRAME_EVIDENCE_WEIGHT`] since consecutive scans of one object are alike; a box
+//!   size averaged over its detections; and a heading in the world frame: the matched box's,
+//!   turned by π towards the direction of travel once the track moves.
 //! * The speed enters the class once, when the class is read: the class speed densities
 //!   averaged over the track's velocity particles ([`speed_evidence`]) at its last matched
 //!   detection. The velocity posterior already sums up every frame; multiplying its
@@ -221,17 +221,18 @@ impl RoadUserState {
             size: shape.bbox.size,
             yaw: world_yaw,
         };
-        s.observe_class(shape, speed_ll, None, model)?;
+        s.observe_class(shape, speed_ll, None, 1.0, model)?;
         Ok(s)
     }
 
     /// `travel`: the direction of travel in the detection's (sensor) frame, when the track
-    /// knows it (see [`travel_direction`]).
+    /// knows it (see [`travel_direction`]); `weight`: that of the shape evidence.
     fn observe_class(
         &mut self,
         shape: &ClusterShape,
         speed_ll: &[f64; CLASS_COUNT],
         travel: Option<f64>,
+        weight: f64,
         model: &ClassModel,
     ) -> Result<()> {
         let features = ClassFeatures {
@@ -245,9 +246,7 @@ impl RoadUserState {
                 format!("{speed_ll:?} (NaN or +∞)"),
             ));
         }
-        let ll = model
-            .log_likelihoods(&features)?
-            .map(|l| FRAME_EVIDENCE_WEIGHT * l);
+        let ll = model.log_likelihoods(&features)?.map(|l| weight * l);
         self.speed_ll = *speed_ll;
         self.belief.update(&ll, DEFAULT_FORGETTING)
     }
@@ -261,7 +260,7 @@ impl RoadUserState {
         travel: Option<f64>,
         model: &ClassModel,
     ) -> Result<()> {
-        self.observe_class(shape, speed_ll, travel, model)?;
+        self.observe_class(shape, speed_ll, travel, FRAME_EVIDENCE_WEIGHT, model)?;
         for (s, d) in self.size.iter_mut().zip(shape.bbox.size) {
             *s += SIZE_GAIN * (d - *s);
         }
@@ -468,17 +467,33 @@ mod tests {
             let sum: f64 = v.iter().sum();
             v.map(|x| x / sum)
         };
-        // One frame from the prior: prior · exp(w · shape) · exp(speed).
+        // The first frame counts in full: prior · exp(shape) · exp(speed).
         let prior = default_prior();
         let one = RoadUserState::new(&shape, 0.0, &standing, &model).unwrap();
         let expected = normalise(std::array::from_fn(|k| {
-            prior[k] * (FRAME_EVIDENCE_WEIGHT * ll[k] + standing[k]).exp()
+            prior[k] * (ll[k] + standing[k]).exp()
         }));
         for (a, b) in one.probabilities().iter().zip(&expected) {
             assert!(
                 (a - b).abs() < 1e-9,
                 "{:?} vs {expected:?}",
                 one.probabilities()
+            );
+        }
+        // A second one with weight w, after the forgetting's step towards the prior.
+        let mut two = one.clone();
+        two.update(&shape, 0.0, &standing, None, &model).unwrap();
+        let f = DEFAULT_FORGETTING;
+        let first = normalise(std::array::from_fn(|k| prior[k] * ll[k].exp()));
+        let expected = normalise(std::array::from_fn(|k| {
+            ((1.0 - f) * first[k] + f * prior[k])
+                * (FRAME_EVIDENCE_WEIGHT * ll[k] + standing[k]).exp()
+        }));
+        for (a, b) in two.probabilities().iter().zip(&expected) {
+            assert!(
+                (a - b).abs() < 1e-9,
+                "{:?} vs {expected:?}",
+                two.probabilities()
             );
         }
         // Ten frames with the same speed evidence equal ten without it, times it once.
