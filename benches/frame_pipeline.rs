@@ -19,13 +19,17 @@
 //!   default: every object-sized cluster of the exact Euclidean clustering within range) and
 //!   the filter update in a row;
 //! * `frame/filter_update_range_image`, `frame/whole_range_image`: the same with the range
-//!   image's clustering selected.
+//!   image's clustering selected;
+//! * `frame/boxes_one_search`, `frame/boxes_two_searches`: every cluster's box bare and with a
+//!   car's footprint, from one heading search (`BoxOutline`, as the detector does) or from two
+//!   separate fits (as it did before).
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use nalgebra::Isometry3;
+use smc_lmb::cloud::boxes::{fit_box_of, outline_of, BoxFitParams, BoxScratch, SizePrior};
 use smc_lmb::cloud::planes::{extract_planes, PlaneConfig};
 use smc_lmb::cloud::range_image::{range_image_clusters, ImageClusterParams, RangeImage};
-use smc_lmb::cloud::{euclidean_clusters_of, read_kitti_bin, ClusterParams, PointCloud};
+use smc_lmb::cloud::{euclidean_clusters_of, read_kitti_bin, Cluster, ClusterParams, PointCloud};
 use smc_lmb::pipeline::drive_tracking::{
     detect_objects, ClusterMethod, DriveTracker, FrameDetections, TrackingConfig,
 };
@@ -94,8 +98,45 @@ fn frame(c: &mut Criterion) {
             euclidean_clusters_of(&cloud, &seg.remaining, &clusters).unwrap()
         })
     });
+    boxes(&mut g, &cloud, &found);
     filter_update(&mut g, &path, &cloud);
     g.finish();
+}
+
+/// Every cluster's box bare and with a car's footprint: one heading search or two fits.
+fn boxes(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    cloud: &PointCloud,
+    clusters: &[Cluster],
+) {
+    let params = BoxFitParams::default();
+    let car = SizePrior {
+        length: 3.9,
+        width: 1.6,
+    };
+    let mut scratch = BoxScratch::default();
+    g.bench_function("boxes_one_search", |b| {
+        b.iter(|| {
+            for c in clusters {
+                let idx = &c.indices;
+                let outline = outline_of(cloud, idx, Some(-1.73), &params, &mut scratch).unwrap();
+                std::hint::black_box((
+                    outline.fit(None).unwrap(),
+                    outline.fit(Some(&car)).unwrap(),
+                ));
+            }
+        })
+    });
+    g.bench_function("boxes_two_searches", |b| {
+        b.iter(|| {
+            for c in clusters {
+                let idx = &c.indices;
+                let bare = fit_box_of(cloud, idx, Some(-1.73), None, &params, &mut scratch);
+                let with = fit_box_of(cloud, idx, Some(-1.73), Some(&car), &params, &mut scratch);
+                std::hint::black_box((bare.unwrap(), with.unwrap()));
+            }
+        })
+    });
 }
 
 /// The drive tracker's filter step on this frame's walls and clusters, and the whole frame.
