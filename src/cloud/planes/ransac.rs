@@ -210,14 +210,18 @@ fn near_points(pts: &[[f32; 3]], idx: &[u32], plane: &PlaneF32, max: f64) -> (Ve
             for (r, &i) in all.iter_mut().zip(ix) {
                 *r = plane.residual(&pts[i as usize]);
             }
-            let mut near = Vec::new();
-            let mut res = Vec::new();
+            // Branch-free compaction: every point is written at the next free place, which
+            // only a near one keeps.
+            let mut near = vec![0u32; ix.len()];
+            let mut res = vec![0.0f32; ix.len()];
+            let mut kept = 0;
             for (&r, &i) in all.iter().zip(ix) {
-                if r as f64 <= max {
-                    near.push(i);
-                    res.push(r);
-                }
+                near[kept] = i;
+                res[kept] = r;
+                kept += (r as f64 <= max) as usize;
             }
+            near.truncate(kept);
+            res.truncate(kept);
             (near, res)
         })
         .collect();
