@@ -153,7 +153,7 @@ impl BoxOutline {
                 ),
             ));
         }
-        check_settings(ground_z, None, params)?;
+        check_settings(ground_z, params)?;
         // Centre the x–y coordinates on their mean (keeps the projections' rounding small).
         let (mut mx, mut my) = (0.0f64, 0.0f64);
         let (mut z_lo, mut z_hi, mut z_sum) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
@@ -309,11 +309,8 @@ pub struct BoxScratch {
     centred: Vec<f64>,
 }
 
-fn check_settings(
-    ground_z: Option<f64>,
-    prior: Option<&SizePrior>,
-    params: &BoxFitParams,
-) -> Result<()> {
+/// Checks the fit's settings (a size prior is checked by [`BoxOutline::fit`], which takes it).
+fn check_settings(ground_z: Option<f64>, params: &BoxFitParams) -> Result<()> {
     if !(params.angle_step > 0.0 && params.angle_step <= FRAC_PI_2) {
         return Err(Error::invalid(
             "box fit angle_step",
@@ -325,10 +322,6 @@ fn check_settings(
     crate::error::ensure_non_negative("box fit search_cell", params.search_cell)?;
     if let Some(g) = ground_z {
         crate::error::ensure_finite("box fit ground_z", &[g])?;
-    }
-    if let Some(p) = prior {
-        crate::error::ensure_non_negative("size prior length", p.length)?;
-        crate::error::ensure_non_negative("size prior width", p.width)?;
     }
     Ok(())
 }
