@@ -198,8 +198,9 @@ fn travel_angle(fitted: &Box3, travel: f64) -> Option<f64> {
 pub struct RoadUserState {
     /// The class belief from the shape evidence of every matched frame.
     belief: ClassBelief,
-    /// The speed evidence at the last matched frame, combined with `belief` when read.
-    speed_ll: [f64; CLASS_COUNT],
+    /// `belief` with the speed evidence of the last matched frame applied once: the class
+    /// that is read.
+    current: ClassBelief,
     size: [f64; 3],
     /// Heading of the box's length axis in the world frame (rad).
     yaw: f64,
@@ -215,9 +216,10 @@ impl RoadUserState {
         speed_ll: &[f64; CLASS_COUNT],
         model: &ClassModel,
     ) -> Result<Self> {
+        let prior = ClassBelief::new(default_prior())?;
         let mut s = RoadUserState {
-            belief: ClassBelief::new(default_prior())?,
-            speed_ll: [0.0; CLASS_COUNT],
+            belief: prior,
+            current: prior,
             size: shape.bbox.size,
             yaw: world_yaw,
         };
@@ -240,15 +242,14 @@ impl RoadUserState {
             travel_angle: travel.and_then(|t| travel_angle(&shape.fitted, t)),
             ..shape.features
         };
-        if speed_ll.iter().any(|v| v.is_nan() || *v == f64::INFINITY) {
-            return Err(crate::error::Error::invalid(
-                "class speed log-likelihoods",
-                format!("{speed_ll:?} (NaN or +∞)"),
-            ));
-        }
         let ll = model.log_likelihoods(&features)?.map(|l| weight * l);
-        self.speed_ll = *speed_ll;
-        self.belief.update(&ll, DEFAULT_FORGETTING)
+        let mut belief = self.belief;
+        belief.update(&ll, DEFAULT_FORGETTING)?;
+        let mut current = belief;
+        current.update(speed_ll, 0.0)?;
+        self.belief = belief;
+        self.current = current;
+        Ok(())
     }
 
     /// Folds in one more matched detection.
@@ -270,30 +271,14 @@ impl RoadUserState {
 
     /// The most likely class and its probability.
     pub fn class(&self) -> (ObjectClass, f64) {
-        let p = self.probabilities();
-        let best = (1..CLASS_COUNT).fold(0, |b, k| if p[k] > p[b] { k } else { b });
-        (ObjectClass::ALL[best], p[best])
+        let c = self.current.most_likely();
+        (c, self.current.probability(c))
     }
 
     /// The class probabilities in [`ObjectClass::ALL`] order: the shape belief times the
     /// last speed evidence, normalised.
     pub fn probabilities(&self) -> [f64; CLASS_COUNT] {
-        let b = self.belief.probabilities();
-        let top = self
-            .speed_ll
-            .iter()
-            .copied()
-            .fold(f64::NEG_INFINITY, f64::max);
-        if top == f64::NEG_INFINITY {
-            return b;
-        }
-        let p: [f64; CLASS_COUNT] = std::array::from_fn(|k| b[k] * (self.speed_ll[k] - top).exp());
-        let sum: f64 = p.iter().sum();
-        if sum > 0.0 {
-            p.map(|v| v / sum)
-        } else {
-            b
-        }
+        self.current.probabilities()
     }
 
     /// Box size (length, width, height, m).
