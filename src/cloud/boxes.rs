@@ -43,8 +43,7 @@ pub struct BoxFitParams {
     /// on an edge do not dominate. Zhang et al. use 0.01 m, about a scanner's range noise.
     pub min_distance: f64,
     /// Azimuth spacing of the scanner's points (rad), for the sampling gap of the visible-face
-    /// model: KITTI's HDL-64E at 10 Hz gives about 2,000 points per laser and turn (≈ 125,000
-    /// points per scan over 64 lasers), 2π / 2,000 ≈ 0.0031 rad.
+    /// model. Default [`super::HDL64E_AZIMUTH_STEP`].
     pub azimuth_step: f64,
     /// The heading search scores one point per cell of this size (m) in the bird's-eye view
     /// (the first in the cluster's order), 0 for every point. A lidar sees an object's
@@ -59,7 +58,7 @@ impl Default for BoxFitParams {
         Self {
             angle_step: 0.5f64.to_radians(),
             min_distance: 0.01,
-            azimuth_step: 0.0031,
+            azimuth_step: super::HDL64E_AZIMUTH_STEP,
             search_cell: 0.1,
         }
     }

@@ -178,8 +178,7 @@ pub struct ClassModel {
     /// class spread: about two azimuth steps of the scanner at 20 m (2 × 0.0031 rad × 20 m ≈
     /// 0.12 m) plus range noise (≈ 0.02 m for an HDL-64E).
     pub fit_sigma: f64,
-    /// Azimuth spacing of the scanner's points (rad): KITTI's HDL-64E at 10 Hz gives about
-    /// 2,000 points per laser and turn (≈ 125,000 points per scan over 64 lasers).
+    /// Azimuth spacing of the scanner's points (rad). Default [`super::HDL64E_AZIMUTH_STEP`].
     pub azimuth_step: f64,
     /// Elevation spacing of the scanner's lasers (rad): 26.9° over 64 lasers for the HDL-64E.
     pub elevation_step: f64,
@@ -213,7 +212,7 @@ impl Default for ClassModel {
     fn default() -> Self {
         Self {
             fit_sigma: 0.15,
-            azimuth_step: 0.0031,
+            azimuth_step: super::HDL64E_AZIMUTH_STEP,
             elevation_step: 26.9f64.to_radians() / 64.0,
             return_fraction: 0.8,
             log_count_sigma: 0.6,

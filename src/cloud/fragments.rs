@@ -26,7 +26,7 @@ use crate::error::{Error, Result};
 #[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct FragmentParams {
-    /// The scanner's azimuth step (rad): KITTI's HDL-64E at 10 Hz, about 0.0031.
+    /// The scanner's azimuth step (rad). Default [`super::HDL64E_AZIMUTH_STEP`].
     pub azimuth_step: f64,
     /// Largest angle between a fragment's long axis and the line of sight (degrees). Default
     /// 20: beyond it a face's samples lie closer than 3·r·Δφ ≈ 0.3 m at 36 m apart and the
@@ -53,7 +53,7 @@ pub struct FragmentParams {
 impl Default for FragmentParams {
     fn default() -> Self {
         Self {
-            azimuth_step: 0.0031,
+            azimuth_step: super::HDL64E_AZIMUTH_STEP,
             max_angle_deg: 20.0,
             min_length: 1.0,
             min_elongation: 4.0,

@@ -25,6 +25,11 @@ pub mod range_image;
 pub mod scan_file;
 pub mod voxel_groups;
 
+/// Azimuth spacing of a KITTI HDL-64E's points at 10 Hz (rad): about 2,000 points per laser
+/// and turn (≈ 125,000 points per scan over 64 lasers), 2π / 2,000 ≈ 0.0031. The default of
+/// every setting that needs the scanner's sampling step along a turn.
+pub const HDL64E_AZIMUTH_STEP: f64 = 0.0031;
+
 pub use cluster::{euclidean_clusters, euclidean_clusters_of, Cluster, ClusterParams};
 pub use kitti_bin::{read_kitti_bin, read_kitti_bin_with, write_kitti_bin, BinScan, NonFinite};
 pub use las_io::{read_las, write_las, write_las_labelled};
