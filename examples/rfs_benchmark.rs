@@ -68,6 +68,10 @@ struct Args {
     /// Also score the fixed-lag smoothed estimates with this lag (steps); 0: off.
     #[arg(long, default_value_t = 0)]
     smooth_lag: usize,
+    /// Merge duplicate tracks within this squared scaled distance
+    /// (`LmbConfig::merge_threshold`); default: no merging.
+    #[arg(long)]
+    merge: Option<f64>,
 }
 
 struct RunResult {
@@ -348,6 +352,7 @@ fn main() -> Result<()> {
         prune_threshold: 1e-3,
         max_tracks: 100,
         smoothing_lag: args.smooth_lag,
+        merge_threshold: args.merge,
     };
     let mut runs = Vec::with_capacity(args.runs);
     for r in 0..args.runs {

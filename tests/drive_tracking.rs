@@ -586,11 +586,12 @@ fn a_box_centre_off_for_one_frame_barely_moves_the_track() {
     };
     let mut config = config();
     let robust = shift(&config);
-    // A Gaussian of σ = 0.3 m alone follows the odd centre: the velocity jumps by over 1 m/s.
+    // A Gaussian of σ = 0.3 m alone follows the odd centre: the velocity jumps by about 1 m/s
+    // (a little less since duplicate tracks merge: the birth at the odd centre joins the track).
     config.cluster.outlier_weight = 0.0;
     let plain = shift(&config);
     assert!(
-        robust < 0.3 && plain > 1.0,
+        robust < 0.3 && plain > 0.6,
         "velocity moved {robust} m/s, plain {plain} m/s"
     );
     // Out-of-range settings are refused.

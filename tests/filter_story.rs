@@ -339,3 +339,58 @@ fn missing_models_and_bad_config_are_named() {
         .unwrap();
     assert!(err.to_string().contains("prune_threshold"), "{err}");
 }
+
+/// Two birth terms on one object: without merging both tracks live on, sharing its
+/// detections; with [`LmbConfig::merge_threshold`] they become one track that holds their
+/// summed existence, and a second object 8 m away keeps its own track.
+#[test]
+fn duplicate_tracks_of_one_object_are_merged() {
+    let filter_with = |merge: Option<f64>| {
+        let term = |x: f64, y: f64| BirthTerm {
+            existence: 0.3,
+            mean: vec![x, 0.0, y, 0.0],
+            std: vec![0.5, 0.3, 0.5, 0.3],
+        };
+        LmbFilter::builder()
+            .transition(ConstantVelocity::new(2, 0.5).unwrap())
+            .measurement(PositionMeasurement::new(2, 0.5).unwrap())
+            .detection(ConstantDetection(0.9))
+            .clutter(UniformClutter::rectangle(1.0, [-50.0, 50.0], [-50.0, 50.0]).unwrap())
+            .birth(
+                StaticBirth::new(vec![term(0.0, 0.0), term(0.2, 0.1), term(8.0, 0.0)], 500)
+                    .unwrap(),
+            )
+            .config(LmbConfig {
+                particles: 500,
+                merge_threshold: merge,
+                ..LmbConfig::default()
+            })
+            .build()
+            .unwrap()
+    };
+    let frame = Frame::new(
+        0.0,
+        Measurements::from_rows(2, &[[0.1, 0.0], [8.0, 0.1]]).unwrap(),
+    );
+    let near_origin = |f: &LmbFilter| {
+        f.tracks()
+            .iter()
+            .filter(|t| t.particles.mean()[0].abs() < 1.0)
+            .map(|t| t.existence)
+            .collect::<Vec<_>>()
+    };
+    let mut plain = filter_with(None);
+    plain.step(&frame, &mut seeded(3)).unwrap();
+    let apart = near_origin(&plain);
+    assert_eq!(apart.len(), 2, "{apart:?}");
+    let mut merging = filter_with(Some(9.0));
+    merging.step(&frame, &mut seeded(3)).unwrap();
+    let one = near_origin(&merging);
+    assert_eq!(one.len(), 1, "{one:?}");
+    assert!(
+        (one[0] - (apart[0] + apart[1]).min(1.0)).abs() < 1e-9,
+        "{one:?} vs {apart:?}"
+    );
+    // The object 8 m away keeps its track.
+    assert_eq!(merging.tracks().len(), 2);
+}

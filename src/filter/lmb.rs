@@ -15,6 +15,7 @@ use super::association::{AssociationMethod, AssociationProblem, Associator, Marg
 use super::birth::{unexplained, BirthEvidence, BirthModel, CurrentMeasurements};
 use super::estimate::map_estimates;
 use super::groups::partition;
+use super::merge::{duplicate_pairs, merge_into, MergeDistance, ScaledDistance};
 use super::track::{Estimate, Track};
 use super::{Jitter, Label, Measurements, ParticleSet};
 use crate::error::{Error, Result};
@@ -69,6 +70,11 @@ pub struct LmbConfig {
     /// ([`crate::filter::smoothing::FixedLagSmoother`]), at most [`MAX_SMOOTHING_LAG`]; each
     /// step of lag copies every particle once more per step. Default 0: none kept.
     pub smoothing_lag: usize,
+    /// When set, duplicate tracks are merged after each update ([`super::merge`]): two tracks
+    /// whose most probable measurement is the same and whose posterior means lie within this
+    /// squared distance (each component scaled by the sum of the two tracks' variances)
+    /// become one, under the more probable one's label. Default `None`: no merging.
+    pub merge_threshold: Option<f64>,
 }
 
 impl Default for LmbConfig {
@@ -81,6 +87,7 @@ impl Default for LmbConfig {
             prune_threshold: 1e-3,
             max_tracks: 100,
             smoothing_lag: 0,
+            merge_threshold: None,
         }
     }
 }
@@ -126,6 +133,14 @@ impl LmbConfig {
                     self.smoothing_lag
                 ),
             ));
+        }
+        if let Some(t) = self.merge_threshold {
+            if !(t >= 0.0 && t.is_finite()) {
+                return Err(Error::invalid(
+                    "config field `merge_threshold`",
+                    format!("{t} must be finite and ≥ 0"),
+                ));
+            }
         }
         if self.max_tracks == 0 {
             return Err(Error::invalid(
@@ -185,6 +200,7 @@ pub struct LmbFilterBuilder {
     clutter: Option<Box<dyn ClutterModel>>,
     birth: Option<Box<dyn BirthModel>>,
     associator: Option<Box<dyn Associator>>,
+    merge_distance: Option<Box<dyn MergeDistance>>,
     config: LmbConfig,
 }
 
@@ -224,6 +240,12 @@ impl LmbFilterBuilder {
         self.associator = Some(Box::new(a));
         self
     }
+    /// How far apart two tracks are for the duplicate merge, which
+    /// [`LmbConfig::merge_threshold`] turns on (default: [`ScaledDistance`]).
+    pub fn merge_distance(mut self, d: impl MergeDistance + 'static) -> Self {
+        self.merge_distance = Some(Box::new(d));
+        self
+    }
     /// Tuning (default: [`LmbConfig::default`]).
     pub fn config(mut self, c: LmbConfig) -> Self {
         self.config = c;
@@ -249,6 +271,9 @@ impl LmbFilterBuilder {
                 associator: self
                     .associator
                     .unwrap_or_else(|| Box::new(AssociationMethod::default())),
+                merge_distance: self
+                    .merge_distance
+                    .unwrap_or_else(|| Box::new(ScaledDistance)),
             },
             config: self.config,
             tracks: Vec::new(),
@@ -271,6 +296,7 @@ struct Models {
     clutter: Box<dyn ClutterModel>,
     birth: Box<dyn BirthModel>,
     associator: Box<dyn Associator>,
+    merge_distance: Box<dyn MergeDistance>,
 }
 
 /// What the previous step leaves for the next: its context and, for adaptive birth, its
@@ -456,7 +482,8 @@ impl LmbFilter {
         let likelihoods = self.likelihoods(z, &ctx)?;
         let marginals = self.associate(z, &ctx, &likelihoods, seed);
         let assigned = self.update(&likelihoods, &marginals, z.len());
-        let resampled = self.resample(seed);
+        let merged = self.merge_duplicates(&likelihoods, &marginals);
+        let resampled = self.resample(seed, &merged);
         self.record_diagnostics(predicted, likelihoods, &marginals, &resampled);
         self.prune();
         let estimates = map_estimates(&self.tracks);
@@ -797,12 +824,13 @@ impl LmbFilter {
     /// off that number (any difference for a fixed count, beyond a factor of two for a scaled
     /// one) or its effective sample size is below `resample_threshold` times its count.
     /// Returns for every track whether it was resampled.
-    fn resample(&mut self, seed: u64) -> Vec<bool> {
+    fn resample(&mut self, seed: u64, merged: &[bool]) -> Vec<bool> {
         let cfg = &self.config;
         let caps = &self.particle_caps;
         self.tracks
             .par_iter_mut()
-            .map(|t| {
+            .zip(merged)
+            .map(|(t, &merged)| {
                 let n = t.particles.len();
                 let cap = caps.get(&t.label).map(|&c| c.max(1));
                 let (target, off) = match (cfg.min_particles, cap) {
@@ -819,8 +847,9 @@ impl LmbFilter {
                         (target, 2 * n < target || n > 2 * target)
                     }
                 };
-                let resample =
-                    off || t.particles.effective_sample_size() < cfg.resample_threshold * n as f64;
+                let resample = merged
+                    || off
+                    || t.particles.effective_sample_size() < cfg.resample_threshold * n as f64;
                 if resample {
                     let mut rng = stream(seed, KEY_RESAMPLE ^ t.label.key());
                     t.particles.resample(target, cfg.jitter, &mut rng);
@@ -828,6 +857,41 @@ impl LmbFilter {
                 resample
             })
             .collect()
+    }
+
+    /// Merges duplicate tracks ([`super::merge`]) when [`LmbConfig::merge_threshold`] is set:
+    /// tracks whose most probable measurement is the same. Returns for every track whether it
+    /// absorbed another (and must be resampled to its count); an absorbed track is left with
+    /// existence 0 for pruning.
+    fn merge_duplicates(&mut self, lik: &[TrackLikelihoods], marg: &[TrackMarginals]) -> Vec<bool> {
+        let mut merged = vec![false; self.tracks.len()];
+        let Some(threshold) = self.config.merge_threshold else {
+            return merged;
+        };
+        let claims: Vec<Option<usize>> = lik
+            .iter()
+            .zip(marg)
+            .map(|(l, mg)| {
+                let best = mg.detect.iter().max_by(|a, b| a.1.total_cmp(&b.1));
+                best.map(|&(k, _)| l.pairs[k].measurement)
+            })
+            .collect();
+        for (keep, drop) in duplicate_pairs(
+            &self.tracks,
+            &claims,
+            &*self.models.merge_distance,
+            threshold,
+        ) {
+            let (a, b) = if keep < drop {
+                let (x, y) = self.tracks.split_at_mut(drop);
+                (&mut x[keep], &mut y[0])
+            } else {
+                let (x, y) = self.tracks.split_at_mut(keep);
+                (&mut y[0], &mut x[drop])
+            };
+            merged[keep] |= merge_into(a, b);
+        }
+        merged
     }
 
     /// A copy of every track's particle set as predicted (births as drawn), taken before the
@@ -1001,6 +1065,20 @@ mod tests {
                     ..LmbConfig::default()
                 },
                 "max_tracks",
+            ),
+            (
+                LmbConfig {
+                    merge_threshold: Some(f64::NAN),
+                    ..LmbConfig::default()
+                },
+                "merge_threshold",
+            ),
+            (
+                LmbConfig {
+                    merge_threshold: Some(-1.0),
+                    ..LmbConfig::default()
+                },
+                "merge_threshold",
             ),
         ] {
             let e = config.validate().unwrap_err().to_string();

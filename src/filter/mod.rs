@@ -7,7 +7,7 @@
 //!
 //! The filter's contract with its models lives here too: the plug-in traits of [`model`]
 //! ([`TransitionModel`], [`SurvivalModel`], [`MeasurementModel`], [`DetectionModel`],
-//! [`ClutterModel`]), [`BirthModel`] and [`Associator`]. The built-in models implementing them
+//! [`ClutterModel`]), [`BirthModel`], [`Associator`] and the duplicate merge's [`MergeDistance`]. The built-in models implementing them
 //! are in [`crate::models`] (and next to the applications that need their own).
 //!
 //! Not for: sensors, detectors or models of particular objects.
@@ -19,6 +19,7 @@ pub mod groups;
 pub mod label;
 pub mod lmb;
 pub mod measurements;
+pub mod merge;
 pub mod model;
 pub mod particles;
 pub mod smoothing;
@@ -36,6 +37,7 @@ pub use lmb::{
     MAX_SMOOTHING_LAG, MAX_TRACKS,
 };
 pub use measurements::Measurements;
+pub use merge::{MergeDistance, ScaledDistance};
 pub use model::{
     ClutterModel, DetectionModel, MeasurementModel, StepContext, SurvivalModel, TrackSummary,
     TransitionModel,

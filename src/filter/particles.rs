@@ -315,6 +315,47 @@ impl ParticleSet {
         cov
     }
 
+    /// Joins `other`'s particles to these as one mixture: this set's weights times
+    /// (1 − `share`), `other`'s times `share` (`share` in [0, 1]). Histories are joined
+    /// particle by particle. Returns false, changing nothing, when the dimensions differ, the
+    /// two keep histories of different lag, depth or position, or `share` is outside [0, 1].
+    pub fn mix(&mut self, other: &ParticleSet, share: f64) -> bool {
+        let same_history = (self.history_lag, self.history_depth, self.history_head)
+            == (other.history_lag, other.history_depth, other.history_head);
+        if other.dim != self.dim || !same_history || !(0.0..=1.0).contains(&share) {
+            return false;
+        }
+        if other.len == 0 {
+            return true;
+        }
+        let len = self.len + other.len;
+        let mut states = Vec::with_capacity(self.dim * len);
+        for c in 0..self.dim {
+            states.extend_from_slice(self.component(c));
+            states.extend_from_slice(other.component(c));
+        }
+        if self.history_lag > 0 {
+            let mut history = Vec::with_capacity(self.history.len() + other.history.len());
+            let rows = self.history_lag * self.dim;
+            for r in 0..rows {
+                history.extend_from_slice(&self.history[r * self.len..(r + 1) * self.len]);
+                history.extend_from_slice(&other.history[r * other.len..(r + 1) * other.len]);
+            }
+            self.history = history;
+        }
+        let keep = if self.len == 0 { 0.0 } else { 1.0 - share };
+        let share = if self.len == 0 { 1.0 } else { share };
+        let mut weights = Vec::with_capacity(len);
+        weights.extend(self.weights.iter().map(|w| w * keep));
+        weights.extend(other.weights.iter().map(|w| w * share));
+        let total: f64 = weights.iter().sum();
+        weights.iter_mut().for_each(|w| *w /= total);
+        self.states = states;
+        self.weights = weights;
+        self.len = len;
+        true
+    }
+
     /// Effective sample size 1 / Σ wᵢ².
     pub fn effective_sample_size(&self) -> f64 {
         let s: f64 = self.weights.iter().map(|w| w * w).sum();

@@ -36,6 +36,9 @@
 //!   clutter intensity per kind (the plane clutter density is in the (angle, offset) units
 //!   of [`PlaneMeasurement`]; the cluster one per m³).
 //! - [`MixedBirthSampler`]: the inverse measurement model for measurement-driven birth.
+//! - [`MixedMergeDistance`]: duplicate cluster tracks merge ([`ScaledDistance`]); planes never
+//!   do, because two stretches of one facade are one plane state, each measured by its own
+//!   segment.
 //!
 //! The ECT option moves planes by the vehicle (IMU) motion without the IMU → Velodyne
 //! conjugation; for KITTI (a 1 m lever arm) the difference per 0.1 s step is below 1 cm.
@@ -46,7 +49,7 @@
 //! [`LmbFilter`]: crate::filter::LmbFilter
 
 use crate::error::{ensure_positive, ensure_probability, Error, Result};
-use crate::filter::{BirthSampler, ParticleSet};
+use crate::filter::{BirthSampler, MergeDistance, ParticleSet, ScaledDistance};
 use crate::filter::{
     ClutterModel, DetectionModel, MeasurementModel, StepContext, TrackSummary, TransitionModel,
 };
@@ -66,6 +69,24 @@ pub const KIND: usize = 6;
 pub const MEASUREMENT_DIM: usize = 5;
 /// Index of the kind component in a measurement.
 pub const MEASUREMENT_KIND: usize = 4;
+
+/// The duplicate merge's distance for the mixed state: [`ScaledDistance`] between two
+/// clusters; planes never merge (see the module documentation).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MixedMergeDistance;
+
+impl MergeDistance for MixedMergeDistance {
+    fn distance2(&self, a: (&[f64], &[f64]), b: (&[f64], &[f64])) -> Option<f64> {
+        let cluster = |m: &[f64]| {
+            m.get(KIND).copied().and_then(ObjectKind::from_code) == Some(ObjectKind::Cluster)
+        };
+        if cluster(a.0) && cluster(b.0) {
+            ScaledDistance.distance2(a, b)
+        } else {
+            None
+        }
+    }
+}
 
 /// What a track or a measurement is.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]

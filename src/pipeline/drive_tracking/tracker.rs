@@ -24,8 +24,8 @@ use crate::geometry::Plane;
 use crate::models::plane::{canonical_plane, plane_residual};
 use crate::models::{ExtendedConstantTurn, PlaneMeasurement};
 use crate::pipeline::drive_tracking::mixed::{
-    MixedBirthSampler, MixedClutter, MixedDetection, MixedMeasurement, MixedTransition, ObjectKind,
-    VehicleStateHandle, KIND,
+    MixedBirthSampler, MixedClutter, MixedDetection, MixedMeasurement, MixedMergeDistance,
+    MixedTransition, ObjectKind, VehicleStateHandle, KIND,
 };
 use crate::rng::{seeded, FilterRng};
 use nalgebra::{Isometry3, Point3, Vector3};
@@ -132,6 +132,7 @@ impl DriveTracker {
             )?)
             .survival(crate::filter::ConstantSurvival(config.birth.survival))
             .birth(birth)
+            .merge_distance(MixedMergeDistance)
             .config(config.filter.clone())
             .build()?;
         Ok(DriveTracker {
