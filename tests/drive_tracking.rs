@@ -599,3 +599,50 @@ fn a_box_centre_off_for_one_frame_barely_moves_the_track() {
     let err = DriveTracker::new(&config, 3).unwrap_err();
     assert!(err.to_string().contains("cluster.outlier_weight"), "{err}");
 }
+
+#[test]
+fn road_users_are_reported_from_the_least_existence_on() {
+    use smc_lmb::pipeline::drive_tracking::{ClusterDetection, FrameDetections};
+    // A car-sized box driving past a standing sensor for 8 frames, then gone for 6; the
+    // existence of every reported road user, frame by frame.
+    let run = |least: f64| -> Vec<Vec<f64>> {
+        let mut c = config();
+        c.all_clusters = false;
+        c.report_min_existence = least;
+        let mut tracker = DriveTracker::new(&c, 5).unwrap();
+        let pose = nalgebra::Isometry3::identity();
+        (0..14)
+            .map(|k| {
+                let x = 5.0 + 8.0 * DT * k as f64;
+                let clusters = if k < 8 {
+                    vec![ClusterDetection::around([x, 6.0, -0.9], [4.2, 1.8, 1.5])]
+                } else {
+                    vec![]
+                };
+                let det = FrameDetections {
+                    walls: vec![],
+                    clusters,
+                    ground: vec![],
+                    planes_ms: 0.0,
+                    clusters_ms: 0.0,
+                };
+                let f = tracker.step(k, k as f64 * DT, pose, None, &det).unwrap();
+                f.clusters.iter().map(|c| c.existence).collect()
+            })
+            .collect()
+    };
+    let (map, strict) = (run(0.0), run(0.9));
+    assert!(strict.iter().flatten().all(|&r| r >= 0.9), "{strict:?}");
+    // While the car is seen, both report it once it is established.
+    assert!(
+        (3..8).all(|k| map[k].len() == 1 && strict[k].len() == 1),
+        "{map:?} {strict:?}"
+    );
+    // After it is gone, the MAP estimate coasts on it for longer than the strict report.
+    let coasting = |r: &[Vec<f64>]| r[8..].iter().filter(|f| !f.is_empty()).count();
+    assert!(coasting(&strict) < coasting(&map), "{map:?} {strict:?}");
+    let mut c = config();
+    c.report_min_existence = 1.5;
+    let err = DriveTracker::new(&c, 5).unwrap_err().to_string();
+    assert!(err.contains("report_min_existence"), "{err}");
+}

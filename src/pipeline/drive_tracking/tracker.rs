@@ -63,6 +63,8 @@ pub struct DriveTracker {
     road_users: HashMap<Label, RoadUserState>,
     class_model: ClassModel,
     all_clusters: bool,
+    /// Least existence of a reported road user (`TrackingConfig::report_min_existence`).
+    report_min_existence: f64,
     /// Particle cap of unreported static clutter (`ClusterTuning::clutter_particles`).
     clutter_particles: Option<usize>,
 }
@@ -145,6 +147,7 @@ impl DriveTracker {
             road_users: HashMap::new(),
             class_model: ClassModel::default(),
             all_clusters: config.all_clusters,
+            report_min_existence: config.report_min_existence,
             clutter_particles: c.clutter_particles,
         })
     }
@@ -359,6 +362,9 @@ impl DriveTracker {
                 if let Some(n) = clutter_particles {
                     caps.insert(e.label, n);
                 }
+                continue;
+            }
+            if e.existence < self.report_min_existence && !self.all_clusters {
                 continue;
             }
             let s = inv * w;
