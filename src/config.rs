@@ -415,6 +415,10 @@ mod tests {
         assert_eq!(c.survival, 0.99);
         assert_eq!(c.filter, LmbConfig::default());
         assert!(c.build().is_ok());
+        // The duplicate merge is off unless the [filter] table sets it.
+        let f: LmbConfig = serde_json::from_str(r#"{"merge_threshold": 9.0}"#).unwrap();
+        assert_eq!(f.merge_threshold, Some(9.0));
+        assert_eq!(LmbConfig::default().merge_threshold, None);
     }
 
     #[test]
