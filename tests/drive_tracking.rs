@@ -646,3 +646,39 @@ fn road_users_are_reported_from_the_least_existence_on() {
     let err = DriveTracker::new(&c, 5).unwrap_err().to_string();
     assert!(err.contains("report_min_existence"), "{err}");
 }
+
+#[test]
+fn births_below_the_least_existence_are_not_made() {
+    use smc_lmb::pipeline::drive_tracking::{ClusterDetection, FrameDetections};
+    // 500 pedestrian-sized clusters on a grid, seen twice: the adaptive birth spreads its 4
+    // expected births over them, 0.008 each.
+    let det = FrameDetections {
+        walls: vec![],
+        clusters: (0..500)
+            .map(|i| {
+                let (x, y) = ((i % 25) as f64 * 3.0 - 36.0, (i / 25) as f64 * 3.0 - 30.0);
+                ClusterDetection::around([x, y, -0.9], [0.6, 0.6, 1.7])
+            })
+            .collect(),
+        ground: vec![],
+        planes_ms: 0.0,
+        clusters_ms: 0.0,
+    };
+    let tracks_after_two_frames = |least: f64| {
+        let mut c = config();
+        c.filter.particles = 50;
+        c.birth.min_existence = least;
+        let mut tracker = DriveTracker::new(&c, 2).unwrap();
+        let pose = nalgebra::Isometry3::identity();
+        for k in 0..2 {
+            tracker.step(k, k as f64 * DT, pose, None, &det).unwrap();
+        }
+        tracker.filter().tracks().len()
+    };
+    assert_eq!(tracks_after_two_frames(0.01), 0);
+    assert!(tracks_after_two_frames(0.005) > 0);
+    let mut c = config();
+    c.birth.min_existence = 0.5;
+    let err = DriveTracker::new(&c, 2).unwrap_err().to_string();
+    assert!(err.contains("birth.min_existence"), "{err}");
+}

@@ -118,7 +118,11 @@ impl DriveTracker {
             config.filter.particles,
         )?;
         // A proposal below the pruning threshold would be pruned right after its first update.
-        birth.min_existence = config.filter.prune_threshold.max(birth.min_existence);
+        birth.min_existence = config
+            .filter
+            .prune_threshold
+            .max(config.birth.min_existence)
+            .max(birth.min_existence);
         let filter = LmbFilter::builder()
             .transition(transition)
             .measurement(
