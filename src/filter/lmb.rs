@@ -873,7 +873,8 @@ impl LmbFilter {
             .zip(marg)
             .map(|(l, mg)| {
                 let best = mg.detect.iter().max_by(|a, b| a.1.total_cmp(&b.1));
-                best.map(|&(k, _)| l.pairs[k].measurement)
+                best.filter(|&&(_, p)| p > 0.0)
+                    .map(|&(k, _)| l.pairs[k].measurement)
             })
             .collect();
         for (keep, drop) in duplicate_pairs(
