@@ -339,6 +339,15 @@ struct TrackMarginals {
     detect: Vec<(usize, f64)>,
 }
 
+impl TrackMarginals {
+    /// The measurement (its index in the step's measurements) this track most probably
+    /// generated, with that probability; `lik` is the same track's row of likelihoods.
+    fn most_probable(&self, lik: &TrackLikelihoods) -> Option<(usize, f64)> {
+        let best = self.detect.iter().max_by(|a, b| a.1.total_cmp(&b.1));
+        best.map(|&(k, p)| (lik.pairs[k].measurement, p))
+    }
+}
+
 /// A track's most probable measurement in a step, with the association's marginal
 /// probability that the track generated it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -872,9 +881,9 @@ impl LmbFilter {
             .iter()
             .zip(marg)
             .map(|(l, mg)| {
-                let best = mg.detect.iter().max_by(|a, b| a.1.total_cmp(&b.1));
-                best.filter(|&&(_, p)| p > 0.0)
-                    .map(|&(k, _)| l.pairs[k].measurement)
+                mg.most_probable(l)
+                    .filter(|&(_, p)| p > 0.0)
+                    .map(|(j, _)| j)
             })
             .collect();
         for (keep, drop) in duplicate_pairs(
@@ -883,14 +892,10 @@ impl LmbFilter {
             &*self.models.merge_distance,
             threshold,
         ) {
-            let (a, b) = if keep < drop {
-                let (x, y) = self.tracks.split_at_mut(drop);
-                (&mut x[keep], &mut y[0])
-            } else {
-                let (x, y) = self.tracks.split_at_mut(keep);
-                (&mut y[0], &mut x[drop])
-            };
-            merged[keep] |= merge_into(a, b);
+            // Two different tracks in range: `duplicate_pairs` pairs a track with another.
+            if let Ok([a, b]) = self.tracks.get_disjoint_mut([keep, drop]) {
+                merged[keep] |= merge_into(a, b);
+            }
         }
         merged
     }
@@ -923,11 +928,10 @@ impl LmbFilter {
         self.predicted.extend(predicted);
         self.most_probable.clear();
         for ((t, l), mg) in self.tracks.iter().zip(&lik).zip(marg) {
-            let best = mg.detect.iter().max_by(|a, b| a.1.total_cmp(&b.1));
-            if let Some(&(k, probability)) = best {
+            if let Some((measurement, probability)) = mg.most_probable(l) {
                 self.most_probable.push(MostProbableMeasurement {
                     label: t.label,
-                    measurement: l.pairs[k].measurement,
+                    measurement,
                     probability,
                 });
             }

@@ -7,8 +7,9 @@
 //!
 //! The filter's contract with its models lives here too: the plug-in traits of [`model`]
 //! ([`TransitionModel`], [`SurvivalModel`], [`MeasurementModel`], [`DetectionModel`],
-//! [`ClutterModel`]), [`BirthModel`], [`Associator`] and the duplicate merge's [`MergeDistance`]. The built-in models implementing them
-//! are in [`crate::models`] (and next to the applications that need their own).
+//! [`ClutterModel`]), [`BirthModel`], [`Associator`] and the duplicate merge's
+//! [`MergeDistance`]. The built-in models implementing them are in [`crate::models`] (and next
+//! to the applications that need their own).
 //!
 //! Not for: sensors, detectors or models of particular objects.
 
