@@ -486,9 +486,18 @@ impl LmbFilter {
         let seed = rng.next_u64();
 
         self.predict(&ctx, seed)?;
-        self.add_births(&ctx, z, seed);
+        // The gates' summaries of the predicted tracks, for the births' and the update's gating.
+        let summaries: Vec<TrackSummary> = if z.is_empty() {
+            Vec::new()
+        } else {
+            self.tracks
+                .par_iter()
+                .map(|t| TrackSummary::of(&t.particles))
+                .collect()
+        };
+        self.add_births(&ctx, z, seed, &summaries);
         let predicted = self.predicted_copies();
-        let likelihoods = self.likelihoods(z, &ctx)?;
+        let likelihoods = self.likelihoods(z, &ctx, &summaries)?;
         let marginals = self.associate(z, &ctx, &likelihoods, seed);
         let assigned = self.update(&likelihoods, &marginals, z.len());
         let merged = self.merge_duplicates(&likelihoods, &marginals);
@@ -598,16 +607,22 @@ impl LmbFilter {
 
     /// Appends the birth tracks of this step, labelled (step, index). A birth model that
     /// samples near this step's measurements is told how unexplained the predicted tracks
-    /// leave each of them.
-    fn add_births(&mut self, ctx: &StepContext, z: &Measurements, seed: u64) {
+    /// (gated by their `summaries`, empty when `z` is) leave each of them.
+    fn add_births(
+        &mut self,
+        ctx: &StepContext,
+        z: &Measurements,
+        seed: u64,
+        summaries: &[TrackSummary],
+    ) {
         let evidence = self.previous.as_ref().map(|p| BirthEvidence {
             measurements: &p.measurements,
             assigned: &p.assigned,
             context: &p.context,
         });
         let m = &self.models;
-        let u = if m.birth.uses_current_measurements() {
-            unexplained(&self.tracks, z, &*m.measurement, ctx)
+        let u = if m.birth.uses_current_measurements() && !z.is_empty() {
+            unexplained(&self.tracks, summaries, z, &*m.measurement, ctx)
         } else {
             Vec::new()
         };
@@ -643,16 +658,24 @@ impl LmbFilter {
         self.tracks.extend(new);
     }
 
-    /// Gating and the particle sums η_j(ℓ) and η_miss(ℓ) for every track, in parallel.
-    /// A measurement model that returns NaN or +∞ as a log-likelihood is an error naming the
-    /// track and measurement (the first in track order); −∞ is a valid "impossible".
-    fn likelihoods(&self, z: &Measurements, ctx: &StepContext) -> Result<Vec<TrackLikelihoods>> {
+    /// Gating and the particle sums η_j(ℓ) and η_miss(ℓ) for every track, in parallel; the
+    /// tracks that `summaries` covers (the predicted ones) are gated by them, this step's
+    /// births by their own. A measurement model that returns NaN or +∞ as a log-likelihood is
+    /// an error naming the track and measurement (the first in track order); −∞ is a valid
+    /// "impossible".
+    fn likelihoods(
+        &self,
+        z: &Measurements,
+        ctx: &StepContext,
+        summaries: &[TrackSummary],
+    ) -> Result<Vec<TrackLikelihoods>> {
         let m = &self.models;
         let step = self.step;
         let all: Vec<Result<TrackLikelihoods>> = self
             .tracks
             .par_iter()
-            .map(|t| {
+            .enumerate()
+            .map(|(k, t)| {
                 let p = &t.particles;
                 let n = p.len();
                 let mut pd = vec![0.0; n];
@@ -664,9 +687,10 @@ impl LmbFilter {
                 let detectable = w.iter().zip(&pd).any(|(w, d)| w * d > 0.0);
                 let mut gated: Vec<usize> = Vec::new();
                 if detectable && !z.is_empty() {
-                    let (mean, std) = p.mean_and_std_dev();
-                    let summary = TrackSummary { mean, std };
-                    m.measurement.gate_all(z, &summary, ctx, &mut gated);
+                    match summaries.get(k) {
+                        Some(s) => m.measurement.gate_all(z, s, ctx, &mut gated),
+                        None => m.measurement.gate_all(z, &TrackSummary::of(p), ctx, &mut gated),
+                    }
                 }
                 let zs: Vec<&[f64]> = gated.iter().map(|&j| z.get(j)).collect();
                 let mut scaled_g = vec![vec![0.0; n]; zs.len()];

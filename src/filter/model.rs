@@ -81,6 +81,14 @@ pub struct TrackSummary {
     pub std: Vec<f64>,
 }
 
+impl TrackSummary {
+    /// The weighted mean and standard deviation of `particles`.
+    pub fn of(particles: &ParticleSet) -> TrackSummary {
+        let (mean, std) = particles.mean_and_std_dev();
+        TrackSummary { mean, std }
+    }
+}
+
 /// Moves a whole particle set one step forward (Markov transition density f(x' | x)).
 ///
 /// Implementations sample the process noise themselves, from `rng`, so that a user's model

@@ -8,11 +8,13 @@
 use crate::filter::{MeasurementModel, Measurements, StepContext, Track, TrackSummary};
 use rayon::prelude::*;
 
-/// `u(z)` of every measurement of `z` given the predicted `tracks` (in measurement order).
-/// Tracks are gated in parallel and combined in track order, so the result does not depend on
-/// the thread count.
+/// `u(z)` of every measurement of `z` given the predicted `tracks` (in measurement order),
+/// whose gate summaries are `summaries` (one per track, in track order; see
+/// [`TrackSummary::of`]). Tracks are gated in parallel and combined in track order, so the
+/// result does not depend on the thread count.
 pub fn unexplained(
     tracks: &[Track],
+    summaries: &[TrackSummary],
     z: &Measurements,
     model: &dyn MeasurementModel,
     ctx: &StepContext,
@@ -21,13 +23,14 @@ pub fn unexplained(
     if z.is_empty() {
         return u;
     }
+    debug_assert_eq!(tracks.len(), summaries.len());
     let gated: Vec<Vec<usize>> = tracks
         .par_iter()
-        .map(|t| {
+        .zip(summaries)
+        .map(|(t, s)| {
             let mut out = Vec::new();
             if t.existence > 0.0 && !t.particles.is_empty() {
-                let (mean, std) = t.particles.mean_and_std_dev();
-                model.gate_all(z, &TrackSummary { mean, std }, ctx, &mut out);
+                model.gate_all(z, s, ctx, &mut out);
             }
             out
         })
@@ -70,7 +73,8 @@ mod tests {
             Track::new(Label::new(0, 2), 0.4, at(2.0)),
         ];
         let z = Measurements::from_rows(2, &[[1.0, 1.0], [99.0, 0.0], [50.0, 0.0]]).unwrap();
-        let u = unexplained(&tracks, &z, &BoxGate, &StepContext::new(1, 1.0, 1.0));
+        let summaries: Vec<_> = tracks.iter().map(|t| TrackSummary::of(&t.particles)).collect();
+        let u = unexplained(&tracks, &summaries, &z, &BoxGate, &StepContext::new(1, 1.0, 1.0));
         // z0: tracks 0 and 2 → 0.1 · 0.6; z1: track 1 → 0.5; z2: none → 1.
         assert!((u[0] - 0.06).abs() < 1e-12, "{u:?}");
         assert!((u[1] - 0.5).abs() < 1e-12, "{u:?}");
