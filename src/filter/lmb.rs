@@ -689,7 +689,9 @@ impl LmbFilter {
                 if detectable && !z.is_empty() {
                     match summaries.get(k) {
                         Some(s) => m.measurement.gate_all(z, s, ctx, &mut gated),
-                        None => m.measurement.gate_all(z, &TrackSummary::of(p), ctx, &mut gated),
+                        None => m
+                            .measurement
+                            .gate_all(z, &TrackSummary::of(p), ctx, &mut gated),
                     }
                 }
                 let zs: Vec<&[f64]> = gated.iter().map(|&j| z.get(j)).collect();

@@ -73,8 +73,17 @@ mod tests {
             Track::new(Label::new(0, 2), 0.4, at(2.0)),
         ];
         let z = Measurements::from_rows(2, &[[1.0, 1.0], [99.0, 0.0], [50.0, 0.0]]).unwrap();
-        let summaries: Vec<_> = tracks.iter().map(|t| TrackSummary::of(&t.particles)).collect();
-        let u = unexplained(&tracks, &summaries, &z, &BoxGate, &StepContext::new(1, 1.0, 1.0));
+        let summaries: Vec<_> = tracks
+            .iter()
+            .map(|t| TrackSummary::of(&t.particles))
+            .collect();
+        let u = unexplained(
+            &tracks,
+            &summaries,
+            &z,
+            &BoxGate,
+            &StepContext::new(1, 1.0, 1.0),
+        );
         // z0: tracks 0 and 2 → 0.1 · 0.6; z1: track 1 → 0.5; z2: none → 1.
         assert!((u[0] - 0.06).abs() < 1e-12, "{u:?}");
         assert!((u[1] - 0.5).abs() < 1e-12, "{u:?}");

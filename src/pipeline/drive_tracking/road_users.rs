@@ -24,9 +24,10 @@
 //! * A confirmed cluster is a road user unless its class is `Other` and it moves slower than
 //!   [`STATIC_SPEED`]; parked cars are road users.
 //! * Two road users cannot stand in one place: a road user whose footprint lies mostly
-//!   ([`CONTAINED`]) inside the footprint of a more certain one (higher existence, then the
-//!   larger footprint) is a fragment of it — a pedestrian-sized piece of a van, say — and is
-//!   not reported ([`contained_in_others`]).
+//!   ([`CONTAINED`]) inside the footprint of one that ranks before it (reported in the frame
+//!   before, then higher existence, then the larger footprint) is a fragment of it — a
+//!   pedestrian-sized piece of a van, or a new track on part of a car already reported — and
+//!   is not reported ([`contained_in_others`]).
 //!
 //! Not for: clustering (see [`super::detect`]) or the filter (see [`super::tracker`]).
 
@@ -49,15 +50,22 @@ pub const STATIC_SPEED: f64 = 1.0;
 pub const CONTAINED: f64 = 0.5;
 
 /// For each box (with its track's existence), whether it is contained in the footprint of a
-/// box that ranks before it and is itself not contained: ranks go by existence, then by
-/// footprint area, then by position, largest first. Greedy, like a non-maximum suppression
-/// whose overlap is the intersection over the smaller footprint.
-pub fn contained_in_others(boxes: &[(Box3, f64)]) -> Vec<bool> {
+/// box that ranks before it and is itself not contained: the boxes whose `incumbent` flag is
+/// set (their tracks were reported in the frame before) rank first, then existence, then
+/// footprint area, then position, largest first. Greedy, like a non-maximum suppression whose
+/// overlap is the intersection over the smaller footprint. Incumbents first, because
+/// existences near 1 differ by chance: a track born on part of a car already reported reaches
+/// 1.0 within a few frames, and would otherwise take the car's place (its label with it)
+/// whenever its existence came out a ten-thousandth higher.
+pub fn contained_in_others(boxes: &[(Box3, f64)], incumbent: &[bool]) -> Vec<bool> {
+    debug_assert_eq!(boxes.len(), incumbent.len());
     let mut order: Vec<usize> = (0..boxes.len()).collect();
     order.sort_by(|&a, &b| {
         let (ba, ea) = &boxes[a];
         let (bb, eb) = &boxes[b];
-        eb.total_cmp(ea)
+        incumbent[b]
+            .cmp(&incumbent[a])
+            .then(eb.total_cmp(ea))
             .then(bb.bev_area().total_cmp(&ba.bev_area()))
             .then(a.cmp(&b))
     });
@@ -367,14 +375,27 @@ mod tests {
             (b(10.0, 1.4, 0.8, 0.6, 0.0), 0.95),
         ];
         assert_eq!(
-            contained_in_others(&boxes),
+            contained_in_others(&boxes, &[false; 5]),
             vec![false, true, false, true, false]
         );
         // A more certain small box keeps its place; the large one is not "inside" it, but
         // the small one's area is: the more certain one wins.
         let swapped = [(boxes[0].0, 0.6), (boxes[1].0, 0.99)];
-        assert_eq!(contained_in_others(&swapped), vec![true, false]);
-        assert!(contained_in_others(&[]).is_empty());
+        assert_eq!(
+            contained_in_others(&swapped, &[false; 2]),
+            vec![true, false]
+        );
+        // Unless the large one was reported in the frame before and the small one was not.
+        assert_eq!(
+            contained_in_others(&swapped, &[true, false]),
+            vec![false, true]
+        );
+        // Two incumbents rank by existence again.
+        assert_eq!(
+            contained_in_others(&swapped, &[true, true]),
+            vec![true, false]
+        );
+        assert!(contained_in_others(&[], &[]).is_empty());
     }
 
     use super::*;

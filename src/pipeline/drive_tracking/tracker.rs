@@ -29,7 +29,7 @@ use crate::pipeline::drive_tracking::mixed::{
 };
 use crate::rng::{seeded, FilterRng};
 use nalgebra::{Isometry3, Point3, Vector3};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::time::Instant;
 
 /// Largest normal angle between a wall track and the detection it is matched to (rad).
@@ -67,6 +67,8 @@ pub struct DriveTracker {
     report_min_existence: f64,
     /// Particle cap of unreported static clutter (`ClusterTuning::clutter_particles`).
     clutter_particles: Option<usize>,
+    /// The road users reported in the last frame.
+    reported: HashSet<Label>,
 }
 
 impl std::fmt::Debug for DriveTracker {
@@ -153,6 +155,7 @@ impl DriveTracker {
             all_clusters: config.all_clusters,
             report_min_existence: config.report_min_existence,
             clutter_particles: c.clutter_particles,
+            reported: HashSet::new(),
         })
     }
 
@@ -418,11 +421,20 @@ impl DriveTracker {
                 c.box_world.as_ref().map(|b| (b.to_box3(), c.existence))
             })
             .collect();
-        for (&i, contained) in users.iter().zip(contained_in_others(&boxes)) {
+        let incumbent: Vec<bool> = users
+            .iter()
+            .map(|&i| self.reported.contains(&out_clusters[i].label))
+            .collect();
+        for (&i, contained) in users.iter().zip(contained_in_others(&boxes, &incumbent)) {
             if contained {
                 out_clusters[i].road_user = false;
             }
         }
+        self.reported = out_clusters
+            .iter()
+            .filter(|c| c.road_user)
+            .map(|c| c.label)
+            .collect();
         if !self.all_clusters {
             out_clusters.retain(|c| c.road_user);
         }
