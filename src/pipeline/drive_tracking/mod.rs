@@ -132,7 +132,9 @@ impl Default for PlaneTuning {
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ClusterTuning {
-    /// Acceleration noise of the constant-velocity model (m/s²). Default 4.
+    /// Acceleration noise of the constant-velocity model (m/s²). Default 8: a white-noise
+    /// acceleration has to cover a turn or a braking that lasts, not only its typical size
+    /// (a car turning at 15 m/s on a 20 m radius accelerates at 11 m/s² for a second or two).
     pub sigma_accel: f64,
     /// Centroid measurement noise per axis (m). Default 0.3.
     pub sigma: f64,
@@ -169,7 +171,7 @@ pub struct ClusterTuning {
 impl Default for ClusterTuning {
     fn default() -> Self {
         ClusterTuning {
-            sigma_accel: 4.0,
+            sigma_accel: 8.0,
             sigma: 0.3,
             gate: 4.0,
             outlier_weight: 0.1,
