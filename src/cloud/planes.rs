@@ -252,7 +252,11 @@ pub fn extract_planes(
 
     for (k, (plane, inliers)) in extracted.iter().enumerate() {
         if Some(k) == ground_idx {
-            let patch = patch_of(plane, inliers)?;
+            let patch = if config.ground_outline {
+                patch_of(plane, inliers)?
+            } else {
+                PlanePatch::from_points(*plane, &[point64(pts[inliers[0] as usize])])?
+            };
             for &i in inliers {
                 assigned[i as usize] = true;
             }
@@ -469,6 +473,27 @@ mod tests {
 
     fn angle(n: &Vector3<f64>, axis: Vector3<f64>) -> f64 {
         n.dot(&axis).abs().min(1.0).acos()
+    }
+
+    #[test]
+    fn without_its_outline_the_ground_keeps_its_plane_inliers_and_walls() {
+        let (cloud, _) = street(11);
+        let full = extract_planes(&cloud, &PlaneConfig::default(), &mut seeded(5)).unwrap();
+        let cfg = PlaneConfig {
+            ground_outline: false,
+            ..PlaneConfig::default()
+        };
+        let bare = extract_planes(&cloud, &cfg, &mut seeded(5)).unwrap();
+        let (g, b) = (full.ground.unwrap(), bare.ground.unwrap());
+        assert_eq!(g.patch.plane, b.patch.plane);
+        assert_eq!((&g.inliers, g.rms), (&b.inliers, b.rms));
+        // The ground is sampled over 60 m × 60 m; without the outline its patch is a point.
+        assert!(g.patch.area > 3000.0, "{}", g.patch.area);
+        assert_eq!(b.patch.area, 0.0);
+        assert_eq!(
+            (&full.walls, &full.remaining),
+            (&bare.walls, &bare.remaining)
+        );
     }
 
     #[test]

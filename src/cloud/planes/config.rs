@@ -60,6 +60,11 @@ pub struct PlaneConfig {
     /// cars or hedges hide its foot, which changes from scan to scan; a facade stands on the
     /// ground, so its rectangle's bottom edge is put there.
     pub walls_to_ground: bool,
+    /// Ground: find its bounding rectangle (`PlaneDetection::patch`), the hull of its tens of
+    /// thousands of inliers, about a millisecond a frame on a real scan. Without it the
+    /// ground's patch is the zero-size one at its first inlier; its plane, inliers and RMS
+    /// are the same either way.
+    pub ground_outline: bool,
 }
 
 /// A facade test for wall pieces that already pass the size limits, so that parked cars,
@@ -124,6 +129,7 @@ impl Default for PlaneConfig {
             min_cell_points: 3,
             wall_quality: Some(WallQuality::BUILDING),
             walls_to_ground: true,
+            ground_outline: true,
         }
     }
 }

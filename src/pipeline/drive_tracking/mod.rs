@@ -358,7 +358,11 @@ impl Default for TrackingConfig {
             dt: 0.1,
             all_clusters: false,
             report_min_existence: REPORT_MIN_EXISTENCE,
-            planes: PlaneConfig::default(),
+            // The tracker uses the ground's plane and inliers, never its rectangle.
+            planes: PlaneConfig {
+                ground_outline: false,
+                ..PlaneConfig::default()
+            },
         }
     }
 }
