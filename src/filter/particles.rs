@@ -20,6 +20,10 @@ use crate::rng::FilterRng;
 use rand::RngExt;
 use rand_distr::{Distribution, StandardNormal};
 
+/// Components summed in one pass by the weighted means and spreads (the drive tracker's
+/// states have seven).
+const FUSED: usize = 8;
+
 /// A weighted particle set of fixed state dimension.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ParticleSet {
@@ -240,16 +244,17 @@ impl ParticleSet {
     /// Weighted mean of every component into `out`.
     pub fn mean_into(&self, out: &mut [f64]) {
         let dims = self.dim.min(out.len());
-        for (c, o) in (0..dims).step_by(4).zip(out.chunks_mut(4)) {
-            let k = (dims - c).min(4);
-            self.fused_sums(c, k, &mut o[..k], |x, w, _| x * w, &[0.0; 4]);
+        for (c, o) in (0..dims).step_by(FUSED).zip(out.chunks_mut(FUSED)) {
+            let k = (dims - c).min(FUSED);
+            self.fused_sums(c, k, &mut o[..k], |x, w, _| x * w, &[0.0; FUSED]);
         }
     }
 
-    /// Σᵢ term(xᵢ, wᵢ, shift[j]) of the `k` ≤ 4 components `first..first + k` into `out`:
-    /// one pass over the particles with one running sum per component, each added in particle
-    /// order from −0.0 as `Iterator::sum` does, so the numbers equal separate sums while the
-    /// additions of different components overlap.
+    /// Σᵢ term(xᵢ, wᵢ, shift[j]) of the `k` ≤ [`FUSED`] components `first..first + k` into
+    /// `out`: one pass over the particles with one running sum per component, each added in
+    /// particle order from −0.0 as `Iterator::sum` does, so the numbers equal separate sums
+    /// while the additions of different components overlap (each sum is a chain of dependent
+    /// additions; eight chains keep the adder busy where one would wait on each result).
     #[inline(always)]
     fn fused_sums(
         &self,
@@ -257,17 +262,18 @@ impl ParticleSet {
         k: usize,
         out: &mut [f64],
         term: impl Fn(f64, f64, f64) -> f64,
-        shift: &[f64; 4],
+        shift: &[f64; FUSED],
     ) {
-        let w = &self.weights;
-        let c = |j: usize| self.component(first + j.min(k - 1));
-        let (a, b, d, e) = (c(0), c(1), c(2), c(3));
-        let mut s = [-0.0f64; 4];
-        for ((((&w, &x0), &x1), &x2), &x3) in w.iter().zip(a).zip(b).zip(d).zip(e) {
-            s[0] += term(x0, w, shift[0]);
-            s[1] += term(x1, w, shift[1]);
-            s[2] += term(x2, w, shift[2]);
-            s[3] += term(x3, w, shift[3]);
+        let n = self.len;
+        let w = &self.weights[..n];
+        let cols: [&[f64]; FUSED] =
+            std::array::from_fn(|j| &self.component(first + j.min(k - 1))[..n]);
+        let mut s = [-0.0f64; FUSED];
+        for i in 0..n {
+            let wi = w[i];
+            for j in 0..FUSED {
+                s[j] += term(cols[j][i], wi, shift[j]);
+            }
         }
         out[..k].copy_from_slice(&s[..k]);
     }
@@ -288,9 +294,9 @@ impl ParticleSet {
     pub fn mean_and_std_dev(&self) -> (Vec<f64>, Vec<f64>) {
         let mean = self.mean();
         let mut std = vec![0.0; self.dim];
-        for (c, o) in (0..self.dim).step_by(4).zip(std.chunks_mut(4)) {
-            let k = (self.dim - c).min(4);
-            let mut shift = [0.0; 4];
+        for (c, o) in (0..self.dim).step_by(FUSED).zip(std.chunks_mut(FUSED)) {
+            let k = (self.dim - c).min(FUSED);
+            let mut shift = [0.0; FUSED];
             shift[..k].copy_from_slice(&mean[c..c + k]);
             self.fused_sums(c, k, o, |x, w, m| w * (x - m) * (x - m), &shift);
         }
@@ -518,7 +524,7 @@ mod tests {
         /// The fused passes give bit for bit the component-by-component sums.
         #[test]
         fn fused_mean_and_spread_equal_separate_sums(
-            dim in 1usize..8,
+            dim in 1usize..20,
             values in proptest::collection::vec(-1e3f64..1e3, 0..600),
             seed in 0u64..1000,
         ) {
