@@ -621,7 +621,7 @@ impl LmbFilter {
             context: &p.context,
         });
         let m = &self.models;
-        let u = if m.birth.uses_current_measurements() && !z.is_empty() {
+        let u = if m.birth.uses_current_measurements() {
             unexplained(&self.tracks, summaries, z, &*m.measurement, ctx)
         } else {
             Vec::new()

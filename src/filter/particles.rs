@@ -254,7 +254,9 @@ impl ParticleSet {
     /// `out`: one pass over the particles with one running sum per component, each added in
     /// particle order from −0.0 as `Iterator::sum` does, so the numbers equal separate sums
     /// while the additions of different components overlap (each sum is a chain of dependent
-    /// additions; eight chains keep the adder busy where one would wait on each result).
+    /// additions; several chains keep the adder busy where one would wait on each result).
+    /// Four lanes for up to four components, eight above: a lane that repeats a component is
+    /// work thrown away.
     #[inline(always)]
     fn fused_sums(
         &self,
@@ -264,14 +266,31 @@ impl ParticleSet {
         term: impl Fn(f64, f64, f64) -> f64,
         shift: &[f64; FUSED],
     ) {
+        if k <= 4 {
+            self.fused_lanes::<4>(first, k, out, term, shift)
+        } else {
+            self.fused_lanes::<FUSED>(first, k, out, term, shift)
+        }
+    }
+
+    /// [`ParticleSet::fused_sums`] on `L` ≥ `k` lanes, the lanes past `k` repeating the last
+    /// component.
+    #[inline(always)]
+    fn fused_lanes<const L: usize>(
+        &self,
+        first: usize,
+        k: usize,
+        out: &mut [f64],
+        term: impl Fn(f64, f64, f64) -> f64,
+        shift: &[f64; FUSED],
+    ) {
         let n = self.len;
         let w = &self.weights[..n];
-        let cols: [&[f64]; FUSED] =
-            std::array::from_fn(|j| &self.component(first + j.min(k - 1))[..n]);
-        let mut s = [-0.0f64; FUSED];
+        let cols: [&[f64]; L] = std::array::from_fn(|j| &self.component(first + j.min(k - 1))[..n]);
+        let mut s = [-0.0f64; L];
         for i in 0..n {
             let wi = w[i];
-            for j in 0..FUSED {
+            for j in 0..L {
                 s[j] += term(cols[j][i], wi, shift[j]);
             }
         }
