@@ -18,6 +18,8 @@
 //! * `frame/whole`: read, detect (planes and clusters as the drive tracker selects them by
 //!   default: every object-sized cluster of the exact Euclidean clustering within range) and
 //!   the filter update in a row;
+//! * `frame/whole_predict_beside`: the same as `track` runs it, the filter's prediction
+//!   beside the segmentation (`DriveTracker::step_scan`);
 //! * `frame/filter_update_range_image`, `frame/whole_range_image`: the same with the range
 //!   image's clustering selected;
 //! * `frame/boxes_one_search`, `frame/boxes_two_searches`: every cluster's box bare and with a
@@ -173,12 +175,13 @@ fn tracker_group(
     );
     let mut tracker = DriveTracker::new(&config, 1).expect("default config is valid");
     let pose = Isometry3::identity();
-    let mut k = 0usize;
-    let mut step = |tracker: &mut DriveTracker, det: &FrameDetections| {
+    // One frame counter for all three benches, so that time never goes backwards.
+    let k = std::cell::Cell::new(0usize);
+    let step = |tracker: &mut DriveTracker, det: &FrameDetections| {
         let f = tracker
-            .step(k, k as f64 * 0.1, pose, None, det)
+            .step(k.get(), k.get() as f64 * 0.1, pose, None, det)
             .expect("step");
-        k += 1;
+        k.set(k.get() + 1);
         f
     };
     for _ in 0..5 {
@@ -192,6 +195,17 @@ fn tracker_group(
             let cloud = read_kitti_bin(path).unwrap();
             let det = detect_objects(&cloud, &config, &mut seeded(1)).unwrap();
             step(&mut tracker, &det)
+        })
+    });
+    // What `track` does: the filter predicts while the scan is segmented.
+    g.bench_function(format!("whole_predict_beside{suffix}"), |b| {
+        b.iter(|| {
+            let cloud = read_kitti_bin(path).unwrap();
+            let f = k.get();
+            k.set(f + 1);
+            tracker
+                .step_scan(f, f as f64 * 0.1, pose, None, &cloud, &mut seeded(1))
+                .expect("step")
         })
     });
 }

@@ -363,6 +363,58 @@ fn assert_clusters_are_components(cloud: &PointCloud, clusters: &[Vec<u32>], tol
     assert!(found == expected, "clusters differ from the components");
 }
 
+/// Segmenting a scan while the filter predicts beside it (`step_scan`) gives the detections
+/// and the frames of segmenting first and stepping after.
+#[test]
+fn predicting_beside_the_segmentation_changes_nothing_but_the_times() {
+    let cloud = smc_lmb::cloud::read_kitti_bin(
+        vendored_kitti()
+            .join("2011_09_26/2011_09_26_drive_UNKNOWN_sync/velodyne_points/data/0000000000.bin"),
+    )
+    .unwrap();
+    let mut config = config();
+    config.all_clusters = false;
+    let (mut after, mut beside) = (
+        DriveTracker::new(&config, 4).unwrap(),
+        DriveTracker::new(&config, 4).unwrap(),
+    );
+    let mut reported = 0;
+    for k in 0..4 {
+        // The sensor turns and moves a little, so the prediction has work to do.
+        let pose = nalgebra::Isometry3::new(
+            nalgebra::Vector3::new(0.3 * k as f64, 0.0, 0.0),
+            nalgebra::Vector3::new(0.0, 0.0, 0.01 * k as f64),
+        );
+        let det =
+            detect_objects(&cloud, &config, &mut smc_lmb::rng::seeded(10 + k as u64)).unwrap();
+        let mut a = after.step(k, k as f64 * 0.1, pose, None, &det).unwrap();
+        let (det_b, mut b) = beside
+            .step_scan(
+                k,
+                k as f64 * 0.1,
+                pose,
+                None,
+                &cloud,
+                &mut smc_lmb::rng::seeded(10 + k as u64),
+            )
+            .unwrap();
+        assert_eq!(det.walls.len(), det_b.walls.len());
+        let indices = |d: &smc_lmb::pipeline::drive_tracking::FrameDetections| {
+            d.clusters
+                .iter()
+                .map(|c| c.indices.clone())
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(indices(&det), indices(&det_b));
+        assert!(b.times.filter_ms > 0.0 && b.times.overlap_ms >= 0.0);
+        a.times = Default::default();
+        b.times = Default::default();
+        assert_eq!(a, b, "frame {k}");
+        reported += a.clusters.len() + a.planes.len();
+    }
+    assert!(reported > 0, "nothing was reported to compare");
+}
+
 #[test]
 fn unreported_static_clutter_carries_fewer_particles() {
     let cloud = smc_lmb::cloud::read_kitti_bin(

@@ -72,3 +72,68 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 16, ..ProptestConfig::default() })]
+    /// A step split into its prediction and its update (what a caller does to predict while the
+    /// measurements are being made) is the same step: the same estimates and the same tracks
+    /// to the last bit, empty frames included.
+    #[test]
+    fn a_step_in_two_halves_is_the_same_step(
+        frames in proptest::collection::vec(proptest::collection::vec((-60.0f64..60.0, -60.0f64..60.0), 0..8), 1..8),
+        seed in 0u64..1000,
+    ) {
+        let (mut whole, mut halves) = (filter(AssociationMethod::default(), 0.9), filter(AssociationMethod::default(), 0.9));
+        let (mut rng_a, mut rng_b) = (seeded(seed), seeded(seed));
+        for (k, zs) in frames.iter().enumerate() {
+            let rows: Vec<[f64; 2]> = zs.iter().map(|&(x, y)| [x, y]).collect();
+            let z = Measurements::from_rows(2, &rows).unwrap();
+            let t = k as f64 * 0.5;
+            let a = whole.step(&Frame::new(t, z.clone()), &mut rng_a).unwrap();
+            halves.predict_step(t, None, &mut rng_b).unwrap();
+            let b = halves.update_step(&z).unwrap();
+            prop_assert_eq!(a.len(), b.len());
+            for (ea, eb) in a.iter().zip(&b) {
+                prop_assert_eq!(ea.label, eb.label);
+                prop_assert_eq!(&ea.state, &eb.state);
+            }
+            prop_assert_eq!(whole.tracks().len(), halves.tracks().len());
+            for (ta, tb) in whole.tracks().iter().zip(halves.tracks()) {
+                prop_assert_eq!(ta.label, tb.label);
+                prop_assert_eq!(ta.existence, tb.existence);
+                prop_assert_eq!(ta.particles.weights(), tb.particles.weights());
+                for c in 0..ta.particles.dim() {
+                    prop_assert_eq!(ta.particles.component(c), tb.particles.component(c));
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn halves_out_of_order_are_errors_that_change_nothing() {
+    let mut f = filter(AssociationMethod::default(), 0.9);
+    let mut rng = seeded(3);
+    let z = Measurements::from_rows(2, &[[1.0, 2.0]]).unwrap();
+    let err = f.update_step(&z).unwrap_err().to_string();
+    assert!(err.contains("not predicted"), "{err}");
+    f.predict_step(0.0, None, &mut rng).unwrap();
+    let err = f.predict_step(0.5, None, &mut rng).unwrap_err().to_string();
+    assert!(err.contains("predicted already"), "{err}");
+    let err = f
+        .step(&Frame::new(0.5, z.clone()), &mut rng)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("predicted already"), "{err}");
+    // Measurements of the wrong dimension leave the prediction pending.
+    let wrong = Measurements::from_rows(3, &[[1.0, 2.0, 3.0]]).unwrap();
+    let err = f.update_step(&wrong).unwrap_err().to_string();
+    assert!(err.contains("dimension 3"), "{err}");
+    f.update_step(&z).unwrap();
+    assert_eq!(f.steps(), 1);
+    // A reset forgets a pending prediction.
+    f.predict_step(0.5, None, &mut rng).unwrap();
+    f.reset();
+    f.predict_step(0.0, None, &mut rng).unwrap();
+    f.update_step(&z).unwrap();
+}

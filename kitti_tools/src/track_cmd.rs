@@ -265,11 +265,19 @@ pub fn print_summary(tracks: &DriveTracks) {
         s.mean_planes, s.mean_clusters, s.plane_labels, s.cluster_labels
     );
     println!(
-        "ms/frame: read {:.1}, planes {:.1}, clusters {:.1}, filter {:.1}, total {:.1}{}",
+        "ms/frame: read {:.1}, planes {:.1}, clusters {:.1}, filter {:.1}{}, total {:.1}{}",
         t.read_ms,
         t.planes_ms,
         t.clusters_ms,
         t.filter_ms,
+        if t.overlap_ms > 0.0 {
+            format!(
+                " (its prediction beside the segmentation: −{:.1})",
+                t.overlap_ms
+            )
+        } else {
+            String::new()
+        },
         t.total_ms(),
         if t.ego_ms > 0.0 {
             format!(" (+ lidar odometry {:.1})", t.ego_ms)

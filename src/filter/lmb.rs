@@ -284,6 +284,7 @@ impl LmbFilterBuilder {
             keep_predicted: false,
             predicted: Vec::new(),
             particle_caps: HashMap::new(),
+            pending: None,
         })
     }
 }
@@ -386,6 +387,18 @@ pub struct LmbFilter {
     /// Per-track upper bounds on the particle count, set by the caller
     /// ([`LmbFilter::set_particle_caps`]).
     particle_caps: HashMap<Label, usize>,
+    /// A step predicted by [`LmbFilter::predict_step`] and not yet updated.
+    pending: Option<Pending>,
+}
+
+/// The first half of a step, between [`LmbFilter::predict_step`] and
+/// [`LmbFilter::update_step`].
+struct Pending {
+    context: StepContext,
+    seed: u64,
+    /// The gates' summaries of the predicted tracks, for the births' and the update's gating
+    /// (empty when the step's measurements are known to be none).
+    summaries: Vec<TrackSummary>,
 }
 
 impl std::fmt::Debug for LmbFilter {
@@ -427,6 +440,7 @@ impl LmbFilter {
         self.unmoved_detection.clear();
         self.most_probable.clear();
         self.predicted.clear();
+        self.pending = None;
     }
 
     /// Each track's most probable measurement of the last step, with its marginal
@@ -479,22 +493,50 @@ impl LmbFilter {
     /// Runs one frame and returns the MAP multi-object estimate.
     ///
     /// One call per stage of the recursion; the step seed is the only draw from `rng`, and each
-    /// random stage derives its own streams from it.
+    /// random stage derives its own streams from it. The same as [`LmbFilter::predict_step`]
+    /// followed by [`LmbFilter::update_step`], with the frame checked whole before either.
     pub fn step(&mut self, frame: &Frame, rng: &mut FilterRng) -> Result<Vec<Estimate>> {
-        let ctx = self.context(frame)?;
-        let z = &frame.measurements;
-        let seed = rng.next_u64();
+        self.check_measurements(&frame.measurements)?;
+        self.predict_phase(
+            frame.time,
+            frame.platform,
+            rng,
+            !frame.measurements.is_empty(),
+        )?;
+        self.update_step(&frame.measurements)
+    }
 
-        self.predict(&ctx, seed)?;
-        // The gates' summaries of the predicted tracks, for the births' and the update's gating.
-        let summaries: Vec<TrackSummary> = if z.is_empty() {
-            Vec::new()
-        } else {
-            self.tracks
-                .par_iter()
-                .map(|t| TrackSummary::of(&t.particles))
-                .collect()
+    /// The first half of a step: the survival and transition of every track to `time`, the
+    /// platform at `platform`. Needs no measurements, so a caller can run it while the frame's
+    /// measurements are still being made (the drive tracker predicts while it segments the
+    /// scan). Draws the step seed from `rng`, as [`LmbFilter::step`] does; an error when the
+    /// step before is predicted and not yet updated.
+    pub fn predict_step(
+        &mut self,
+        time: f64,
+        platform: Option<Isometry3<f64>>,
+        rng: &mut FilterRng,
+    ) -> Result<()> {
+        self.predict_phase(time, platform, rng, true)
+    }
+
+    /// The second half of a step predicted by [`LmbFilter::predict_step`]: births, update with
+    /// `measurements`, resampling and pruning; returns the MAP multi-object estimate. An error
+    /// when no step is predicted or the measurements have the wrong dimension (the prediction
+    /// then stays pending).
+    pub fn update_step(&mut self, measurements: &Measurements) -> Result<Vec<Estimate>> {
+        let Some(pending) = self.pending.as_ref() else {
+            return Err(Error::invalid(
+                format!("update of step {}", self.step),
+                "the step was not predicted (call predict_step first)",
+            ));
         };
+        let z = measurements;
+        self.check_measurements(z)?;
+        let (ctx, seed) = (pending.context, pending.seed);
+        let summaries = self.pending.take().map(|p| p.summaries).unwrap_or_default();
+        // Gating needs the summaries only when there is something to gate.
+        let summaries = if z.is_empty() { Vec::new() } else { summaries };
         self.add_births(&ctx, z, seed, &summaries);
         let predicted = self.predicted_copies();
         let likelihoods = self.likelihoods(z, &ctx, &summaries)?;
@@ -510,34 +552,42 @@ impl LmbFilter {
         Ok(estimates)
     }
 
-    /// The step context: time step from the previous frame, platform poses. Rejects a frame
-    /// whose time or pose is not finite, whose time goes backwards, or whose measurements do
-    /// not have the measurement model's dimension.
-    fn context(&self, frame: &Frame) -> Result<StepContext> {
-        let what = || format!("frame of step {}", self.step);
-        if !frame.time.is_finite() {
+    /// Prediction and, when `summaries`, the predicted tracks' gate summaries; the step is
+    /// then pending.
+    fn predict_phase(
+        &mut self,
+        time: f64,
+        platform: Option<Isometry3<f64>>,
+        rng: &mut FilterRng,
+        summaries: bool,
+    ) -> Result<()> {
+        if self.pending.is_some() {
             return Err(Error::invalid(
-                what(),
-                format!("time stamp {} is not finite", frame.time),
+                format!("prediction of step {}", self.step),
+                "the step is predicted already and not yet updated (call update_step)",
             ));
         }
-        if let Some(p) = &frame.platform {
-            let v = p.to_homogeneous();
-            if v.iter().any(|x| !x.is_finite()) {
-                return Err(Error::invalid(what(), "platform pose is not finite"));
-            }
-        }
-        let (dt, previous_platform) = match &self.previous {
-            None => (0.0, None),
-            Some(p) => (frame.time - p.context.time, p.context.platform),
+        let ctx = self.context(time, platform)?;
+        let seed = rng.next_u64();
+        self.predict(&ctx, seed)?;
+        let summaries: Vec<TrackSummary> = if summaries {
+            self.tracks
+                .par_iter()
+                .map(|t| TrackSummary::of(&t.particles))
+                .collect()
+        } else {
+            Vec::new()
         };
-        if dt < 0.0 {
-            return Err(Error::invalid(
-                what(),
-                format!("time goes backwards by {} s", -dt),
-            ));
-        }
-        let z = &frame.measurements;
+        self.pending = Some(Pending {
+            context: ctx,
+            seed,
+            summaries,
+        });
+        Ok(())
+    }
+
+    /// Rejects measurements that do not have the measurement model's dimension.
+    fn check_measurements(&self, z: &Measurements) -> Result<()> {
         if !z.is_empty() && z.dim() != self.models.measurement.measurement_dim() {
             return Err(Error::invalid(
                 format!("measurements of step {}", self.step),
@@ -548,11 +598,40 @@ impl LmbFilter {
                 ),
             ));
         }
+        Ok(())
+    }
+
+    /// The step context: time step from the previous frame, platform poses. Rejects a time or
+    /// pose that is not finite, or a time that goes backwards.
+    fn context(&self, time: f64, platform: Option<Isometry3<f64>>) -> Result<StepContext> {
+        let what = || format!("frame of step {}", self.step);
+        if !time.is_finite() {
+            return Err(Error::invalid(
+                what(),
+                format!("time stamp {time} is not finite"),
+            ));
+        }
+        if let Some(p) = &platform {
+            let v = p.to_homogeneous();
+            if v.iter().any(|x| !x.is_finite()) {
+                return Err(Error::invalid(what(), "platform pose is not finite"));
+            }
+        }
+        let (dt, previous_platform) = match &self.previous {
+            None => (0.0, None),
+            Some(p) => (time - p.context.time, p.context.platform),
+        };
+        if dt < 0.0 {
+            return Err(Error::invalid(
+                what(),
+                format!("time goes backwards by {} s", -dt),
+            ));
+        }
         Ok(StepContext {
             step: self.step,
-            time: frame.time,
+            time,
             dt,
-            platform: frame.platform,
+            platform,
             previous_platform,
         })
     }

@@ -126,7 +126,7 @@ pub fn detect_objects(
     rayon::scope(|_| detect_here(cloud, config, rng))
 }
 
-fn detect_here(
+pub(super) fn detect_here(
     cloud: &PointCloud,
     config: &TrackingConfig,
     rng: &mut FilterRng,

@@ -729,7 +729,6 @@ fn track_recording(
         let start = Instant::now();
         let cloud = (rec.read)(k)?;
         let read_ms = start.elapsed().as_secs_f64() * 1e3;
-        let detections = detect_objects(&cloud, config, &mut stream(seed, KEY_SEGMENT ^ k as u64))?;
         let previous_state = vehicle
             .as_ref()
             .map(|v| v[if k > range.start { k - 1 } else { k }]);
@@ -750,7 +749,15 @@ fn track_recording(
             }
             (None, None) => unreachable!("odometry is set up when there are no poses"),
         };
-        let mut tracked = tracker.step(k, times[k], pose, previous_state, &detections)?;
+        // The filter predicts while the scan is segmented.
+        let (detections, mut tracked) = tracker.step_scan(
+            k,
+            times[k],
+            pose,
+            previous_state,
+            &cloud,
+            &mut stream(seed, KEY_SEGMENT ^ k as u64),
+        )?;
         tracked.times.read_ms = read_ms;
         tracked.times.ego_ms = ego_ms;
         on_frame(&FrameView {

@@ -111,12 +111,18 @@ pub struct StageTimes {
     /// Lidar odometry, when the ego motion comes from the scans (0 otherwise).
     #[serde(default)]
     pub ego_ms: f64,
+    /// The time the filter's prediction ran beside the segmentation: planes, clusters and
+    /// prediction less the wall time of the three side by side
+    /// ([`super::DriveTracker::step_scan`]; 0 when they ran one after the other).
+    #[serde(default)]
+    pub overlap_ms: f64,
 }
 
 impl StageTimes {
-    /// Read, planes, clusters and filter: the frame's work without lidar odometry.
+    /// Read, planes, clusters and filter less what of them ran side by side: the frame's
+    /// wall time without lidar odometry.
     pub fn total_ms(&self) -> f64 {
-        self.read_ms + self.planes_ms + self.clusters_ms + self.filter_ms
+        self.read_ms + self.planes_ms + self.clusters_ms + self.filter_ms - self.overlap_ms
     }
 }
 
@@ -183,6 +189,7 @@ impl TrackingSummary {
             t.planes_ms += f.times.planes_ms / nf;
             t.clusters_ms += f.times.clusters_ms / nf;
             t.filter_ms += f.times.filter_ms / nf;
+            t.overlap_ms += f.times.overlap_ms / nf;
         }
         TrackingSummary {
             frames: n,

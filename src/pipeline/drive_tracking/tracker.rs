@@ -11,12 +11,13 @@
 //!
 //! Not for: reading drives or segmenting clouds (see [`super::detect`], [`super::track_drive`]).
 
-use super::detect::FrameDetections;
+use super::detect::{detect_here, FrameDetections};
 use super::output::{OrientedBox, StageTimes, TrackedCluster, TrackedFrame, TrackedPlane};
 use super::road_users::{contained_in_others, speed_evidence, travel_direction, RoadUserState};
 use super::{EgoModel, TrackingConfig};
 use crate::cloud::classes::speed_log_likelihoods;
 use crate::cloud::classes::ClassModel;
+use crate::cloud::PointCloud;
 use crate::error::Result;
 use crate::filter::{AdaptiveBirth, Estimate, Frame, Label, LmbFilter, Track};
 use crate::geometry::wrap_angle;
@@ -69,6 +70,8 @@ pub struct DriveTracker {
     clutter_particles: Option<usize>,
     /// The road users reported in the last frame.
     reported: HashSet<Label>,
+    /// The configuration, for the segmentation of [`DriveTracker::step_scan`].
+    config: TrackingConfig,
 }
 
 impl std::fmt::Debug for DriveTracker {
@@ -156,6 +159,7 @@ impl DriveTracker {
             report_min_existence: config.report_min_existence,
             clutter_particles: c.clutter_particles,
             reported: HashSet::new(),
+            config: config.clone(),
         })
     }
 
@@ -181,6 +185,49 @@ impl DriveTracker {
         rayon::scope(|_| self.step_here(frame, time, pose, vehicle_state, detections))
     }
 
+    /// Runs one frame from its scan: segments `cloud` (sensor frame) with the tracker's
+    /// configuration and `segment_rng` while the filter predicts its tracks to `time` beside
+    /// it, then updates them with the detections. The same detections, tracks and report as
+    /// [`detect_objects`](super::detect_objects) with that generator followed by
+    /// [`DriveTracker::step`]; only the times differ (`times.overlap_ms`). After an error the
+    /// tracker is not to be stepped again.
+    pub fn step_scan(
+        &mut self,
+        frame: usize,
+        time: f64,
+        pose: Isometry3<f64>,
+        vehicle_state: Option<[f64; 6]>,
+        cloud: &PointCloud,
+        segment_rng: &mut FilterRng,
+    ) -> Result<(FrameDetections, TrackedFrame)> {
+        rayon::scope(|_| {
+            let start = Instant::now();
+            if let (Some(h), Some(s)) = (&self.vehicle, vehicle_state) {
+                h.set(s);
+            }
+            let (config, filter, rng) = (&self.config, &mut self.filter, &mut self.rng);
+            let (detections, predicted) = rayon::join(
+                || detect_here(cloud, config, segment_rng),
+                || {
+                    let start = Instant::now();
+                    filter
+                        .predict_step(time, Some(pose), rng)
+                        .map(|()| start.elapsed().as_secs_f64() * 1e3)
+                },
+            );
+            let (detections, predict_ms) = (detections?, predicted?);
+            let side_by_side_ms = start.elapsed().as_secs_f64() * 1e3;
+            let start = Instant::now();
+            let measurements = detections.measurements()?;
+            let estimates = self.filter.update_step(&measurements)?;
+            let mut tracked = self.finish(frame, time, pose, &detections, &estimates, start)?;
+            let t = &mut tracked.times;
+            t.filter_ms += predict_ms;
+            t.overlap_ms = (t.planes_ms + t.clusters_ms + predict_ms - side_by_side_ms).max(0.0);
+            Ok((detections, tracked))
+        })
+    }
+
     fn step_here(
         &mut self,
         frame: usize,
@@ -202,7 +249,21 @@ impl DriveTracker {
             },
             &mut self.rng,
         )?;
-        let (planes, clusters) = self.report(&estimates, &pose, detections)?;
+        self.finish(frame, time, pose, detections, &estimates, start)
+    }
+
+    /// The frame's report from the filter's estimates; `start` is when the filter's work
+    /// began.
+    fn finish(
+        &mut self,
+        frame: usize,
+        time: f64,
+        pose: Isometry3<f64>,
+        detections: &FrameDetections,
+        estimates: &[Estimate],
+        start: Instant,
+    ) -> Result<TrackedFrame> {
+        let (planes, clusters) = self.report(estimates, &pose, detections)?;
         let filter_ms = start.elapsed().as_secs_f64() * 1e3;
         let (_, _, yaw) = pose.rotation.euler_angles();
         let t = pose.translation.vector;
@@ -221,6 +282,7 @@ impl DriveTracker {
                 planes_ms: detections.planes_ms,
                 clusters_ms: detections.clusters_ms,
                 filter_ms,
+                overlap_ms: 0.0,
             },
         })
     }
