@@ -338,15 +338,11 @@ fn heading_mod_pi(a: f64) -> f64 {
 /// Appends to `xy` (interleaved x–y, the first `n2` values) the first point of each
 /// `cell`-sized square they occupy, in the order the points come, re-centred on their mean.
 fn one_point_per_cell(xy: &mut Vec<f64>, n2: usize, cell: f64) {
-    let mut keys: Vec<(i64, i64, usize)> = xy[..n2]
+    let keys: Vec<(i64, i64)> = xy[..n2]
         .chunks_exact(2)
-        .enumerate()
-        .map(|(i, p)| (floor_i64(p[0] / cell), floor_i64(p[1] / cell), i))
+        .map(|p| (floor_i64(p[0] / cell), floor_i64(p[1] / cell)))
         .collect();
-    keys.sort_unstable();
-    keys.dedup_by(|a, b| a.0 == b.0 && a.1 == b.1);
-    let mut first: Vec<usize> = keys.into_iter().map(|k| k.2).collect();
-    first.sort_unstable();
+    let first = first_in_each_cell(&keys);
     let m = first.len() as f64;
     let (mx, my) = first
         .iter()
@@ -358,6 +354,43 @@ fn one_point_per_cell(xy: &mut Vec<f64>, n2: usize, cell: f64) {
         xy.push(x);
         xy.push(y);
     }
+}
+
+/// The positions in `keys` (cells) where a cell occurs for the first time, ascending: on a
+/// dense grid of the cells' bounding box when that is small (a car at 0.1 m: ~1,000 cells),
+/// else by sorting.
+fn first_in_each_cell(keys: &[(i64, i64)]) -> Vec<usize> {
+    let Some(&(x0, y0)) = keys.first() else {
+        return Vec::new();
+    };
+    let (mut lo, mut hi) = ((x0, y0), (x0, y0));
+    for &(x, y) in keys {
+        lo = (lo.0.min(x), lo.1.min(y));
+        hi = (hi.0.max(x), hi.1.max(y));
+    }
+    let (w, h) = ((hi.0 - lo.0) as u64 + 1, (hi.1 - lo.1) as u64 + 1);
+    let cells = w.saturating_mul(h);
+    if cells <= (8 * keys.len() as u64).max(1 << 12) {
+        let mut seen = vec![false; cells as usize];
+        return keys
+            .iter()
+            .enumerate()
+            .filter_map(|(i, &(x, y))| {
+                let c = ((y - lo.1) as u64 * w + (x - lo.0) as u64) as usize;
+                (!std::mem::replace(&mut seen[c], true)).then_some(i)
+            })
+            .collect();
+    }
+    let mut sorted: Vec<(i64, i64, usize)> = keys
+        .iter()
+        .enumerate()
+        .map(|(i, &(x, y))| (x, y, i))
+        .collect();
+    sorted.sort_unstable();
+    sorted.dedup_by(|a, b| a.0 == b.0 && a.1 == b.1);
+    let mut first: Vec<usize> = sorted.into_iter().map(|k| k.2).collect();
+    first.sort_unstable();
+    first
 }
 
 /// The heading in [0, π/2) maximising the closeness criterion over the interleaved x–y
@@ -778,6 +811,21 @@ mod tests {
             .zip(&d2)
             .map(|(a, b)| 1.0 / a.min(*b).max(d0))
             .sum()
+    }
+
+    proptest! {
+        /// The first point of every occupied cell, on the dense grid or by sorting (a spread
+        /// of keys too wide for the grid), is what a plain scan with a set of seen cells keeps.
+        #[test]
+        fn first_in_each_cell_keeps_each_cells_first_point(
+            keys in proptest::collection::vec((-40i64..40, -40i64..40), 0..300),
+            spread in prop_oneof![Just(1i64), Just(1_000_000_000)],
+        ) {
+            let keys: Vec<(i64, i64)> = keys.iter().map(|&(x, y)| (x * spread, y)).collect();
+            let mut seen = std::collections::HashSet::new();
+            let expected: Vec<usize> = (0..keys.len()).filter(|&i| seen.insert(keys[i])).collect();
+            prop_assert_eq!(first_in_each_cell(&keys), expected);
+        }
     }
 
     proptest! {
