@@ -173,7 +173,8 @@ fn cluster_indices(cloud: &PointCloud, subset: &[u32], params: &ClusterParams) -
         .collect()
 }
 
-/// Cells per axis above which the grid is not used (coordinates are packed 21 bits each).
+/// Cells per axis above which the grid is not used (so that the mixed-radix keys stay below
+/// 2⁶³).
 const GRID_AXIS_LIMIT: f64 = ((1u64 << 21) - 8) as f64;
 
 /// Components by a voxel grid: a component label (a local position) for every point, or
@@ -185,7 +186,7 @@ const GRID_AXIS_LIMIT: f64 = ((1u64 << 21) - 8) as f64;
 /// surrounding cells can hold a neighbour; each pair of occupied cells is examined once (the
 /// 62 "forward" offsets) and joined in a union-find as soon as one point pair is within the
 /// tolerance, with the same `dx² + dy² + dz² ≤ tol²` test (f32) as the definition. Cells are
-/// sorted by packed key (z, y, x major to minor); for each forward row offset a cursor walks
+/// sorted by key (z, y, x major to minor); for each forward row offset a cursor walks
 /// the sorted cells in step with the current cell, so neighbours are found without hashing.
 fn grid_components(points: &[[f32; 3]], tolerance: f32) -> Option<Vec<u32>> {
     if tolerance <= 0.0 {
@@ -206,23 +207,25 @@ fn grid_components(points: &[[f32; 3]], tolerance: f32) -> Option<Vec<u32>> {
     if (0..3).any(|a| (hi[a] - lo[a]) * inv >= GRID_AXIS_LIMIT) {
         return None;
     }
-    // Cell coordinates start at 2 so that offsets down to −2 stay non-negative.
+    // Cell coordinates start at 2 so that offsets down to −2 stay non-negative, and each
+    // axis has room up to 2 past its last cell; keys are mixed-radix (z, y, x major to
+    // minor), so their order is that of the cells' coordinates and a neighbour's key is the
+    // cell's plus a fixed offset.
+    let span = |a: usize| ((hi[a] - lo[a]) * inv) as u64 + 5;
+    let (nx, ny) = (span(0), span(1));
     let key_of = |p: &[f32; 3]| -> u64 {
         let c = |a: usize| (((p[a] as f64 - lo[a]) * inv) as u64) + 2;
-        (c(2) << 42) | (c(1) << 21) | c(0)
+        (c(2) * ny + c(1)) * nx + c(0)
     };
-    // (cell key, local position) packed into one u128, so the sort compares plain integers.
-    let mut packed: Vec<u128> = points
+    // (cell key, local position), sorted by key with positions ascending inside a cell: a
+    // stable radix sort of the keys taken in position order (only the keys' occupied bytes
+    // are passed over).
+    let mut order: Vec<(u64, u32)> = points
         .iter()
         .enumerate()
-        .map(|(i, p)| ((key_of(p) as u128) << 32) | i as u128)
+        .map(|(i, p)| (key_of(p), i as u32))
         .collect();
-    packed.sort_unstable();
-    let order: Vec<(u64, u32)> = packed
-        .iter()
-        .map(|&k| ((k >> 32) as u64, k as u32))
-        .collect();
-    drop(packed);
+    radsort::sort_by_key(&mut order, |&(key, _)| key);
     // Occupied cells: key and range into `sorted`.
     let sorted: Vec<[f32; 3]> = order.iter().map(|&(_, i)| points[i as usize]).collect();
     let mut cell_keys: Vec<u64> = Vec::new();
@@ -255,10 +258,11 @@ fn grid_components(points: &[[f32; 3]], tolerance: f32) -> Option<Vec<u32>> {
         i
     }
     // Forward rows: (dy, dz) with dz > 0, or dz = 0 and dy > 0; dx from −2 to 2.
+    let (nx, ny) = (nx as i64, ny as i64);
     let rows: Vec<u64> = (0..=2i64)
         .flat_map(|dz| (-2..=2i64).map(move |dy| (dz, dy)))
         .filter(|&(dz, dy)| dz > 0 || dy > 0)
-        .map(|(dz, dy)| ((dz << 42) + (dy << 21)) as u64)
+        .map(|(dz, dy)| ((dz * ny + dy) * nx) as u64)
         .collect();
     let mut cursors = vec![0usize; rows.len()];
     for c in 0..n_cells {
@@ -276,8 +280,8 @@ fn grid_components(points: &[[f32; 3]], tolerance: f32) -> Option<Vec<u32>> {
             d += 1;
         }
         for (row, cur) in rows.iter().zip(cursors.iter_mut()) {
-            // Cell (x − 2, y + dy, z + dz); no field under- or overflows (coordinates start
-            // at 2 and stay below 2²¹ − 4).
+            // Cell (x − 2, y + dy, z + dz); no coordinate under- or overflows its axis
+            // (coordinates start at 2 and stay 2 below the axis' span).
             let start = key + row - 2;
             let end = start + 4;
             while *cur < n_cells && cell_keys[*cur] < start {
