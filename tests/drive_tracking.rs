@@ -10,8 +10,8 @@ use smc_lmb::cloud::{read_las, read_ply, write_las_labelled, write_ply_labelled,
 use smc_lmb::filter::Label;
 use smc_lmb::kitti::RawDrive;
 use smc_lmb::pipeline::drive_tracking::{
-    detect_objects, drive_plot, point_labels, track_drive, ClusterMethod, DriveTracker,
-    DriveTracks, TrackingConfig,
+    detect_objects, drive_plot, point_labels, segment_rng, track_drive, ClusterMethod,
+    DriveTracker, DriveTracks, TrackingConfig,
 };
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -261,6 +261,34 @@ fn same_seed_same_tracks() {
             .collect::<Vec<_>>()
     };
     assert_eq!(strip(&a), strip(&b));
+}
+
+/// The tracking loop segments each scan beside the filter's update of the frame before; the
+/// tracks are those of a plain loop that segments a frame and then steps the tracker.
+#[test]
+fn overlapped_frames_track_as_a_plain_loop_does() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = synthetic_drive(tmp.path());
+    let drive = RawDrive::open(&dir).unwrap();
+    let mut c = config();
+    c.filter.particles = 300;
+    let seed = 9;
+    let run = track_drive(&drive, None, &c, seed, |_| Ok(())).unwrap();
+    let poses = drive.poses().unwrap();
+    let times = drive.timestamps().unwrap().seconds;
+    let mut tracker = DriveTracker::new(&c, seed).unwrap();
+    assert_eq!(run.frames.len(), FRAMES);
+    for (k, got) in run.frames.iter().enumerate() {
+        let cloud = drive.velodyne(k).unwrap();
+        let det = detect_objects(&cloud, &c, &mut segment_rng(seed, k)).unwrap();
+        let mut want = tracker.step(k, times[k], poses[k], None, &det).unwrap();
+        let mut got = got.clone();
+        assert!(got.times.filter_ms > 0.0 && got.times.total_ms() > 0.0);
+        want.times = Default::default();
+        got.times = Default::default();
+        assert_eq!(got, want, "frame {k}");
+    }
+    assert!(run.frames.iter().any(|f| !f.clusters.is_empty()));
 }
 
 #[test]

@@ -271,10 +271,7 @@ pub fn print_summary(tracks: &DriveTracks) {
         t.clusters_ms,
         t.filter_ms,
         if t.overlap_ms > 0.0 {
-            format!(
-                " (its prediction beside the segmentation: −{:.1})",
-                t.overlap_ms
-            )
+            format!(" (side by side: {:.1})", t.overlap_ms)
         } else {
             String::new()
         },

@@ -28,6 +28,7 @@ pub mod road_users;
 pub mod source;
 pub mod tracker;
 
+use detect::detect_here;
 pub use detect::{detect_objects, ClusterDetection, FrameDetections, WallDetection};
 pub use export::point_labels;
 #[cfg(feature = "plot")]
@@ -447,6 +448,13 @@ pub struct FrameView<'a> {
 /// Stream key of the plane segmentation random stream of a frame.
 const KEY_SEGMENT: u64 = 0x5E6 << 48;
 
+/// The random stream the segmentation of frame `frame` draws from in a run seeded `seed`
+/// ([`track_drive`] and its siblings): [`detect_objects`] with it gives that frame's
+/// detections again.
+pub fn segment_rng(seed: u64, frame: usize) -> crate::rng::FilterRng {
+    stream(seed, KEY_SEGMENT ^ frame as u64)
+}
+
 /// What the tracking loop needs from a recording, whatever its layout.
 struct Recording<'a> {
     /// Name in errors and in the output.
@@ -693,6 +701,42 @@ pub fn track_odometry_sequence(
     track_recording(&recording, frames, config, seed, on_frame)
 }
 
+/// A frame segmented and predicted, waiting for its update in the next round of the loop.
+struct Held {
+    frame: usize,
+    cloud: PointCloud,
+    detections: FrameDetections,
+    read_ms: f64,
+    ego_ms: f64,
+    /// The filter's prediction to this frame.
+    predict_ms: f64,
+    /// What ran side by side with this frame's segmentation (see [`StageTimes::overlap_ms`]).
+    overlap_ms: f64,
+}
+
+/// Completes a held frame's report with its times, hands it to `on_frame` and keeps it.
+fn emit(
+    h: Held,
+    mut tracked: TrackedFrame,
+    out: &mut Vec<TrackedFrame>,
+    total: usize,
+    on_frame: &mut impl FnMut(&FrameView<'_>) -> Result<()>,
+) -> Result<()> {
+    let t = &mut tracked.times;
+    t.read_ms = h.read_ms;
+    t.ego_ms = h.ego_ms;
+    t.filter_ms += h.predict_ms;
+    t.overlap_ms = h.overlap_ms;
+    on_frame(&FrameView {
+        cloud: &h.cloud,
+        detections: &h.detections,
+        tracked: &tracked,
+        progress: (out.len() + 1, total),
+    })?;
+    out.push(tracked);
+    Ok(())
+}
+
 /// Fails when `frames` is empty or reaches beyond `n` frames of `what`.
 fn check_frame_range(frames: Option<&Range<usize>>, n: usize, what: &str) -> Result<()> {
     let range = frames.cloned().unwrap_or(0..n);
@@ -725,6 +769,10 @@ fn track_recording(
     };
     let mut out = Vec::with_capacity(range.len());
     let total = range.len();
+    // Frames overlap: the scan of frame k is segmented while the filter updates frame k − 1
+    // with its detections and predicts to frame k, on the pool's other thread. Each half
+    // runs in the order of a frame-by-frame loop, so the tracks are the same.
+    let mut held: Option<Held> = None;
     for k in range.clone() {
         let start = Instant::now();
         let cloud = (rec.read)(k)?;
@@ -749,24 +797,44 @@ fn track_recording(
             }
             (None, None) => unreachable!("odometry is set up when there are no poses"),
         };
-        // The filter predicts while the scan is segmented.
-        let (detections, mut tracked) = tracker.step_scan(
-            k,
-            times[k],
-            pose,
-            previous_state,
-            &cloud,
-            &mut stream(seed, KEY_SEGMENT ^ k as u64),
-        )?;
-        tracked.times.read_ms = read_ms;
-        tracked.times.ego_ms = ego_ms;
-        on_frame(&FrameView {
-            cloud: &cloud,
-            detections: &detections,
-            tracked: &tracked,
-            progress: (out.len() + 1, total),
-        })?;
-        out.push(tracked);
+        let start = Instant::now();
+        let earlier = held.take();
+        let (detections, filter) = rayon::join(
+            || detect_here(&cloud, config, &mut segment_rng(seed, k)),
+            || -> Result<(Option<(Held, TrackedFrame)>, f64)> {
+                let earlier = match earlier {
+                    Some(h) => {
+                        let tracked = tracker.update_with(h.frame, &h.detections)?;
+                        Some((h, tracked))
+                    }
+                    None => None,
+                };
+                let start = Instant::now();
+                tracker.predict_to(times[k], pose, previous_state)?;
+                Ok((earlier, start.elapsed().as_secs_f64() * 1e3))
+            },
+        );
+        let side_by_side_ms = start.elapsed().as_secs_f64() * 1e3;
+        let (detections, (earlier, predict_ms)) = (detections?, filter?);
+        let beside_ms = predict_ms + earlier.as_ref().map_or(0.0, |(_, t)| t.times.filter_ms);
+        let overlap_ms =
+            (detections.planes_ms + detections.clusters_ms + beside_ms - side_by_side_ms).max(0.0);
+        if let Some((h, tracked)) = earlier {
+            emit(h, tracked, &mut out, total, &mut on_frame)?;
+        }
+        held = Some(Held {
+            frame: k,
+            cloud,
+            detections,
+            read_ms,
+            ego_ms,
+            predict_ms,
+            overlap_ms,
+        });
+    }
+    if let Some(h) = held.take() {
+        let tracked = tracker.update_with(h.frame, &h.detections)?;
+        emit(h, tracked, &mut out, total, &mut on_frame)?;
     }
     let mut summary = TrackingSummary::of(&out);
     summary.ego_fallbacks = odometry

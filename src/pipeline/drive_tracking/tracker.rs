@@ -72,6 +72,9 @@ pub struct DriveTracker {
     reported: HashSet<Label>,
     /// The configuration, for the segmentation of [`DriveTracker::step_scan`].
     config: TrackingConfig,
+    /// Time and sensor pose of a frame predicted by [`DriveTracker::predict_to`] and not yet
+    /// updated.
+    predicted: Option<(f64, Isometry3<f64>)>,
 }
 
 impl std::fmt::Debug for DriveTracker {
@@ -160,6 +163,7 @@ impl DriveTracker {
             clutter_particles: c.clutter_particles,
             reported: HashSet::new(),
             config: config.clone(),
+            predicted: None,
         })
     }
 
@@ -200,31 +204,67 @@ impl DriveTracker {
         cloud: &PointCloud,
         segment_rng: &mut FilterRng,
     ) -> Result<(FrameDetections, TrackedFrame)> {
-        rayon::scope(|_| {
-            let start = Instant::now();
-            if let (Some(h), Some(s)) = (&self.vehicle, vehicle_state) {
-                h.set(s);
-            }
-            let (config, filter, rng) = (&self.config, &mut self.filter, &mut self.rng);
+        let config = self.config.clone();
+        let start = Instant::now();
+        let (detections, predict_ms) = rayon::scope(|_| {
             let (detections, predicted) = rayon::join(
-                || detect_here(cloud, config, segment_rng),
+                || detect_here(cloud, &config, segment_rng),
                 || {
                     let start = Instant::now();
-                    filter
-                        .predict_step(time, Some(pose), rng)
+                    self.predict_to(time, pose, vehicle_state)
                         .map(|()| start.elapsed().as_secs_f64() * 1e3)
                 },
             );
-            let (detections, predict_ms) = (detections?, predicted?);
-            let side_by_side_ms = start.elapsed().as_secs_f64() * 1e3;
+            Ok::<_, crate::error::Error>((detections?, predicted?))
+        })?;
+        let side_by_side_ms = start.elapsed().as_secs_f64() * 1e3;
+        let mut tracked = self.update_with(frame, &detections)?;
+        let t = &mut tracked.times;
+        t.filter_ms += predict_ms;
+        t.overlap_ms = (t.planes_ms + t.clusters_ms + predict_ms - side_by_side_ms).max(0.0);
+        Ok((detections, tracked))
+    }
+
+    /// The first half of a step: the filter's tracks predicted to `time`, the sensor at
+    /// `pose` (`vehicle_state` as for [`DriveTracker::step`]). Needs no detections, so a
+    /// caller can run it while the scan is segmented; [`DriveTracker::update_with`] completes
+    /// the frame. An error when a frame is predicted and not yet updated.
+    pub fn predict_to(
+        &mut self,
+        time: f64,
+        pose: Isometry3<f64>,
+        vehicle_state: Option<[f64; 6]>,
+    ) -> Result<()> {
+        rayon::scope(|_| {
+            if let (Some(h), Some(s)) = (&self.vehicle, vehicle_state) {
+                h.set(s);
+            }
+            self.filter.predict_step(time, Some(pose), &mut self.rng)
+        })?;
+        self.predicted = Some((time, pose));
+        Ok(())
+    }
+
+    /// The second half of a step predicted by [`DriveTracker::predict_to`]: the update with the
+    /// frame's `detections` and the frame's report (`times.filter_ms` counts this half only).
+    /// An error when no frame is predicted.
+    pub fn update_with(
+        &mut self,
+        frame: usize,
+        detections: &FrameDetections,
+    ) -> Result<TrackedFrame> {
+        let Some((time, pose)) = self.predicted else {
+            return Err(crate::error::Error::invalid(
+                format!("update of frame {frame}"),
+                "the frame was not predicted (call predict_to first)",
+            ));
+        };
+        rayon::scope(|_| {
             let start = Instant::now();
             let measurements = detections.measurements()?;
             let estimates = self.filter.update_step(&measurements)?;
-            let mut tracked = self.finish(frame, time, pose, &detections, &estimates, start)?;
-            let t = &mut tracked.times;
-            t.filter_ms += predict_ms;
-            t.overlap_ms = (t.planes_ms + t.clusters_ms + predict_ms - side_by_side_ms).max(0.0);
-            Ok((detections, tracked))
+            self.predicted = None;
+            self.finish(frame, time, pose, detections, &estimates, start)
         })
     }
 
