@@ -462,7 +462,7 @@ struct Recording<'a> {
     /// Number of scans.
     frames: usize,
     /// Reads scan k.
-    read: &'a dyn Fn(usize) -> Result<PointCloud>,
+    read: &'a (dyn Fn(usize) -> Result<PointCloud> + Sync),
     /// Velodyne poses (frame k → frame 0), one per scan; `None`: lidar odometry on the scans.
     poses: Option<Vec<Isometry3<f64>>>,
     /// Where the poses come from, e.g. `oxts` (`none` when every pose is the identity).
@@ -773,10 +773,15 @@ fn track_recording(
     // with its detections and predicts to frame k, on the pool's other thread. Each half
     // runs in the order of a frame-by-frame loop, so the tracks are the same.
     let mut held: Option<Held> = None;
-    for k in range.clone() {
+    // Scan k + 1 is read beside the segmentation of scan k too.
+    let read = |k: usize| -> Result<(PointCloud, f64)> {
         let start = Instant::now();
         let cloud = (rec.read)(k)?;
-        let read_ms = start.elapsed().as_secs_f64() * 1e3;
+        Ok((cloud, start.elapsed().as_secs_f64() * 1e3))
+    };
+    let mut next = Some(read(range.start)?);
+    for k in range.clone() {
+        let (cloud, read_ms) = next.take().expect("each scan is read before its round");
         let previous_state = vehicle
             .as_ref()
             .map(|v| v[if k > range.start { k - 1 } else { k }]);
@@ -799,9 +804,10 @@ fn track_recording(
         };
         let start = Instant::now();
         let earlier = held.take();
-        let (detections, filter) = rayon::join(
+        type Beside = (Option<(Held, TrackedFrame)>, f64, Option<(PointCloud, f64)>);
+        let (detections, beside) = rayon::join(
             || detect_here(&cloud, config, &mut segment_rng(seed, k)),
-            || -> Result<(Option<(Held, TrackedFrame)>, f64)> {
+            || -> Result<Beside> {
                 let earlier = match earlier {
                     Some(h) => {
                         let tracked = tracker.update_with(h.frame, &h.detections)?;
@@ -811,12 +817,21 @@ fn track_recording(
                 };
                 let start = Instant::now();
                 tracker.predict_to(times[k], pose, previous_state)?;
-                Ok((earlier, start.elapsed().as_secs_f64() * 1e3))
+                let predict_ms = start.elapsed().as_secs_f64() * 1e3;
+                let next = if k + 1 < range.end {
+                    Some(read(k + 1)?)
+                } else {
+                    None
+                };
+                Ok((earlier, predict_ms, next))
             },
         );
         let side_by_side_ms = start.elapsed().as_secs_f64() * 1e3;
-        let (detections, (earlier, predict_ms)) = (detections?, filter?);
-        let beside_ms = predict_ms + earlier.as_ref().map_or(0.0, |(_, t)| t.times.filter_ms);
+        let (detections, (earlier, predict_ms, read_next)) = (detections?, beside?);
+        next = read_next;
+        let beside_ms = predict_ms
+            + earlier.as_ref().map_or(0.0, |(_, t)| t.times.filter_ms)
+            + next.as_ref().map_or(0.0, |(_, ms)| *ms);
         let overlap_ms =
             (detections.planes_ms + detections.clusters_ms + beside_ms - side_by_side_ms).max(0.0);
         if let Some((h, tracked)) = earlier {

@@ -111,9 +111,11 @@ pub struct StageTimes {
     /// Lidar odometry, when the ego motion comes from the scans (0 otherwise).
     #[serde(default)]
     pub ego_ms: f64,
-    /// The time the filter's prediction ran beside the segmentation: planes, clusters and
-    /// prediction less the wall time of the three side by side
-    /// ([`super::DriveTracker::step_scan`]; 0 when they ran one after the other).
+    /// What of the stages ran side by side with this frame's segmentation: planes and
+    /// clusters plus the work beside them (in the tracking loop the filter's update of the
+    /// frame before, its prediction to this one and the read of the next scan; in
+    /// [`super::DriveTracker::step_scan`] the prediction) less the wall time of the two
+    /// sides. 0 when everything ran one after the other.
     #[serde(default)]
     pub overlap_ms: f64,
 }
