@@ -777,8 +777,19 @@ impl LmbFilter {
                 let mut scaled_g = vec![vec![0.0; n]; zs.len()];
                 m.measurement
                     .log_likelihood_batch(&zs, p, ctx, &mut scaled_g);
+                // Each row's largest log-likelihood, and the first NaN or +∞ in any row.
+                let mut tops = Vec::with_capacity(scaled_g.len());
                 for (g, &j) in scaled_g.iter().zip(&gated) {
-                    if let Some(i) = g.iter().position(|v| v.is_nan() || *v == f64::INFINITY) {
+                    let (mut top, mut bad) = (f64::NEG_INFINITY, false);
+                    for &v in g {
+                        bad |= v.is_nan() || v == f64::INFINITY;
+                        top = top.max(v);
+                    }
+                    if bad {
+                        let i = g
+                            .iter()
+                            .position(|v| v.is_nan() || *v == f64::INFINITY)
+                            .unwrap_or(0);
                         return Err(Error::invalid(
                             format!("update of step {step}"),
                             format!(
@@ -788,12 +799,12 @@ impl LmbFilter {
                             ),
                         ));
                     }
+                    tops.push(top);
                 }
                 let mut pairs = Vec::with_capacity(zs.len());
-                for (mut g, measurement) in scaled_g.into_iter().zip(gated) {
+                for ((mut g, measurement), top) in scaled_g.into_iter().zip(gated).zip(tops) {
                     // log-sum-exp: shift by the largest log-likelihood before leaving the log
                     // domain, so likelihoods that would underflow keep their ratios.
-                    let top = g.iter().copied().fold(f64::NEG_INFINITY, f64::max);
                     if !top.is_finite() {
                         continue; // no particle can explain it
                     }

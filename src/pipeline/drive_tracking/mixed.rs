@@ -382,16 +382,18 @@ impl MeasurementModel for MixedMeasurement {
         let w2 = s2 * scale * scale;
         let (norm_a, half_a) = (ln_normal(s2) + (1.0 - weight).ln(), 0.5 / s2);
         let (norm_b, half_b) = (ln_normal(w2) + weight.ln(), 0.5 / w2);
-        for (o, p) in out.iter_mut().zip(points()) {
-            *o = (norm_a - norm_b) - (half_a - half_b) * c.squared(p);
+        // The squared distances once, for the first pass and the last.
+        let d2: Vec<f64> = points().map(|p| c.squared(p)).collect();
+        for (o, &d) in out.iter_mut().zip(&d2) {
+            *o = (norm_a - norm_b) - (half_a - half_b) * d;
         }
         exp_in_place(out);
         for o in out.iter_mut() {
             *o += 1.0;
         }
         ln_in_place(out);
-        for (o, p) in out.iter_mut().zip(points()) {
-            let l = *o + norm_b - half_b * c.squared(p);
+        for (o, &d) in out.iter_mut().zip(&d2) {
+            let l = *o + norm_b - half_b * d;
             *o = if l.is_nan() { f64::NEG_INFINITY } else { l };
         }
     }
