@@ -391,15 +391,20 @@ fn assert_clusters_are_components(cloud: &PointCloud, clusters: &[Vec<u32>], tol
     assert!(found == expected, "clusters differ from the components");
 }
 
+/// The vendored real frame (117,709 points).
+fn vendored_frame() -> PointCloud {
+    smc_lmb::cloud::read_kitti_bin(
+        vendored_kitti()
+            .join("2011_09_26/2011_09_26_drive_UNKNOWN_sync/velodyne_points/data/0000000000.bin"),
+    )
+    .unwrap()
+}
+
 /// Segmenting a scan while the filter predicts beside it (`step_scan`) gives the detections
 /// and the frames of segmenting first and stepping after.
 #[test]
 fn predicting_beside_the_segmentation_changes_nothing_but_the_times() {
-    let cloud = smc_lmb::cloud::read_kitti_bin(
-        vendored_kitti()
-            .join("2011_09_26/2011_09_26_drive_UNKNOWN_sync/velodyne_points/data/0000000000.bin"),
-    )
-    .unwrap();
+    let cloud = vendored_frame();
     let mut config = config();
     config.all_clusters = false;
     let (mut after, mut beside) = (
@@ -445,11 +450,7 @@ fn predicting_beside_the_segmentation_changes_nothing_but_the_times() {
 
 #[test]
 fn unreported_static_clutter_carries_fewer_particles() {
-    let cloud = smc_lmb::cloud::read_kitti_bin(
-        vendored_kitti()
-            .join("2011_09_26/2011_09_26_drive_UNKNOWN_sync/velodyne_points/data/0000000000.bin"),
-    )
-    .unwrap();
+    let cloud = vendored_frame();
     let mut config = config();
     config.all_clusters = false;
     let cap = config.cluster.clutter_particles.expect("capped by default");
