@@ -668,8 +668,10 @@ fn a_box_centre_off_for_one_frame_barely_moves_the_track() {
     // At an acceleration noise of 4 m/s²: the more process noise, the more any measurement
     // moves the velocity (at the default 8 m/s² the robust shift is about 0.6 m/s, the plain
     // one about 3 m/s); what is checked here is the likelihood's part.
+    // Manoeuvre steps (a fringe of the cloud driven 3 times harder) off for the same reason.
     let mut config = config();
     config.cluster.sigma_accel = 4.0;
+    config.cluster.manoeuvre_probability = 0.0;
     let robust = shift(&config);
     // A Gaussian of σ = 0.3 m alone follows the odd centre: the velocity jumps by about 1 m/s
     // (a little less since duplicate tracks merge: the birth at the odd centre joins the track).
@@ -683,6 +685,17 @@ fn a_box_centre_off_for_one_frame_barely_moves_the_track() {
     config.cluster.outlier_weight = 1.0;
     let err = DriveTracker::new(&config, 3).unwrap_err();
     assert!(err.to_string().contains("cluster.outlier_weight"), "{err}");
+    config.cluster.outlier_weight = 0.1;
+    config.cluster.manoeuvre_probability = 1.5;
+    let err = DriveTracker::new(&config, 3).unwrap_err();
+    assert!(
+        err.to_string().contains("cluster.manoeuvre_probability"),
+        "{err}"
+    );
+    config.cluster.manoeuvre_probability = 0.1;
+    config.cluster.manoeuvre_scale = 0.5;
+    let err = DriveTracker::new(&config, 3).unwrap_err();
+    assert!(err.to_string().contains("cluster.manoeuvre_scale"), "{err}");
 }
 
 #[test]

@@ -13,14 +13,21 @@
 //! is sampled exactly: Q_axis = σ² b bᵀ with b = [T²/2, T]ᵀ has rank one, so one draw
 //! a ~ N(0, σ²) per axis and particle moves the position by T²/2 · a and the velocity by T · a.
 //!
-//! Not for: manoeuvring objects (see [`crate::models::CoordinatedTurn`]) or ego-motion
-//! compensation.
+//! Manoeuvres ([`ConstantVelocity::with_manoeuvres`]): with probability p a particle's
+//! acceleration in a step is drawn k times wider (one draw of the mode per particle and step,
+//! shared by its axes) — a contaminated Gaussian, the memoryless form of a two-mode jump model
+//! (cruise and manoeuvre). The cloud then keeps a fringe of particles that can follow a turn or
+//! a braking the core would lag behind; its covariance is (1 − p + p k²) Q.
+//!
+//! Not for: sustained turns at a known rate (see [`crate::models::CoordinatedTurn`]) or
+//! ego-motion compensation.
 
 use crate::error::{Error, Result};
 use crate::filter::ParticleSet;
 use crate::filter::{StepContext, TransitionModel};
 use crate::rng::FilterRng;
 use nalgebra::DMatrix;
+use rand::RngExt;
 use rand_distr::{Distribution, StandardNormal};
 
 /// Constant-velocity transition with white-noise acceleration of standard deviation
@@ -33,6 +40,9 @@ use rand_distr::{Distribution, StandardNormal};
 pub struct ConstantVelocity {
     dims: usize,
     sigma_accel: f64,
+    /// (probability, scale) of a manoeuvre step, when set.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    manoeuvre: Option<(f64, f64)>,
 }
 
 impl ConstantVelocity {
@@ -50,7 +60,37 @@ impl ConstantVelocity {
                 format!("{sigma_accel} (must be finite and non-negative)"),
             ));
         }
-        Ok(ConstantVelocity { dims, sigma_accel })
+        Ok(ConstantVelocity {
+            dims,
+            sigma_accel,
+            manoeuvre: None,
+        })
+    }
+
+    /// The same model whose acceleration is, with probability `probability` per particle and
+    /// step, drawn `scale` times wider (see the module notes). `probability` 0 keeps the plain
+    /// model (and its random stream); `probability` must lie in [0, 1], `scale` be finite and
+    /// at least 1.
+    pub fn with_manoeuvres(mut self, probability: f64, scale: f64) -> Result<Self> {
+        if !(0.0..=1.0).contains(&probability) {
+            return Err(Error::invalid(
+                "constant-velocity manoeuvre probability",
+                format!("{probability} (must lie in [0, 1])"),
+            ));
+        }
+        if !(scale.is_finite() && scale >= 1.0) {
+            return Err(Error::invalid(
+                "constant-velocity manoeuvre scale",
+                format!("{scale} (must be finite and at least 1)"),
+            ));
+        }
+        self.manoeuvre = (probability > 0.0).then_some((probability, scale));
+        Ok(self)
+    }
+
+    /// (probability, scale) of a manoeuvre step, when the model has them.
+    pub fn manoeuvres(&self) -> Option<(f64, f64)> {
+        self.manoeuvre
     }
 
     /// A planar model, state `[x, ẋ, y, ẏ]`.
@@ -83,10 +123,12 @@ impl ConstantVelocity {
         f
     }
 
-    /// The process-noise covariance Q for a step of length `dt`.
+    /// The process-noise covariance Q for a step of length `dt` (with manoeuvres, that of the
+    /// mixture: (1 − p + p k²) times the plain one).
     pub fn process_covariance(&self, dt: f64) -> DMatrix<f64> {
         let n = 2 * self.dims;
-        let s2 = self.sigma_accel * self.sigma_accel;
+        let widen = self.manoeuvre.map_or(1.0, |(p, k)| 1.0 - p + p * k * k);
+        let s2 = self.sigma_accel * self.sigma_accel * widen;
         let mut q = DMatrix::zeros(n, n);
         for axis in 0..self.dims {
             let (p, v) = (2 * axis, 2 * axis + 1);
@@ -111,6 +153,31 @@ impl TransitionModel for ConstantVelocity {
         let dt = ctx.dt;
         let half_dt2 = 0.5 * dt * dt;
         let sigma = self.sigma_accel;
+        if let (Some((probability, scale)), true) = (self.manoeuvre, sigma > 0.0) {
+            // One mode a particle, drawn before its axes' accelerations.
+            let widths: Vec<f64> = (0..particles.len())
+                .map(|_| {
+                    if rng.random::<f64>() < probability {
+                        sigma * scale
+                    } else {
+                        sigma
+                    }
+                })
+                .collect();
+            let mut comps = particles.components_mut();
+            for axis in 0..self.dims {
+                let (head, tail) = comps.split_at_mut(2 * axis + 1);
+                let pos = &mut *head[2 * axis];
+                let vel = &mut *tail[0];
+                for ((p, v), &w) in pos.iter_mut().zip(vel.iter_mut()).zip(&widths) {
+                    let e: f64 = StandardNormal.sample(rng);
+                    let a = w * e;
+                    *p += dt * *v + half_dt2 * a;
+                    *v += dt * a;
+                }
+            }
+            return;
+        }
         let mut comps = particles.components_mut();
         for axis in 0..self.dims {
             let (head, tail) = comps.split_at_mut(2 * axis + 1);
@@ -218,5 +285,61 @@ mod tests {
         assert_eq!(q[(0, 0)], 100.0);
         assert_eq!(q[(0, 1)], 100.0);
         assert_eq!(q[(1, 1)], 100.0);
+    }
+
+    #[test]
+    fn manoeuvres_are_checked_and_probability_zero_is_the_plain_model() {
+        let cv = ConstantVelocity::spatial(2.0).unwrap();
+        assert!(cv.with_manoeuvres(-0.1, 3.0).is_err());
+        assert!(cv.with_manoeuvres(1.5, 3.0).is_err());
+        assert!(cv.with_manoeuvres(0.1, 0.5).is_err());
+        assert!(cv.with_manoeuvres(0.1, f64::INFINITY).is_err());
+        assert_eq!(
+            cv.with_manoeuvres(0.2, 3.0).unwrap().manoeuvres(),
+            Some((0.2, 3.0))
+        );
+        let off = cv.with_manoeuvres(0.0, 3.0).unwrap();
+        assert_eq!(off, cv);
+        let step = |m: &ConstantVelocity| {
+            let mut p = ParticleSet::zeros(6, 50);
+            m.predict(&mut p, &StepContext::new(1, 0.1, 0.1), &mut seeded(5));
+            p
+        };
+        assert_eq!(step(&off), step(&cv));
+    }
+
+    /// With manoeuvres the velocity change of one step is the contaminated Gaussian
+    /// (1 − p)·N(0, (σT)²) + p·N(0, (kσT)²): its variance is (1 − p + p k²)(σT)², the
+    /// process covariance says so, and |Δv| > 3σT is as frequent as the mixture makes it
+    /// (0.9 · 0.27 % + 0.1 · 31.7 % ≈ 3.4 % for p = 0.1, k = 3), far above a Gaussian's 0.27 %.
+    #[test]
+    fn manoeuvres_widen_the_acceleration_as_the_mixture_does() {
+        let (sigma, dt, p, k) = (8.0, 0.1, 0.1, 3.0);
+        let cv = ConstantVelocity::spatial(sigma)
+            .unwrap()
+            .with_manoeuvres(p, k)
+            .unwrap();
+        let n = 200_000;
+        let mut set = ParticleSet::zeros(6, n);
+        cv.predict(&mut set, &StepContext::new(1, dt, dt), &mut seeded(9));
+        let s = sigma * dt;
+        let widen = 1.0 - p + p * k * k;
+        for axis in 0..3 {
+            let v = set.component(2 * axis + 1);
+            let var = v.iter().map(|x| x * x).sum::<f64>() / n as f64;
+            assert!(
+                (var / (widen * s * s) - 1.0).abs() < 0.03,
+                "axis {axis}: {var}"
+            );
+            let tail = v.iter().filter(|x| x.abs() > 3.0 * s).count() as f64 / n as f64;
+            assert!((0.030..0.039).contains(&tail), "axis {axis}: tail {tail}");
+        }
+        // One mode a particle: its axes are widened together, so their squares correlate.
+        let (vx, vy) = (set.component(1), set.component(3));
+        let mean_sq = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>() / n as f64;
+        let joint = vx.iter().zip(vy).map(|(a, b)| a * a * b * b).sum::<f64>() / n as f64;
+        assert!(joint > 1.2 * mean_sq(vx) * mean_sq(vy), "{joint}");
+        let q = cv.process_covariance(dt);
+        assert!((q[(1, 1)] - widen * s * s).abs() < 1e-12);
     }
 }

@@ -227,6 +227,15 @@ impl MixedTransition {
     }
 }
 
+impl MixedTransition {
+    /// The same transition whose clusters manoeuvre now and then
+    /// ([`ConstantVelocity::with_manoeuvres`]).
+    pub fn with_cluster_manoeuvres(mut self, probability: f64, scale: f64) -> Result<Self> {
+        self.cluster = self.cluster.with_manoeuvres(probability, scale)?;
+        Ok(self)
+    }
+}
+
 impl TransitionModel for MixedTransition {
     fn state_dim(&self) -> usize {
         STATE_DIM

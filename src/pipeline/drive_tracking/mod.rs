@@ -137,6 +137,13 @@ pub struct ClusterTuning {
     /// acceleration has to cover a turn or a braking that lasts, not only its typical size
     /// (a car turning at 15 m/s on a 20 m radius accelerates at 11 m/s² for a second or two).
     pub sigma_accel: f64,
+    /// Probability that a particle's acceleration in a step is drawn `manoeuvre_scale` times
+    /// wider ([`crate::models::ConstantVelocity::with_manoeuvres`]): a fringe of the cloud that
+    /// follows a car turning or braking where the core lags behind (on the simulated street a
+    /// turning car's track fell behind and a newborn took the car). 0 turns it off. Default 0.1.
+    pub manoeuvre_probability: f64,
+    /// How much wider a manoeuvre step's acceleration is. Default 3.
+    pub manoeuvre_scale: f64,
     /// Centroid measurement noise per axis (m). Default 0.3.
     pub sigma: f64,
     /// Gate width in multiples of (σ + spread). Default 4.
@@ -173,6 +180,8 @@ impl Default for ClusterTuning {
     fn default() -> Self {
         ClusterTuning {
             sigma_accel: 8.0,
+            manoeuvre_probability: 0.1,
+            manoeuvre_scale: 3.0,
             sigma: 0.3,
             gate: 4.0,
             outlier_weight: 0.1,
@@ -403,6 +412,17 @@ impl TrackingConfig {
         if !(k >= 1.0 && k.is_finite()) {
             return Err(Error::invalid(
                 "tracking config field cluster.outlier_scale",
+                format!("{k} (must be finite and at least 1)"),
+            ));
+        }
+        ensure_probability(
+            "tracking config field cluster.manoeuvre_probability",
+            self.cluster.manoeuvre_probability,
+        )?;
+        let k = self.cluster.manoeuvre_scale;
+        if !(k >= 1.0 && k.is_finite()) {
+            return Err(Error::invalid(
+                "tracking config field cluster.manoeuvre_scale",
                 format!("{k} (must be finite and at least 1)"),
             ));
         }

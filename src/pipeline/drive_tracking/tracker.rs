@@ -110,6 +110,8 @@ impl DriveTracker {
                 (t, Some(h))
             }
         };
+        let transition =
+            transition.with_cluster_manoeuvres(c.manoeuvre_probability, c.manoeuvre_scale)?;
         let plane_meas = PlaneMeasurement::new(p.sigma_angle, p.sigma_offset)?.with_gate(p.gate)?;
         let sampler = MixedBirthSampler {
             plane_sigma_angle: p.birth_angle,
