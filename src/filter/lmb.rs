@@ -525,18 +525,22 @@ impl LmbFilter {
     /// when no step is predicted or the measurements have the wrong dimension (the prediction
     /// then stays pending).
     pub fn update_step(&mut self, measurements: &Measurements) -> Result<Vec<Estimate>> {
-        let Some(pending) = self.pending.as_ref() else {
+        if self.pending.is_none() {
             return Err(Error::invalid(
                 format!("update of step {}", self.step),
                 "the step was not predicted (call predict_step first)",
             ));
-        };
+        }
         let z = measurements;
         self.check_measurements(z)?;
-        let (ctx, seed) = (pending.context, pending.seed);
-        let summaries = self.pending.take().map(|p| p.summaries).unwrap_or_default();
-        // Gating needs the summaries only when there is something to gate.
-        let summaries = if z.is_empty() { Vec::new() } else { summaries };
+        let Some(Pending {
+            context: ctx,
+            seed,
+            summaries,
+        }) = self.pending.take()
+        else {
+            unreachable!("checked above");
+        };
         self.add_births(&ctx, z, seed, &summaries);
         let predicted = self.predicted_copies();
         let likelihoods = self.likelihoods(z, &ctx, &summaries)?;

@@ -141,6 +141,33 @@ impl ConstantVelocity {
     }
 }
 
+impl ConstantVelocity {
+    /// One step of every axis: particle i's acceleration is `width(i)`·e, e ~ N(0, 1) drawn
+    /// axis after axis, particle after particle.
+    #[inline(always)]
+    fn accelerate(
+        &self,
+        particles: &mut ParticleSet,
+        dt: f64,
+        width: impl Fn(usize) -> f64,
+        rng: &mut FilterRng,
+    ) {
+        let half_dt2 = 0.5 * dt * dt;
+        let mut comps = particles.components_mut();
+        for axis in 0..self.dims {
+            let (head, tail) = comps.split_at_mut(2 * axis + 1);
+            let pos = &mut *head[2 * axis];
+            let vel = &mut *tail[0];
+            for (i, (p, v)) in pos.iter_mut().zip(vel.iter_mut()).enumerate() {
+                let e: f64 = StandardNormal.sample(rng);
+                let a = width(i) * e;
+                *p += dt * *v + half_dt2 * a;
+                *v += dt * a;
+            }
+        }
+    }
+}
+
 impl TransitionModel for ConstantVelocity {
     fn state_dim(&self) -> usize {
         2 * self.dims
@@ -150,50 +177,31 @@ impl TransitionModel for ConstantVelocity {
         if particles.dim() < self.state_dim() || particles.is_empty() {
             return;
         }
-        let dt = ctx.dt;
-        let half_dt2 = 0.5 * dt * dt;
-        let sigma = self.sigma_accel;
-        if let (Some((probability, scale)), true) = (self.manoeuvre, sigma > 0.0) {
-            // One mode a particle, drawn before its axes' accelerations.
-            let widths: Vec<f64> = (0..particles.len())
-                .map(|_| {
-                    if rng.random::<f64>() < probability {
-                        sigma * scale
-                    } else {
-                        sigma
-                    }
-                })
-                .collect();
+        let (dt, sigma) = (ctx.dt, self.sigma_accel);
+        if sigma == 0.0 {
             let mut comps = particles.components_mut();
             for axis in 0..self.dims {
                 let (head, tail) = comps.split_at_mut(2 * axis + 1);
-                let pos = &mut *head[2 * axis];
-                let vel = &mut *tail[0];
-                for ((p, v), &w) in pos.iter_mut().zip(vel.iter_mut()).zip(&widths) {
-                    let e: f64 = StandardNormal.sample(rng);
-                    let a = w * e;
-                    *p += dt * *v + half_dt2 * a;
-                    *v += dt * a;
+                for (p, v) in head[2 * axis].iter_mut().zip(tail[0].iter()) {
+                    *p += dt * *v;
                 }
             }
             return;
         }
-        let mut comps = particles.components_mut();
-        for axis in 0..self.dims {
-            let (head, tail) = comps.split_at_mut(2 * axis + 1);
-            let pos = &mut *head[2 * axis];
-            let vel = &mut *tail[0];
-            if sigma > 0.0 {
-                for (p, v) in pos.iter_mut().zip(vel.iter_mut()) {
-                    let e: f64 = StandardNormal.sample(rng);
-                    let a = sigma * e;
-                    *p += dt * *v + half_dt2 * a;
-                    *v += dt * a;
-                }
-            } else {
-                for (p, v) in pos.iter_mut().zip(vel.iter()) {
-                    *p += dt * *v;
-                }
+        match self.manoeuvre {
+            None => self.accelerate(particles, dt, |_| sigma, rng),
+            Some((probability, scale)) => {
+                // One mode a particle, drawn before its axes' accelerations.
+                let widths: Vec<f64> = (0..particles.len())
+                    .map(|_| {
+                        if rng.random::<f64>() < probability {
+                            sigma * scale
+                        } else {
+                            sigma
+                        }
+                    })
+                    .collect();
+                self.accelerate(particles, dt, |i| widths[i], rng)
             }
         }
     }
