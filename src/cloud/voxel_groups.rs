@@ -1,6 +1,7 @@
 //! Points grouped by the voxel (a cube of a given edge, aligned to the origin) they fall
-//! into, in linear time: voxels are numbered by a hash table in the order their first point
-//! appears, then the point indices are placed by a counting sort on that number. The members
+//! into, in linear time: voxels are numbered in the order their first point appears (on a
+//! dense array over the points' bounding box of voxels when that box is small, else by a hash
+//! table), then the point indices are placed by a counting sort on that number. The members
 //! of a voxel are one contiguous, ascending slice.
 //!
 //! Used by the plane RANSAC's triple sampling (the points of a coarse cell).
@@ -27,39 +28,21 @@ impl VoxelGroups {
     /// axis.
     pub fn new(points: &[[f32; 3]], edge: f32) -> Self {
         let inv = 1.0 / edge;
+        let keys: Vec<[i32; 3]> = points
+            .iter()
+            .map(|p| {
+                [
+                    floor_f32_i32(p[0] * inv),
+                    floor_f32_i32(p[1] * inv),
+                    floor_f32_i32(p[2] * inv),
+                ]
+            })
+            .collect();
+        let (group_of, count) = match dense_extent(&keys) {
+            Some((lo, span)) => number_on_grid(&keys, lo, span),
+            None => number_by_hash(&keys),
+        };
         let m = points.len();
-        // Open addressing with linear probing, at most half full; a slot holds a voxel number
-        // and the voxel's coordinates are kept once per voxel.
-        let slots = (2 * m).next_power_of_two().max(2);
-        let mask = slots - 1;
-        let mut table: Vec<u32> = vec![u32::MAX; slots];
-        let mut key_of: Vec<[i32; 3]> = Vec::new();
-        let mut count: Vec<u32> = Vec::new();
-        let mut group_of: Vec<u32> = Vec::with_capacity(m);
-        for p in points {
-            let key = [
-                floor_f32_i32(p[0] * inv),
-                floor_f32_i32(p[1] * inv),
-                floor_f32_i32(p[2] * inv),
-            ];
-            let mut slot = voxel_hash(key) as usize & mask;
-            let id = loop {
-                let id = table[slot];
-                if id == u32::MAX {
-                    let id = key_of.len() as u32;
-                    table[slot] = id;
-                    key_of.push(key);
-                    count.push(0);
-                    break id;
-                }
-                if key_of[id as usize] == key {
-                    break id;
-                }
-                slot = (slot + 1) & mask;
-            };
-            count[id as usize] += 1;
-            group_of.push(id);
-        }
         // Start of every voxel's run, then the indices in ascending order into their runs.
         let mut start: Vec<u32> = Vec::with_capacity(count.len() + 1);
         let mut acc = 0u32;
@@ -103,6 +86,78 @@ impl VoxelGroups {
     }
 }
 
+/// The keys' smallest corner and their extent per axis, when a dense array over that box
+/// (at most [`DENSE_CELLS`] voxels, and no more than 16 per point) is cheaper than hashing.
+fn dense_extent(keys: &[[i32; 3]]) -> Option<([i32; 3], [usize; 3])> {
+    let first = keys.first()?;
+    let (mut lo, mut hi) = (*first, *first);
+    for k in keys {
+        for a in 0..3 {
+            lo[a] = lo[a].min(k[a]);
+            hi[a] = hi[a].max(k[a]);
+        }
+    }
+    let span: [usize; 3] = std::array::from_fn(|a| (hi[a] as i64 - lo[a] as i64 + 1) as usize);
+    let cells = span.iter().try_fold(1usize, |acc, &s| acc.checked_mul(s))?;
+    (cells <= DENSE_CELLS && cells <= 16 * keys.len()).then_some((lo, span))
+}
+
+/// Largest dense array of voxel numbers [`VoxelGroups::new`] allocates.
+const DENSE_CELLS: usize = 1 << 20;
+
+/// Voxel numbers in order of first appearance, and each voxel's count, from a dense array over
+/// the keys' box.
+fn number_on_grid(keys: &[[i32; 3]], lo: [i32; 3], span: [usize; 3]) -> (Vec<u32>, Vec<u32>) {
+    let mut id_at = vec![u32::MAX; span[0] * span[1] * span[2]];
+    let mut count: Vec<u32> = Vec::new();
+    let mut group_of = Vec::with_capacity(keys.len());
+    for k in keys {
+        let at = ((k[2] - lo[2]) as usize * span[1] + (k[1] - lo[1]) as usize) * span[0]
+            + (k[0] - lo[0]) as usize;
+        let mut id = id_at[at];
+        if id == u32::MAX {
+            id = count.len() as u32;
+            id_at[at] = id;
+            count.push(0);
+        }
+        count[id as usize] += 1;
+        group_of.push(id);
+    }
+    (group_of, count)
+}
+
+/// Voxel numbers in order of first appearance, and each voxel's count, by open addressing
+/// with linear probing (at most half full; a slot holds a voxel number and the voxel's
+/// coordinates are kept once per voxel).
+fn number_by_hash(keys: &[[i32; 3]]) -> (Vec<u32>, Vec<u32>) {
+    let slots = (2 * keys.len()).next_power_of_two().max(2);
+    let mask = slots - 1;
+    let mut table: Vec<u32> = vec![u32::MAX; slots];
+    let mut key_of: Vec<[i32; 3]> = Vec::new();
+    let mut count: Vec<u32> = Vec::new();
+    let mut group_of: Vec<u32> = Vec::with_capacity(keys.len());
+    for &key in keys {
+        let mut slot = voxel_hash(key) as usize & mask;
+        let id = loop {
+            let id = table[slot];
+            if id == u32::MAX {
+                let id = key_of.len() as u32;
+                table[slot] = id;
+                key_of.push(key);
+                count.push(0);
+                break id;
+            }
+            if key_of[id as usize] == key {
+                break id;
+            }
+            slot = (slot + 1) & mask;
+        };
+        count[id as usize] += 1;
+        group_of.push(id);
+    }
+    (group_of, count)
+}
+
 /// A 64-bit mix of a voxel's three coordinates.
 #[inline]
 fn voxel_hash(key: [i32; 3]) -> u64 {
@@ -132,6 +187,23 @@ mod tests {
         assert_eq!(g.members(2), &[3]);
         assert_eq!(g.group_of(4), 1);
         assert!(VoxelGroups::new(&[], 1.0).is_empty());
+    }
+
+    #[test]
+    fn far_apart_points_are_grouped_by_hashing_alike() {
+        // A box of 2·10⁶ voxels a side: too large for the dense array.
+        let p: [[f32; 3]; 4] = [
+            [1e6, 0.0, 0.0],
+            [-1e6, 0.5, 0.0],
+            [1e6, 0.2, 0.9],
+            [-1e6, 0.0, 0.1],
+        ];
+        let keys: Vec<[i32; 3]> = p.iter().map(|q| q.map(|v| v.floor() as i32)).collect();
+        assert!(dense_extent(&keys).is_none());
+        let g = VoxelGroups::new(&p, 1.0);
+        assert_eq!(g.len(), 2);
+        assert_eq!(g.members(0), &[0, 2]);
+        assert_eq!(g.members(1), &[1, 3]);
     }
 
     proptest! {
