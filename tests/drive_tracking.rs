@@ -780,3 +780,44 @@ fn births_below_the_least_existence_are_not_made() {
     let err = DriveTracker::new(&c, 2).unwrap_err().to_string();
     assert!(err.contains("birth.min_existence"), "{err}");
 }
+
+/// Walls measured every frame in a scene with few other measurements: measurement-driven
+/// birth shares out its expected births among well-explained measurements, and a duplicate
+/// of a wall shares the wall's measurement (planes are never merged). The duplicates must
+/// not pile up: a birth is no more probable than its measurement is unexplained.
+#[test]
+fn well_explained_walls_breed_no_lasting_duplicates() {
+    use smc_lmb::pipeline::drive_tracking::mixed::{kind_of_set, ObjectKind};
+    let mut cloud = PointCloud::new();
+    // The street without its moving box: the ground, two walls and the pole.
+    let n_box = box_surface(box_centre(0), [4.0, 1.8, 1.5], 0.1).len();
+    let pts = street(0);
+    for p in &pts[..pts.len() - n_box] {
+        cloud.push(p.x as f32, p.y as f32, p.z as f32, 0.0);
+    }
+    let config = config();
+    let det = detect_objects(&cloud, &config, &mut smc_lmb::rng::seeded(3)).unwrap();
+    assert_eq!(det.walls.len(), 2, "the street's two walls");
+    let mut tracker = DriveTracker::new(&config, 6).unwrap();
+    let mut counts = Vec::new();
+    for k in 0..40 {
+        let pose = nalgebra::Isometry3::identity();
+        let frame = tracker.step(k, k as f64 * DT, pose, None, &det).unwrap();
+        let planes = tracker
+            .filter()
+            .tracks()
+            .iter()
+            .filter(|t| kind_of_set(&t.particles) == Some(ObjectKind::Plane))
+            .count();
+        counts.push(planes);
+        if k >= 10 {
+            assert_eq!(frame.planes.len(), 2, "frame {k}: both walls reported");
+        }
+    }
+    // Two walls, and at most a young duplicate on its way out (with births up to r_B,max from
+    // every wall each frame, duplicates held the count at 6).
+    assert!(
+        counts[10..].iter().all(|&c| c <= 3),
+        "plane tracks per frame: {counts:?}"
+    );
+}
