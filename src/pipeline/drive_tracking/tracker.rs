@@ -58,7 +58,11 @@ pub struct DriveTracker {
     filter: LmbFilter,
     vehicle: Option<VehicleStateHandle>,
     rng: FilterRng,
+    /// The report's id of each live label; a label the filter dropped never returns, and its
+    /// entries here and in the maps below leave with it (see [`DriveTracker::forget_dropped`]).
     ids: HashMap<Label, u32>,
+    /// Ids handed out so far.
+    issued: u32,
     wall_corners: HashMap<Label, [Point3<f64>; 4]>,
     cluster_extent: HashMap<Label, [f64; 3]>,
     road_users: HashMap<Label, RoadUserState>,
@@ -81,7 +85,7 @@ impl std::fmt::Debug for DriveTracker {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("DriveTracker")
             .field("filter", &self.filter)
-            .field("labels", &self.ids.len())
+            .field("labels", &self.issued)
             .finish_non_exhaustive()
     }
 }
@@ -156,6 +160,7 @@ impl DriveTracker {
             vehicle,
             rng: seeded(seed),
             ids: HashMap::new(),
+            issued: 0,
             wall_corners: HashMap::new(),
             cluster_extent: HashMap::new(),
             road_users: HashMap::new(),
@@ -306,6 +311,7 @@ impl DriveTracker {
         start: Instant,
     ) -> Result<TrackedFrame> {
         let (planes, clusters) = self.report(estimates, &pose, detections)?;
+        self.forget_dropped();
         let filter_ms = start.elapsed().as_secs_f64() * 1e3;
         let (_, _, yaw) = pose.rotation.euler_angles();
         let t = pose.translation.vector;
@@ -330,8 +336,22 @@ impl DriveTracker {
     }
 
     fn id_of(&mut self, label: Label) -> u32 {
-        let next = self.ids.len() as u32 + 1;
-        *self.ids.entry(label).or_insert(next)
+        let issued = &mut self.issued;
+        *self.ids.entry(label).or_insert_with(|| {
+            *issued += 1;
+            *issued
+        })
+    }
+
+    /// Drops what the report remembers of labels that are no longer tracks: the filter
+    /// never brings a pruned or merged label back, so over a long drive these maps hold only
+    /// the live tracks instead of every label ever reported.
+    fn forget_dropped(&mut self) {
+        let live: HashSet<Label> = self.filter.tracks().iter().map(|t| t.label).collect();
+        self.ids.retain(|l, _| live.contains(l));
+        self.wall_corners.retain(|l, _| live.contains(l));
+        self.cluster_extent.retain(|l, _| live.contains(l));
+        self.road_users.retain(|l, _| live.contains(l));
     }
 
     fn report(
@@ -598,5 +618,46 @@ mod tests {
         assert_eq!(rectangle_gap(&rect(0.0, 10.0), &rect(2.0, 4.0)), 0.0);
         assert!((rectangle_gap(&rect(0.0, 10.0), &rect(25.0, 10.0)) - 15.0).abs() < 1e-12);
         assert!((rectangle_gap(&rect(0.0, 10.0), &rect(-13.0, 10.0)) - 3.0).abs() < 1e-12);
+    }
+
+    /// A real frame seen for a few frames, then nothing: every track dies, and with them
+    /// what the report remembered of their labels; ids keep counting.
+    #[test]
+    fn labels_the_filter_dropped_are_forgotten() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(
+            "tests/data/kitti/2011_09_26/2011_09_26_drive_UNKNOWN_sync/velodyne_points/data/\
+             0000000000.bin",
+        );
+        let cloud = crate::cloud::read_kitti_bin(&path).unwrap();
+        let config = TrackingConfig {
+            all_clusters: true,
+            ..TrackingConfig::default()
+        };
+        let seen = crate::pipeline::drive_tracking::detect_objects(
+            &cloud,
+            &config,
+            &mut crate::rng::seeded(2),
+        )
+        .unwrap();
+        let empty = FrameDetections {
+            walls: Vec::new(),
+            clusters: Vec::new(),
+            ground: Vec::new(),
+            planes_ms: 0.0,
+            clusters_ms: 0.0,
+        };
+        let mut tracker = DriveTracker::new(&config, 3).unwrap();
+        let pose = Isometry3::identity();
+        for k in 0..60 {
+            let det = if k < 5 { &seen } else { &empty };
+            tracker.step(k, k as f64 * 0.1, pose, None, det).unwrap();
+            if k == 4 {
+                assert!(!tracker.ids.is_empty() && !tracker.cluster_extent.is_empty());
+            }
+        }
+        assert!(tracker.filter.tracks().is_empty(), "every track died");
+        assert!(tracker.issued > 0);
+        assert!(tracker.ids.is_empty() && tracker.road_users.is_empty());
+        assert!(tracker.cluster_extent.is_empty() && tracker.wall_corners.is_empty());
     }
 }
