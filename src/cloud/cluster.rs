@@ -239,13 +239,27 @@ fn grid_components(points: &[[f32; 3]], tolerance: f32) -> Option<Vec<u32>> {
     cell_start.push(order.len() as u32);
     let n_cells = cell_keys.len();
     let members = |c: usize| &sorted[cell_start[c] as usize..cell_start[c + 1] as usize];
+    // The tight box of each cell's points. Two cells whose boxes lie farther apart than the
+    // tolerance cannot touch, two whose boxes lie within it everywhere do, and a point farther
+    // from the other cell's box than the tolerance has no neighbour there. f32 subtraction,
+    // squaring and addition are monotone, so these bounds, computed in the order of the
+    // point test, never decide otherwise than the point pairs would.
+    let boxes: Vec<CellBox> = (0..n_cells).map(|c| CellBox::of(members(c))).collect();
     let touches = |a: usize, b: usize| {
+        let (ba, bb) = (&boxes[a], &boxes[b]);
+        if ba.gap2(bb) > r2 {
+            return false;
+        }
+        if ba.span2(bb) <= r2 {
+            return true;
+        }
         let pb = members(b);
         members(a).iter().any(|p| {
-            pb.iter().any(|q| {
-                let (dx, dy, dz) = (p[0] - q[0], p[1] - q[1], p[2] - q[2]);
-                dx * dx + dy * dy + dz * dz <= r2
-            })
+            bb.gap2_to(p) <= r2
+                && pb.iter().any(|q| {
+                    let (dx, dy, dz) = (p[0] - q[0], p[1] - q[1], p[2] - q[2]);
+                    dx * dx + dy * dy + dz * dz <= r2
+                })
         })
     };
     let mut parent: Vec<u32> = (0..n_cells as u32).collect();
@@ -267,10 +281,14 @@ fn grid_components(points: &[[f32; 3]], tolerance: f32) -> Option<Vec<u32>> {
     let mut cursors = vec![0usize; rows.len()];
     for c in 0..n_cells {
         let key = cell_keys[c];
-        let visit = |d: usize, parent: &mut Vec<u32>| {
-            let (rc, rd) = (find(parent, c as u32), find(parent, d as u32));
+        // The root of `c`'s set: only this cell's own unions below change it, and a union
+        // makes the smaller root the root of both (so every root is its set's smallest cell).
+        let mut rc = find(&mut parent, c as u32);
+        let mut visit = |d: usize, parent: &mut Vec<u32>| {
+            let rd = find(parent, d as u32);
             if rc != rd && touches(c, d) {
                 parent[rc.max(rd) as usize] = rc.min(rd);
+                rc = rc.min(rd);
             }
         };
         // Same row, dx = 1, 2.
@@ -304,6 +322,50 @@ fn grid_components(points: &[[f32; 3]], tolerance: f32) -> Option<Vec<u32>> {
         }
     }
     Some(labels)
+}
+
+/// Axis-aligned box of one grid cell's points.
+struct CellBox {
+    lo: [f32; 3],
+    hi: [f32; 3],
+}
+
+impl CellBox {
+    fn of(points: &[[f32; 3]]) -> Self {
+        let mut b = CellBox {
+            lo: [f32::INFINITY; 3],
+            hi: [f32::NEG_INFINITY; 3],
+        };
+        for p in points {
+            for a in 0..3 {
+                b.lo[a] = b.lo[a].min(p[a]);
+                b.hi[a] = b.hi[a].max(p[a]);
+            }
+        }
+        b
+    }
+
+    /// Squared distance between the boxes (a lower bound of every point pair's, as the point
+    /// test computes it).
+    fn gap2(&self, other: &CellBox) -> f32 {
+        let g = |a: usize| (other.lo[a] - self.hi[a]).max(self.lo[a] - other.hi[a]).max(0.0);
+        let (gx, gy, gz) = (g(0), g(1), g(2));
+        gx * gx + gy * gy + gz * gz
+    }
+
+    /// Squared largest distance between the boxes (an upper bound of every point pair's).
+    fn span2(&self, other: &CellBox) -> f32 {
+        let s = |a: usize| (other.hi[a] - self.lo[a]).max(self.hi[a] - other.lo[a]);
+        let (sx, sy, sz) = (s(0), s(1), s(2));
+        sx * sx + sy * sy + sz * sz
+    }
+
+    /// Squared distance from `p` to the box (a lower bound of its distance to every point).
+    fn gap2_to(&self, p: &[f32; 3]) -> f32 {
+        let g = |a: usize| (self.lo[a] - p[a]).max(p[a] - self.hi[a]).max(0.0);
+        let (gx, gy, gz) = (g(0), g(1), g(2));
+        gx * gx + gy * gy + gz * gz
+    }
 }
 
 /// Components by flood fill over a k-d tree (kiddo): a component label (a local position)
