@@ -28,7 +28,7 @@ use crate::cloud::range_image::{
 use crate::cloud::PointCloud;
 use crate::error::Result;
 use crate::filter::Measurements;
-use crate::geometry::PlanePatch;
+use crate::geometry::{Plane, PlanePatch};
 use crate::pipeline::drive_tracking::mixed::{
     cluster_measurement, plane_measurement, MEASUREMENT_DIM,
 };
@@ -131,6 +131,58 @@ pub(super) fn detect_here(
     config: &TrackingConfig,
     rng: &mut FilterRng,
 ) -> Result<FrameDetections> {
+    segment_here(cloud, config, rng)?.finish(cloud, config)
+}
+
+/// A frame's walls and clusters before the clusters' boxes and classes: what
+/// [`segment_here`] hands on, completed by [`Segmented::finish`]. The tracking loop finishes
+/// a frame on the filter's side, just before the update that needs it, so that the
+/// segmentation's side is shorter.
+pub(super) struct Segmented {
+    detections: FrameDetections,
+    ground: Option<Plane>,
+}
+
+impl Segmented {
+    /// The segmentation's times so far: (planes, clusters) in milliseconds.
+    pub(super) fn times(&self) -> (f64, f64) {
+        (self.detections.planes_ms, self.detections.clusters_ms)
+    }
+
+    /// Every cluster's oriented box and class evidence ([`shape_of`]), in parallel; their
+    /// time is added to `clusters_ms`.
+    pub(super) fn finish(self, cloud: &PointCloud, config: &TrackingConfig) -> Result<FrameDetections> {
+        let start = Instant::now();
+        let Segmented {
+            mut detections,
+            ground,
+        } = self;
+        let c = &config.clusters;
+        let ground_z = |x: f64, y: f64| -> Option<f64> {
+            let g = ground.as_ref()?;
+            (g.normal.z.abs() > 0.5)
+                .then(|| -(g.normal.x * x + g.normal.y * y + g.offset) / g.normal.z)
+        };
+        let model = ClassModel::default();
+        detections
+            .clusters
+            .par_iter_mut()
+            .try_for_each_init(BoxScratch::default, |scratch, d| -> Result<()> {
+                let z0 = ground_z(d.centroid[0], d.centroid[1]).or(Some(-c.sensor_height));
+                d.shape = Some(shape_of(cloud, &d.indices, z0, &model, scratch)?);
+                Ok(())
+            })?;
+        detections.clusters_ms += start.elapsed().as_secs_f64() * 1e3;
+        Ok(detections)
+    }
+}
+
+/// The walls and clusters of a frame without the clusters' shapes (see [`Segmented`]).
+pub(super) fn segment_here(
+    cloud: &PointCloud,
+    config: &TrackingConfig,
+    rng: &mut FilterRng,
+) -> Result<Segmented> {
     let start = Instant::now();
     let seg = extract_planes(cloud, &config.planes, rng)?;
     let planes_ms = start.elapsed().as_secs_f64() * 1e3;
@@ -211,21 +263,9 @@ pub(super) fn detect_here(
         .collect();
     let range = |d: &ClusterDetection| d.centroid[0].hypot(d.centroid[1]);
     clusters.sort_by(|a, b| range(a).total_cmp(&range(b)));
-    let ground_z = |x: f64, y: f64| -> Option<f64> {
-        let g = ground.as_ref()?;
-        (g.normal.z.abs() > 0.5).then(|| -(g.normal.x * x + g.normal.y * y + g.offset) / g.normal.z)
-    };
-    let model = ClassModel::default();
-    clusters
-        .par_iter_mut()
-        .try_for_each_init(BoxScratch::default, |scratch, d| -> Result<()> {
-            let z0 = ground_z(d.centroid[0], d.centroid[1]).or(Some(-c.sensor_height));
-            d.shape = Some(shape_of(cloud, &d.indices, z0, &model, scratch)?);
-            Ok(())
-        })?;
     let clusters_ms = start.elapsed().as_secs_f64() * 1e3;
 
-    Ok(FrameDetections {
+    let detections = FrameDetections {
         walls: seg
             .walls
             .into_iter()
@@ -238,5 +278,6 @@ pub(super) fn detect_here(
         ground: seg.ground.map(|g| g.inliers).unwrap_or_default(),
         planes_ms,
         clusters_ms,
-    })
+    };
+    Ok(Segmented { detections, ground })
 }

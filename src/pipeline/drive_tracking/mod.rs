@@ -28,7 +28,7 @@ pub mod road_users;
 pub mod source;
 pub mod tracker;
 
-use detect::detect_here;
+use detect::{segment_here, Segmented};
 pub use detect::{detect_objects, ClusterDetection, FrameDetections, WallDetection};
 pub use export::point_labels;
 #[cfg(feature = "plot")]
@@ -731,7 +731,9 @@ pub fn track_odometry_sequence(
 struct Held {
     frame: usize,
     cloud: PointCloud,
-    detections: FrameDetections,
+    /// The frame's walls and clusters, until the filter's side gives the clusters their
+    /// shapes.
+    segmented: Option<Segmented>,
     read_ms: f64,
     ego_ms: f64,
     /// The filter's prediction to this frame.
@@ -740,9 +742,23 @@ struct Held {
     overlap_ms: f64,
 }
 
+impl Held {
+    /// The frame's finished detections ([`Segmented::finish`]); an error the second time.
+    fn finish(&mut self, config: &TrackingConfig) -> Result<FrameDetections> {
+        match self.segmented.take() {
+            Some(s) => s.finish(&self.cloud, config),
+            None => Err(Error::invalid(
+                format!("detections of frame {}", self.frame),
+                "they were finished already",
+            )),
+        }
+    }
+}
+
 /// Completes a held frame's report with its times, hands it to `on_frame` and keeps it.
 fn emit(
     h: Held,
+    detections: &FrameDetections,
     mut tracked: TrackedFrame,
     out: &mut Vec<TrackedFrame>,
     total: usize,
@@ -755,7 +771,7 @@ fn emit(
     t.overlap_ms = h.overlap_ms;
     on_frame(&FrameView {
         cloud: &h.cloud,
-        detections: &h.detections,
+        detections,
         tracked: &tracked,
         progress: (out.len() + 1, total),
     })?;
@@ -796,8 +812,10 @@ fn track_recording(
     let mut out = Vec::with_capacity(range.len());
     let total = range.len();
     // Frames overlap: the scan of frame k is segmented while the filter updates frame k − 1
-    // with its detections and predicts to frame k, on the pool's other thread. Each half
-    // runs in the order of a frame-by-frame loop, so the tracks are the same.
+    // with its detections and predicts to frame k, on the pool's other thread; that side
+    // also gives frame k − 1's clusters their boxes and classes, just before its update, so
+    // that the two sides take about as long. Each half runs in the order of a frame-by-frame
+    // loop, so the tracks are the same.
     let mut held: Option<Held> = None;
     // Scan k + 1 is read beside the segmentation of scan k too.
     let read = |k: usize| -> Result<(PointCloud, f64)> {
@@ -830,14 +848,18 @@ fn track_recording(
         };
         let start = Instant::now();
         let earlier = held.take();
-        type Beside = (Option<(Held, TrackedFrame)>, f64, Option<(PointCloud, f64)>);
-        let (detections, beside) = rayon::join(
-            || detect_here(&cloud, config, &mut segment_rng(seed, k)),
+        type Earlier = Option<(Held, FrameDetections, TrackedFrame, f64)>;
+        type Beside = (Earlier, f64, Option<(PointCloud, f64)>);
+        let (segmented, beside) = rayon::join(
+            || segment_here(&cloud, config, &mut segment_rng(seed, k)),
             || -> Result<Beside> {
                 let earlier = match earlier {
-                    Some(h) => {
-                        let tracked = tracker.update_with(h.frame, &h.detections)?;
-                        Some((h, tracked))
+                    Some(mut h) => {
+                        let start = Instant::now();
+                        let detections = h.finish(config)?;
+                        let shapes_ms = start.elapsed().as_secs_f64() * 1e3;
+                        let tracked = tracker.update_with(h.frame, &detections)?;
+                        Some((h, detections, tracked, shapes_ms))
                     }
                     None => None,
                 };
@@ -853,29 +875,32 @@ fn track_recording(
             },
         );
         let side_by_side_ms = start.elapsed().as_secs_f64() * 1e3;
-        let (detections, (earlier, predict_ms, read_next)) = (detections?, beside?);
+        let (segmented, (earlier, predict_ms, read_next)) = (segmented?, beside?);
         next = read_next;
         let beside_ms = predict_ms
-            + earlier.as_ref().map_or(0.0, |(_, t)| t.times.filter_ms)
+            + earlier
+                .as_ref()
+                .map_or(0.0, |(_, _, t, shapes_ms)| t.times.filter_ms + shapes_ms)
             + next.as_ref().map_or(0.0, |(_, ms)| *ms);
-        let overlap_ms =
-            (detections.planes_ms + detections.clusters_ms + beside_ms - side_by_side_ms).max(0.0);
-        if let Some((h, tracked)) = earlier {
-            emit(h, tracked, &mut out, total, &mut on_frame)?;
+        let (planes_ms, clusters_ms) = segmented.times();
+        let overlap_ms = (planes_ms + clusters_ms + beside_ms - side_by_side_ms).max(0.0);
+        if let Some((h, detections, tracked, _)) = earlier {
+            emit(h, &detections, tracked, &mut out, total, &mut on_frame)?;
         }
         held = Some(Held {
             frame: k,
             cloud,
-            detections,
+            segmented: Some(segmented),
             read_ms,
             ego_ms,
             predict_ms,
             overlap_ms,
         });
     }
-    if let Some(h) = held.take() {
-        let tracked = tracker.update_with(h.frame, &h.detections)?;
-        emit(h, tracked, &mut out, total, &mut on_frame)?;
+    if let Some(mut h) = held.take() {
+        let detections = h.finish(config)?;
+        let tracked = tracker.update_with(h.frame, &detections)?;
+        emit(h, &detections, tracked, &mut out, total, &mut on_frame)?;
     }
     let mut summary = TrackingSummary::of(&out);
     summary.ego_fallbacks = odometry
