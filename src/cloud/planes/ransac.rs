@@ -126,14 +126,25 @@ pub(super) fn one_round(
         return None;
     }
 
-    // 4. MSSE threshold, inliers, refit; twice.
+    // 4. MSSE threshold, inliers, refit; twice. The first refit only turns the drawn plane
+    // into a fitted one: a pool of more than twice `REFINE_POINTS` points makes it on an
+    // evenly strided part of the pool; the second is made on the whole pool.
+    let stride = (active.len() / REFINE_POINTS).max(1);
+    let part: Vec<u32> = if stride > 1 {
+        active.iter().step_by(stride).copied().collect()
+    } else {
+        Vec::new()
+    };
     let mut plane = hyps[best];
     let mut fitted: Option<Plane> = None;
     let mut inliers: Vec<u32> = Vec::new();
-    for _ in 0..2 {
+    for (pool, least) in [
+        (if stride > 1 { &part[..] } else { active }, config.min_points.div_ceil(stride)),
+        (active, config.min_points),
+    ] {
         // The threshold never exceeds `max_threshold`, and residuals above it do not enter the
         // MSSE scale: only the points within it are kept, in pool order.
-        let (near, residuals) = near_points(pts, active, &plane, config.max_threshold);
+        let (near, residuals) = near_points(pts, pool, &plane, config.max_threshold);
         let tau = msse_threshold(&residuals, config);
         inliers = near
             .iter()
@@ -141,7 +152,7 @@ pub(super) fn one_round(
             .filter(|(_, &r)| r <= tau)
             .map(|(&i, _)| i)
             .collect();
-        if inliers.len() < config.min_points {
+        if inliers.len() < least {
             return None;
         }
         let p = fit_chunked(pts, &inliers)?;
@@ -150,6 +161,10 @@ pub(super) fn one_round(
     }
     fitted.map(|p| (p, inliers))
 }
+
+/// Above twice this many points in its pool, a round makes its first refit on an evenly
+/// strided part of the pool of about this many points (see [`one_round`]).
+const REFINE_POINTS: usize = 30_000;
 
 /// Points as three contiguous coordinate columns, for vectorised residual counts.
 struct Columns {
