@@ -100,11 +100,14 @@ impl PointCloud {
 
     /// Builds a cloud from interleaved `[x, y, z, intensity]` records (the KITTI `.bin` layout).
     pub fn from_records(records: &[[f32; 4]]) -> Self {
-        let mut cloud = Self::with_capacity(records.len());
-        for r in records {
-            cloud.push(r[0], r[1], r[2], r[3]);
+        // One column at a time: plain maps, without a capacity check per value.
+        let column = |k: usize| records.iter().map(|r| r[k]).collect::<Vec<f32>>();
+        PointCloud {
+            x: column(0),
+            y: column(1),
+            z: column(2),
+            intensity: column(3),
         }
-        cloud
     }
 
     /// Number of points.
