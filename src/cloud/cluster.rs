@@ -337,10 +337,8 @@ impl CellBox {
             hi: [f32::NEG_INFINITY; 3],
         };
         for p in points {
-            for a in 0..3 {
-                b.lo[a] = b.lo[a].min(p[a]);
-                b.hi[a] = b.hi[a].max(p[a]);
-            }
+            b.lo = std::array::from_fn(|a| b.lo[a].min(p[a]));
+            b.hi = std::array::from_fn(|a| b.hi[a].max(p[a]));
         }
         b
     }
@@ -348,7 +346,11 @@ impl CellBox {
     /// Squared distance between the boxes (a lower bound of every point pair's, as the point
     /// test computes it).
     fn gap2(&self, other: &CellBox) -> f32 {
-        let g = |a: usize| (other.lo[a] - self.hi[a]).max(self.lo[a] - other.hi[a]).max(0.0);
+        let g = |a: usize| {
+            (other.lo[a] - self.hi[a])
+                .max(self.lo[a] - other.hi[a])
+                .max(0.0)
+        };
         let (gx, gy, gz) = (g(0), g(1), g(2));
         gx * gx + gy * gy + gz * gz
     }
@@ -674,5 +676,32 @@ mod tests {
         assert!(euclidean_clusters(&PointCloud::new(), &p)
             .unwrap()
             .is_empty());
+    }
+
+    proptest::proptest! {
+        /// The cell boxes' bounds hold for the squared distance of every point pair as the
+        /// point test computes it (f32, the same order): gap² ≤ d² ≤ span², and a point's gap
+        /// to the other box ≤ d².
+        #[test]
+        fn cell_box_bounds_hold_for_every_pair(
+            a in proptest::collection::vec(proptest::array::uniform3(-3.0f32..3.0), 1..12),
+            b in proptest::collection::vec(proptest::array::uniform3(-3.0f32..3.0), 1..12),
+            shift in proptest::array::uniform3(-1.0f32..1.0),
+        ) {
+            let b: Vec<[f32; 3]> = b
+                .iter()
+                .map(|q| [q[0] * 0.1 + shift[0], q[1] * 0.1 + shift[1], q[2] * 0.1 + shift[2]])
+                .collect();
+            let (ba, bb) = (CellBox::of(&a), CellBox::of(&b));
+            for p in &a {
+                for q in &b {
+                    let (dx, dy, dz) = (p[0] - q[0], p[1] - q[1], p[2] - q[2]);
+                    let d2 = dx * dx + dy * dy + dz * dz;
+                    proptest::prop_assert!(ba.gap2(&bb) <= d2);
+                    proptest::prop_assert!(d2 <= ba.span2(&bb));
+                    proptest::prop_assert!(bb.gap2_to(p) <= d2);
+                }
+            }
+        }
     }
 }

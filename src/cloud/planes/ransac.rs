@@ -139,7 +139,10 @@ pub(super) fn one_round(
     let mut fitted: Option<Plane> = None;
     let mut inliers: Vec<u32> = Vec::new();
     for (pool, least) in [
-        (if stride > 1 { &part[..] } else { active }, config.min_points.div_ceil(stride)),
+        (
+            if stride > 1 { &part[..] } else { active },
+            config.min_points.div_ceil(stride),
+        ),
         (active, config.min_points),
     ] {
         // The threshold never exceeds `max_threshold`, and residuals above it do not enter the

@@ -151,7 +151,11 @@ impl Segmented {
 
     /// Every cluster's oriented box and class evidence ([`shape_of`]), in parallel; their
     /// time is added to `clusters_ms`.
-    pub(super) fn finish(self, cloud: &PointCloud, config: &TrackingConfig) -> Result<FrameDetections> {
+    pub(super) fn finish(
+        self,
+        cloud: &PointCloud,
+        config: &TrackingConfig,
+    ) -> Result<FrameDetections> {
         let start = Instant::now();
         let Segmented {
             mut detections,
@@ -164,14 +168,14 @@ impl Segmented {
                 .then(|| -(g.normal.x * x + g.normal.y * y + g.offset) / g.normal.z)
         };
         let model = ClassModel::default();
-        detections
-            .clusters
-            .par_iter_mut()
-            .try_for_each_init(BoxScratch::default, |scratch, d| -> Result<()> {
+        detections.clusters.par_iter_mut().try_for_each_init(
+            BoxScratch::default,
+            |scratch, d| -> Result<()> {
                 let z0 = ground_z(d.centroid[0], d.centroid[1]).or(Some(-c.sensor_height));
                 d.shape = Some(shape_of(cloud, &d.indices, z0, &model, scratch)?);
                 Ok(())
-            })?;
+            },
+        )?;
         detections.clusters_ms += start.elapsed().as_secs_f64() * 1e3;
         Ok(detections)
     }

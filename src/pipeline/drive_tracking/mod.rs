@@ -28,8 +28,8 @@ pub mod road_users;
 pub mod source;
 pub mod tracker;
 
-use detect::{segment_here, Segmented};
 pub use detect::{detect_objects, ClusterDetection, FrameDetections, WallDetection};
+use detect::{segment_here, Segmented};
 pub use export::point_labels;
 #[cfg(feature = "plot")]
 pub use export::{drive_plot, frame_plot};
