@@ -173,9 +173,9 @@ fn tracker_group(
         det.walls.len(),
         det.clusters.len()
     );
-    let mut tracker = DriveTracker::new(&config, 1).expect("default config is valid");
     let pose = Isometry3::identity();
-    // One frame counter for all three benches, so that time never goes backwards.
+    // Each bench steps a tracker of its own, started by the same five frames, so that its
+    // time does not depend on which benches ran before it (and for how many iterations).
     let k = std::cell::Cell::new(0usize);
     let step = |tracker: &mut DriveTracker, det: &FrameDetections| {
         let f = tracker
@@ -184,12 +184,19 @@ fn tracker_group(
         k.set(k.get() + 1);
         f
     };
-    for _ in 0..5 {
-        step(&mut tracker, &det);
-    }
+    let started = || {
+        k.set(0);
+        let mut tracker = DriveTracker::new(&config, 1).expect("default config is valid");
+        for _ in 0..5 {
+            step(&mut tracker, &det);
+        }
+        tracker
+    };
+    let mut tracker = started();
     g.bench_function(format!("filter_update{suffix}"), |b| {
         b.iter(|| step(&mut tracker, &det))
     });
+    let mut tracker = started();
     g.bench_function(format!("whole{suffix}"), |b| {
         b.iter(|| {
             let cloud = read_kitti_bin(path).unwrap();
@@ -198,6 +205,7 @@ fn tracker_group(
         })
     });
     // What `track` does: the filter predicts while the scan is segmented.
+    let mut tracker = started();
     g.bench_function(format!("whole_predict_beside{suffix}"), |b| {
         b.iter(|| {
             let cloud = read_kitti_bin(path).unwrap();
