@@ -23,7 +23,6 @@ use crate::filter::{
     ClutterModel, ConstantSurvival, DetectionModel, MeasurementModel, StepContext, SurvivalModel,
     TrackSummary, TransitionModel,
 };
-use crate::numerics::exp::exp_in_place;
 use crate::rng::{stream, FilterRng};
 use nalgebra::Isometry3;
 use rand::Rng;
@@ -779,42 +778,28 @@ impl LmbFilter {
                 }
                 let zs: Vec<&[f64]> = gated.iter().map(|&j| z.get(j)).collect();
                 let mut scaled_g = vec![vec![0.0; n]; zs.len()];
-                m.measurement
-                    .log_likelihood_batch(&zs, p, ctx, &mut scaled_g);
-                // Each row's largest log-likelihood, and the first NaN or +∞ in any row.
-                let mut tops = Vec::with_capacity(scaled_g.len());
-                for (g, &j) in scaled_g.iter().zip(&gated) {
-                    let (mut top, mut bad) = (f64::NEG_INFINITY, false);
-                    for &v in g {
-                        bad |= v.is_nan() || v == f64::INFINITY;
-                        top = top.max(v);
-                    }
-                    if bad {
-                        let i = g
-                            .iter()
-                            .position(|v| v.is_nan() || *v == f64::INFINITY)
-                            .unwrap_or(0);
-                        return Err(Error::invalid(
-                            format!("update of step {step}"),
-                            format!(
-                                "the measurement model's log-likelihood of measurement {j} for \
-                                 particle {i} of track {} is {}",
-                                t.label, g[i]
-                            ),
-                        ));
-                    }
-                    tops.push(top);
+                let mut tops = vec![f64::NEG_INFINITY; zs.len()];
+                if let Err(f) =
+                    m.measurement
+                        .relative_likelihood_batch(&zs, p, ctx, &mut scaled_g, &mut tops)
+                {
+                    return Err(Error::invalid(
+                        format!("update of step {step}"),
+                        format!(
+                            "the measurement model's log-likelihood of measurement {} for \
+                             particle {} of track {} is {}",
+                            gated.get(f.measurement).copied().unwrap_or(f.measurement),
+                            f.particle,
+                            t.label,
+                            f.value
+                        ),
+                    ));
                 }
                 let mut pairs = Vec::with_capacity(zs.len());
-                for ((mut g, measurement), top) in scaled_g.into_iter().zip(gated).zip(tops) {
-                    // log-sum-exp: shift by the largest log-likelihood before leaving the log
-                    // domain, so likelihoods that would underflow keep their ratios.
+                for ((g, measurement), top) in scaled_g.into_iter().zip(gated).zip(tops) {
                     if !top.is_finite() {
                         continue; // no particle can explain it
                     }
-                    // Relative likelihoods below e^−707 ≈ 1e-307 count as 0.
-                    g.iter_mut().for_each(|v| *v -= top);
-                    exp_in_place(&mut g);
                     let sum: f64 = g.iter().zip(w).zip(&pd).map(|((g, w), d)| g * w * d).sum();
                     if sum > 0.0 {
                         pairs.push(GatedPair {

@@ -40,8 +40,8 @@ pub use lmb::{
 pub use measurements::Measurements;
 pub use merge::{MergeDistance, ScaledDistance};
 pub use model::{
-    ClutterModel, DetectionModel, MeasurementModel, StepContext, SurvivalModel, TrackSummary,
-    TransitionModel,
+    relative_from_logs, ClutterModel, DetectionModel, LikelihoodFault, MeasurementModel,
+    StepContext, SurvivalModel, TrackSummary, TransitionModel,
 };
 pub use particles::{Jitter, ParticleSet};
 pub use smoothing::FixedLagSmoother;

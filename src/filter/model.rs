@@ -106,6 +106,49 @@ pub trait SurvivalModel: Send + Sync {
     fn survival_probability(&self, particles: &ParticleSet, ctx: &StepContext, out: &mut [f64]);
 }
 
+/// A log-likelihood that is NaN or +∞: measurement `measurement` of the batch, particle
+/// `particle`, its value.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct LikelihoodFault {
+    /// Index of the measurement in the batch.
+    pub measurement: usize,
+    /// Index of the particle.
+    pub particle: usize,
+    /// The offending log-likelihood.
+    pub value: f64,
+}
+
+/// Rows of log-likelihoods (`rows[j]`) turned into likelihoods relative to each row's largest,
+/// with that largest in `tops[j]`; a row whose largest is −∞ is left as it is. The first NaN
+/// or +∞ is a [`LikelihoodFault`] (rows before it are converted, the rest are not).
+pub fn relative_from_logs(rows: &mut [Vec<f64>], tops: &mut [f64]) -> Result<(), LikelihoodFault> {
+    for (j, (g, top_out)) in rows.iter_mut().zip(tops.iter_mut()).enumerate() {
+        let (mut top, mut bad) = (f64::NEG_INFINITY, false);
+        for &v in g.iter() {
+            bad |= v.is_nan() || v == f64::INFINITY;
+            top = top.max(v);
+        }
+        if bad {
+            let i = g
+                .iter()
+                .position(|v| v.is_nan() || *v == f64::INFINITY)
+                .unwrap_or(0);
+            return Err(LikelihoodFault {
+                measurement: j,
+                particle: i,
+                value: g[i],
+            });
+        }
+        *top_out = top;
+        if top.is_finite() {
+            // Relative likelihoods below e^−707 ≈ 1e-307 count as 0.
+            g.iter_mut().for_each(|v| *v -= top);
+            crate::numerics::exp::exp_in_place(g);
+        }
+    }
+    Ok(())
+}
+
 /// The single-object likelihood g(z | x).
 pub trait MeasurementModel: Send + Sync {
     /// Dimension of one measurement vector.
@@ -132,6 +175,26 @@ pub trait MeasurementModel: Send + Sync {
         for (z, o) in zs.iter().zip(out.iter_mut()) {
             self.log_likelihood(z, particles, ctx, o);
         }
+    }
+    /// The likelihoods relative to the largest, for several measurements at once: `out[j][i]
+    /// = g(zs[j] | xᵢ) / maxₖ g(zs[j] | xₖ)` and `tops[j] = ln maxₖ g(zs[j] | xₖ)` (−∞ when
+    /// no particle can explain `zs[j]`; its row is then left unspecified). What the update
+    /// needs, without leaving the log domain too early: likelihoods that would underflow keep
+    /// their ratios. The default takes [`MeasurementModel::log_likelihood_batch`] and shifts
+    /// each row by its maximum before exponentiating; models whose likelihood has a closed
+    /// form for the ratio override it to skip the logarithms. A NaN or +∞ log-likelihood is
+    /// returned as the first such [`LikelihoodFault`] (the filter turns it into an error
+    /// naming the track).
+    fn relative_likelihood_batch(
+        &self,
+        zs: &[&[f64]],
+        particles: &ParticleSet,
+        ctx: &StepContext,
+        out: &mut [Vec<f64>],
+        tops: &mut [f64],
+    ) -> Result<(), LikelihoodFault> {
+        self.log_likelihood_batch(zs, particles, ctx, out);
+        relative_from_logs(out, tops)
     }
     /// A cheap test whether `z` could come from a track summarised by `track`; pairs that fail
     /// are never evaluated by [`MeasurementModel::log_likelihood`]. The default admits all.
@@ -205,6 +268,16 @@ impl<T: MeasurementModel + ?Sized> MeasurementModel for Box<T> {
         out: &mut [Vec<f64>],
     ) {
         (**self).log_likelihood_batch(zs, particles, ctx, out)
+    }
+    fn relative_likelihood_batch(
+        &self,
+        zs: &[&[f64]],
+        particles: &ParticleSet,
+        ctx: &StepContext,
+        out: &mut [Vec<f64>],
+        tops: &mut [f64],
+    ) -> Result<(), LikelihoodFault> {
+        (**self).relative_likelihood_batch(zs, particles, ctx, out, tops)
     }
     fn gate(&self, z: &[f64], track: &TrackSummary, ctx: &StepContext) -> bool {
         (**self).gate(z, track, ctx)

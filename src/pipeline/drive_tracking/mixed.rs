@@ -49,7 +49,9 @@
 //! [`LmbFilter`]: crate::filter::LmbFilter
 
 use crate::error::{ensure_positive, ensure_probability, Error, Result};
-use crate::filter::{BirthSampler, MergeDistance, ParticleSet, ScaledDistance};
+use crate::filter::{
+    relative_from_logs, BirthSampler, LikelihoodFault, MergeDistance, ParticleSet, ScaledDistance,
+};
 use crate::filter::{
     ClutterModel, DetectionModel, MeasurementModel, StepContext, TrackSummary, TransitionModel,
 };
@@ -407,6 +409,83 @@ impl MeasurementModel for MixedMeasurement {
         }
     }
 
+    /// Box centres under the contaminated Gaussian in closed form: with a(d²) and b(d²) the
+    /// logarithms of the two weighted terms, the largest likelihood is that of the smallest
+    /// squared distance (both terms fall with d²), top = ln(e^a + e^b) there, and a
+    /// particle's relative likelihood is e^(a − top) + e^(b − top): two exponentials a
+    /// particle instead of the log path's exponential, logarithm and exponential. The same
+    /// values up to rounding. Walls, and clusters without the outlier term, take the log path.
+    fn relative_likelihood_batch(
+        &self,
+        zs: &[&[f64]],
+        particles: &ParticleSet,
+        ctx: &StepContext,
+        out: &mut [Vec<f64>],
+        tops: &mut [f64],
+    ) -> std::result::Result<(), LikelihoodFault> {
+        let n = particles.len();
+        let kind = kind_of_set(particles);
+        let (weight, scale) = self.cluster_outliers;
+        if kind != Some(ObjectKind::Cluster) || weight == 0.0 {
+            self.log_likelihood_batch(zs, particles, ctx, out);
+            return relative_from_logs(out, tops);
+        }
+        let inv = Self::world_to_sensor(ctx);
+        let r = inv.rotation.to_rotation_matrix().into_inner();
+        let t = inv.translation.vector;
+        let s2 = self.cluster_sigma * self.cluster_sigma;
+        let w2 = s2 * scale * scale;
+        let ln_normal = |var: f64| -1.5 * (2.0 * std::f64::consts::PI * var).ln();
+        let (norm_a, half_a) = (ln_normal(s2) + (1.0 - weight).ln(), 0.5 / s2);
+        let (norm_b, half_b) = (ln_normal(w2) + weight.ln(), 0.5 / w2);
+        let (x, y, zc) = (
+            &particles.component(0)[..n],
+            &particles.component(2)[..n],
+            &particles.component(4)[..n],
+        );
+        let mut d2 = vec![0.0; n];
+        let mut second = vec![0.0; n];
+        for ((z, row), top_out) in zs.iter().zip(out.iter_mut()).zip(tops.iter_mut()) {
+            *top_out = f64::NEG_INFINITY;
+            if kind_of_measurement(z) != kind {
+                continue;
+            }
+            let c = SensorOffset {
+                r: [
+                    [r[(0, 0)], r[(0, 1)], r[(0, 2)]],
+                    [r[(1, 0)], r[(1, 1)], r[(1, 2)]],
+                    [r[(2, 0)], r[(2, 1)], r[(2, 2)]],
+                ],
+                t: [t.x, t.y, t.z],
+                z: [z[0], z[1], z[2]],
+            };
+            // A particle whose distance is NaN explains nothing (as on the log path).
+            let mut nearest = f64::INFINITY;
+            for (((d, &a), &b), &h) in d2.iter_mut().zip(x).zip(y).zip(zc) {
+                let v = c.squared([a, b, h]);
+                *d = if v.is_nan() { f64::INFINITY } else { v };
+                nearest = nearest.min(*d);
+            }
+            if !nearest.is_finite() {
+                continue;
+            }
+            let (a, b) = (norm_a - half_a * nearest, norm_b - half_b * nearest);
+            let top = a.max(b) + (a.min(b) - a.max(b)).exp().ln_1p();
+            *top_out = top;
+            let row = &mut row[..n];
+            for ((o, s), &d) in row.iter_mut().zip(second.iter_mut()).zip(&d2) {
+                *o = (norm_a - top) - half_a * d;
+                *s = (norm_b - top) - half_b * d;
+            }
+            exp_in_place(row);
+            exp_in_place(&mut second);
+            for (o, s) in row.iter_mut().zip(&second) {
+                *o += s;
+            }
+        }
+        Ok(())
+    }
+
     fn gate(&self, z: &[f64], track: &TrackSummary, ctx: &StepContext) -> bool {
         let track_kind = track
             .mean
@@ -658,6 +737,57 @@ mod tests {
         // one σ off along the sensor's y axis costs ½
         m.log_likelihood(&cluster_measurement([5.0, 0.5, 0.0]), &set, &c, &mut out);
         assert!((out[0] - (peak - 0.5)).abs() < 1e-9);
+    }
+
+    /// The closed-form relative likelihoods of box centres are the mixture written out by hand
+    /// relative to its largest value over the particles, with that largest as `top`; a
+    /// particle whose state is NaN explains nothing, a wall measurement nothing of a cluster
+    /// track, and a moved sensor is accounted for.
+    #[test]
+    fn relative_cluster_likelihoods_match_the_mixture_by_hand() {
+        let pose = Isometry3::new(Vector3::new(2.0, -1.0, 0.3), Vector3::new(0.0, 0.0, 0.4));
+        let c = ctx(pose);
+        let offsets = [0.2, 0.7, 1.0, 2.5, 8.0, 40.0, f64::NAN];
+        let rows: Vec<Vec<f64>> = offsets
+            .iter()
+            .map(|&d| vec![7.0 + d, 0.0, 3.0, 0.0, -1.0, 0.0, 1.0])
+            .collect();
+        let set = ParticleSet::from_rows(&rows, &[1.0; 7]).unwrap();
+        let m = MixedMeasurement::new(PlaneMeasurement::new(0.05, 0.2).unwrap(), 0.3, 4.0)
+            .unwrap()
+            .with_cluster_outliers(0.1, 4.0)
+            .unwrap();
+        // The measurement: the world point (7, 3, −1) seen from the sensor.
+        let seen = pose.inverse() * nalgebra::Point3::new(7.0, 3.0, -1.0);
+        let z = cluster_measurement([seen.x, seen.y, seen.z]);
+        let wall = plane_measurement([-1.0, 0.0, 0.0, 10.0]);
+        let mut out = vec![vec![0.0; 7]; 2];
+        let mut tops = [0.0; 2];
+        m.relative_likelihood_batch(&[&z, &wall], &set, &c, &mut out, &mut tops)
+            .unwrap();
+        let n3 = |d: f64, s: f64| {
+            (-0.5 * d * d / (s * s)).exp() / (2.0 * std::f64::consts::PI * s * s).powf(1.5)
+        };
+        let g = |d: f64| 0.9 * n3(d, 0.3) + 0.1 * n3(d, 1.2);
+        assert!((tops[0] - g(0.2).ln()).abs() < 1e-9, "{}", tops[0]);
+        for (k, &d) in offsets.iter().enumerate() {
+            let want = if d.is_nan() { 0.0 } else { g(d) / g(0.2) };
+            assert!(
+                (out[0][k] - want).abs() <= 1e-12 * want.max(1e-300) + 1e-300,
+                "d = {d}: {} vs {want}",
+                out[0][k]
+            );
+        }
+        assert_eq!(tops[1], f64::NEG_INFINITY);
+        // The log path's rows, exponentiated relative to their largest, agree.
+        let mut logs = vec![vec![0.0; 7]; 1];
+        m.log_likelihood_batch(&[&z], &set, &c, &mut logs);
+        let mut log_tops = [0.0];
+        relative_from_logs(&mut logs, &mut log_tops).unwrap();
+        assert!((log_tops[0] - tops[0]).abs() < 1e-12);
+        for (a, b) in logs[0].iter().zip(&out[0]) {
+            assert!((a - b).abs() <= 1e-12 * a.abs().max(1e-300), "{a} vs {b}");
+        }
     }
 
     #[test]
