@@ -313,9 +313,28 @@ impl MixedMeasurement {
             .map(|p| p.inverse())
             .unwrap_or_else(nalgebra::Isometry3::identity)
     }
+
+    /// The two weighted terms of the box centres' contaminated Gaussian as (ln of weight ×
+    /// normalisation, 1 / (2 variance)): the core of standard deviation σ and the outliers'
+    /// of kσ, so a term's logarithm is `norm − half · d²`.
+    fn cluster_terms(&self) -> [(f64, f64); 2] {
+        let (weight, scale) = self.cluster_outliers;
+        let s2 = self.cluster_sigma * self.cluster_sigma;
+        let w2 = s2 * scale * scale;
+        [
+            (ln_normal3(s2) + (1.0 - weight).ln(), 0.5 / s2),
+            (ln_normal3(w2) + weight.ln(), 0.5 / w2),
+        ]
+    }
+}
+
+/// ln of the normalisation of an isotropic 3-D Gaussian of variance `var`.
+fn ln_normal3(var: f64) -> f64 {
+    -1.5 * (2.0 * std::f64::consts::PI * var).ln()
 }
 
 /// A particle's world position seen from the sensor, less a measured position: R p + t − z.
+#[derive(Copy, Clone)]
 struct SensorOffset {
     r: [[f64; 3]; 3],
     t: [f64; 3],
@@ -323,6 +342,30 @@ struct SensorOffset {
 }
 
 impl SensorOffset {
+    /// The step's world → sensor transform, less the measured position `z`.
+    fn new(ctx: &StepContext, z: &[f64]) -> Self {
+        let inv = MixedMeasurement::world_to_sensor(ctx);
+        let r = inv.rotation.to_rotation_matrix().into_inner();
+        let t = inv.translation.vector;
+        SensorOffset {
+            r: [
+                [r[(0, 0)], r[(0, 1)], r[(0, 2)]],
+                [r[(1, 0)], r[(1, 1)], r[(1, 2)]],
+                [r[(2, 0)], r[(2, 1)], r[(2, 2)]],
+            ],
+            t: [t.x, t.y, t.z],
+            z: [z[0], z[1], z[2]],
+        }
+    }
+
+    /// The same transform less another measured position.
+    fn toward(&self, z: &[f64]) -> Self {
+        SensorOffset {
+            z: [z[0], z[1], z[2]],
+            ..*self
+        }
+    }
+
     /// |R p + t − z|², summed in a fixed order (the same value on every path).
     #[inline(always)]
     fn squared(&self, p: [f64; 3]) -> f64 {
@@ -357,30 +400,17 @@ impl MeasurementModel for MixedMeasurement {
             return;
         }
         // Cluster: s = R p + t, Gaussian around z per axis.
-        let inv = Self::world_to_sensor(ctx);
-        let r = inv.rotation.to_rotation_matrix().into_inner();
-        let t = inv.translation.vector;
-        let s2 = self.cluster_sigma * self.cluster_sigma;
-        let ln_normal = |var: f64| -1.5 * (2.0 * std::f64::consts::PI * var).ln();
         let (x, y, zc) = (
             &particles.component(0)[..n],
             &particles.component(2)[..n],
             &particles.component(4)[..n],
         );
-        let c = SensorOffset {
-            r: [
-                [r[(0, 0)], r[(0, 1)], r[(0, 2)]],
-                [r[(1, 0)], r[(1, 1)], r[(1, 2)]],
-                [r[(2, 0)], r[(2, 1)], r[(2, 2)]],
-            ],
-            t: [t.x, t.y, t.z],
-            z: [z[0], z[1], z[2]],
-        };
-        let (weight, scale) = self.cluster_outliers;
+        let c = SensorOffset::new(ctx, z);
         let out = &mut out[..n];
         let points = || x.iter().zip(y).zip(zc).map(|((&a, &b), &c)| [a, b, c]);
-        if weight == 0.0 {
-            let (norm, half_inv) = (ln_normal(s2), 0.5 / s2);
+        if self.cluster_outliers.0 == 0.0 {
+            let s2 = self.cluster_sigma * self.cluster_sigma;
+            let (norm, half_inv) = (ln_normal3(s2), 0.5 / s2);
             for (o, p) in out.iter_mut().zip(points()) {
                 let l = norm - half_inv * c.squared(p);
                 *o = if l.is_nan() { f64::NEG_INFINITY } else { l };
@@ -390,9 +420,7 @@ impl MeasurementModel for MixedMeasurement {
         // ln((1 − ε) N(d; σ) + ε N(d; kσ)) = b + ln(1 + e^(a − b)), a and b the two terms'
         // logarithms; a − b ≤ ln((1 − ε)/ε) + 3 ln k, so e^(a − b) stays finite. Three passes
         // over the particles, the transcendental ones on vector lanes.
-        let w2 = s2 * scale * scale;
-        let (norm_a, half_a) = (ln_normal(s2) + (1.0 - weight).ln(), 0.5 / s2);
-        let (norm_b, half_b) = (ln_normal(w2) + weight.ln(), 0.5 / w2);
+        let [(norm_a, half_a), (norm_b, half_b)] = self.cluster_terms();
         // The squared distances once, for the first pass and the last.
         let d2: Vec<f64> = points().map(|p| c.squared(p)).collect();
         for (o, &d) in out.iter_mut().zip(&d2) {
@@ -425,19 +453,12 @@ impl MeasurementModel for MixedMeasurement {
     ) -> std::result::Result<(), LikelihoodFault> {
         let n = particles.len();
         let kind = kind_of_set(particles);
-        let (weight, scale) = self.cluster_outliers;
-        if kind != Some(ObjectKind::Cluster) || weight == 0.0 {
+        if kind != Some(ObjectKind::Cluster) || self.cluster_outliers.0 == 0.0 {
             self.log_likelihood_batch(zs, particles, ctx, out);
             return relative_from_logs(out, tops);
         }
-        let inv = Self::world_to_sensor(ctx);
-        let r = inv.rotation.to_rotation_matrix().into_inner();
-        let t = inv.translation.vector;
-        let s2 = self.cluster_sigma * self.cluster_sigma;
-        let w2 = s2 * scale * scale;
-        let ln_normal = |var: f64| -1.5 * (2.0 * std::f64::consts::PI * var).ln();
-        let (norm_a, half_a) = (ln_normal(s2) + (1.0 - weight).ln(), 0.5 / s2);
-        let (norm_b, half_b) = (ln_normal(w2) + weight.ln(), 0.5 / w2);
+        let [(norm_a, half_a), (norm_b, half_b)] = self.cluster_terms();
+        let offset = SensorOffset::new(ctx, &[0.0; 3]);
         let (x, y, zc) = (
             &particles.component(0)[..n],
             &particles.component(2)[..n],
@@ -450,15 +471,7 @@ impl MeasurementModel for MixedMeasurement {
             if kind_of_measurement(z) != kind {
                 continue;
             }
-            let c = SensorOffset {
-                r: [
-                    [r[(0, 0)], r[(0, 1)], r[(0, 2)]],
-                    [r[(1, 0)], r[(1, 1)], r[(1, 2)]],
-                    [r[(2, 0)], r[(2, 1)], r[(2, 2)]],
-                ],
-                t: [t.x, t.y, t.z],
-                z: [z[0], z[1], z[2]],
-            };
+            let c = offset.toward(z);
             // A particle whose distance is NaN explains nothing (as on the log path).
             let mut nearest = f64::INFINITY;
             for (((d, &a), &b), &h) in d2.iter_mut().zip(x).zip(y).zip(zc) {
