@@ -202,20 +202,11 @@ pub fn extract_planes(
         } else {
             0.0
         };
-        let Some((plane, inliers)) = one_round(&pts, &active, &active, min_tilt, config, rng)
+        let Some((plane, inliers, rest)) = one_round(&pts, &active, &active, min_tilt, config, rng)
         else {
             break;
         };
-        // `inliers` is a subsequence of `active`: remove it in one merge walk.
-        let mut next = inliers.iter().peekable();
-        active.retain(|i| {
-            if next.peek() == Some(&i) {
-                next.next();
-                false
-            } else {
-                true
-            }
-        });
+        active = rest;
         if first_ground.is_none() && ground_like(&plane) {
             let g = PlaneF32::new(&plane);
             let clearance = config.ground_clearance as f32;

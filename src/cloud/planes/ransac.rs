@@ -40,8 +40,9 @@ impl PlaneF32 {
     }
 }
 
-/// One RANSAC round on the pool `active`: the refined plane and its inliers (local indices),
-/// or `None` when no plane with `min_points` inliers is found.
+/// One RANSAC round on the pool `active` (ascending local indices): the refined plane, its
+/// inliers and the rest of `active` (both ascending), or `None` when no plane with
+/// `min_points` inliers is found.
 pub(super) fn one_round(
     pts: &[[f32; 3]],
     active: &[u32],
@@ -49,7 +50,7 @@ pub(super) fn one_round(
     min_tilt: f64,
     config: &PlaneConfig,
     rng: &mut FilterRng,
-) -> Option<(Plane, Vec<u32>)> {
+) -> Option<(Plane, Vec<u32>, Vec<u32>)> {
     // 1. Subsample (with replacement when the pool is small) and voxel grid.
     let m = config.score_sample.min(pool.len());
     let sample: Vec<[f32; 3]> = if m == pool.len() {
@@ -138,31 +139,40 @@ pub(super) fn one_round(
     let mut plane = hyps[best];
     let mut fitted: Option<Plane> = None;
     let mut inliers: Vec<u32> = Vec::new();
-    for (pool, least) in [
+    let mut rest: Vec<u32> = Vec::new();
+    for (pool, least, last) in [
         (
             if stride > 1 { &part[..] } else { active },
             config.min_points.div_ceil(stride),
+            false,
         ),
-        (active, config.min_points),
+        (active, config.min_points, true),
     ] {
         // The threshold never exceeds `max_threshold`, and residuals above it do not enter the
-        // MSSE scale: only the points within it are kept, in pool order.
-        let (near, residuals) = near_points(pts, pool, &plane, config.max_threshold);
+        // MSSE scale: only the points within it are kept, in pool order (and, on the whole
+        // pool's pass, the others apart: they stay in the pool whatever the threshold).
+        let (near, residuals, far) = near_points(pts, pool, &plane, config.max_threshold, last);
         let tau = msse_threshold(&residuals, config);
-        inliers = near
-            .iter()
-            .zip(&residuals)
-            .filter(|(_, &r)| r <= tau)
-            .map(|(&i, _)| i)
-            .collect();
+        inliers = Vec::with_capacity(near.len());
+        let mut left = Vec::new();
+        for (&i, &r) in near.iter().zip(&residuals) {
+            if r <= tau {
+                inliers.push(i);
+            } else if last {
+                left.push(i);
+            }
+        }
         if inliers.len() < least {
             return None;
+        }
+        if last {
+            rest = merge_ascending(far, &left);
         }
         let p = fit_chunked(pts, &inliers)?;
         plane = PlaneF32::new(&p);
         fitted = Some(p);
     }
-    fitted.map(|p| (p, inliers))
+    fitted.map(|p| (p, inliers, rest))
 }
 
 /// Above twice this many points in its pool, a round makes its first refit on an evenly
@@ -219,9 +229,16 @@ impl Columns {
 }
 
 /// The points of `idx` whose absolute residual to `plane` is at most `max` (compared in f64,
-/// as [`msse_threshold`] does), with those residuals, both in the order of `idx`.
-fn near_points(pts: &[[f32; 3]], idx: &[u32], plane: &PlaneF32, max: f64) -> (Vec<u32>, Vec<f32>) {
-    let parts: Vec<(Vec<u32>, Vec<f32>)> = idx
+/// as [`msse_threshold`] does), with those residuals, both in the order of `idx`; with
+/// `far`, also the other points of `idx`, in its order (else an empty list).
+fn near_points(
+    pts: &[[f32; 3]],
+    idx: &[u32],
+    plane: &PlaneF32,
+    max: f64,
+    far: bool,
+) -> (Vec<u32>, Vec<f32>, Vec<u32>) {
+    let parts: Vec<(Vec<u32>, Vec<f32>, Vec<u32>)> = idx
         .par_chunks(CHUNK)
         .map(|ix| {
             let mut all = [0.0f32; CHUNK];
@@ -229,28 +246,63 @@ fn near_points(pts: &[[f32; 3]], idx: &[u32], plane: &PlaneF32, max: f64) -> (Ve
                 *r = plane.residual(&pts[i as usize]);
             }
             // Branch-free compaction: every point is written at the next free place, which
-            // only a near one keeps.
+            // only a near one keeps (and, in the other list, only a far one).
             let mut near = vec![0u32; ix.len()];
             let mut res = vec![0.0f32; ix.len()];
             let mut kept = 0;
-            for (&r, &i) in all.iter().zip(ix) {
-                near[kept] = i;
-                res[kept] = r;
-                kept += (r as f64 <= max) as usize;
+            let mut others = Vec::new();
+            if far {
+                others = vec![0u32; ix.len()];
+                let mut left = 0;
+                for (&r, &i) in all.iter().zip(ix) {
+                    let is_near = r as f64 <= max;
+                    near[kept] = i;
+                    res[kept] = r;
+                    others[left] = i;
+                    kept += is_near as usize;
+                    left += !is_near as usize;
+                }
+                others.truncate(left);
+            } else {
+                for (&r, &i) in all.iter().zip(ix) {
+                    near[kept] = i;
+                    res[kept] = r;
+                    kept += (r as f64 <= max) as usize;
+                }
             }
             near.truncate(kept);
             res.truncate(kept);
-            (near, res)
+            (near, res, others)
         })
         .collect();
-    let total = parts.iter().map(|(n, _)| n.len()).sum();
+    let total = parts.iter().map(|(n, _, _)| n.len()).sum();
     let mut near = Vec::with_capacity(total);
     let mut res = Vec::with_capacity(total);
-    for (n, r) in parts {
+    let mut others = Vec::with_capacity(idx.len() - total);
+    for (n, r, o) in parts {
         near.extend_from_slice(&n);
         res.extend_from_slice(&r);
+        others.extend_from_slice(&o);
     }
-    (near, res)
+    (near, res, others)
+}
+
+/// The union of the ascending lists `a` and `b` (no value in both), ascending: `a`'s runs
+/// between `b`'s values are copied whole (`b` is short: the near points a round leaves).
+fn merge_ascending(a: Vec<u32>, b: &[u32]) -> Vec<u32> {
+    if b.is_empty() {
+        return a;
+    }
+    let mut out = Vec::with_capacity(a.len() + b.len());
+    let mut from = 0;
+    for &v in b {
+        let to = from + a[from..].partition_point(|&x| x < v);
+        out.extend_from_slice(&a[from..to]);
+        out.push(v);
+        from = to;
+    }
+    out.extend_from_slice(&a[from..]);
+    out
 }
 
 /// Inlier threshold from the MSSE scale of the sorted residuals (see the module docs).
@@ -384,6 +436,21 @@ mod tests {
     use super::*;
     use crate::rng::seeded;
     use rand_distr::{Distribution, Normal};
+
+    proptest::proptest! {
+        #[test]
+        fn merging_two_disjoint_ascending_lists_gives_their_sorted_union(
+            all in proptest::collection::btree_set(0u32..500, 0..120),
+            to_b in proptest::collection::vec(proptest::bool::weighted(0.2), 120),
+        ) {
+            let (mut a, mut b) = (Vec::new(), Vec::new());
+            for (v, &in_b) in all.iter().zip(&to_b) {
+                if in_b { b.push(*v) } else { a.push(*v) }
+            }
+            let want: Vec<u32> = all.into_iter().collect();
+            proptest::prop_assert_eq!(merge_ascending(a, &b), want);
+        }
+    }
 
     #[test]
     fn msse_threshold_tracks_noise_scale() {
