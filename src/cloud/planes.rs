@@ -60,6 +60,7 @@
 //!
 //! Not for: clustering objects (cars, poles) or tracking planes over time.
 
+mod band;
 mod config;
 mod pieces;
 mod ransac;
@@ -70,8 +71,32 @@ use crate::cloud::PointCloud;
 use crate::error::{Error, Result};
 use crate::geometry::{Plane, PlanePatch};
 use crate::rng::FilterRng;
+use band::BandGrid;
 use pieces::{connected_pieces, hull_candidates, point64, rms};
 use ransac::{fit_chunked, one_round, PlaneF32};
+
+/// Removes from `pool` the values of `taken`, a subsequence of it (both ascending), in place:
+/// the runs of `pool` between them move down whole.
+fn remove_sorted(pool: &mut Vec<u32>, taken: &[u32]) {
+    let (mut kept, mut from) = (0, 0);
+    for &v in taken {
+        // Galloping from the last place: taken values mostly come in runs.
+        let rest = &pool[from..];
+        let mut step = 1;
+        while step < rest.len() && rest[step - 1] < v {
+            step *= 2;
+        }
+        let (a, b) = (step / 2, step.min(rest.len()));
+        let at = from + a + rest[a..b].partition_point(|&x| x < v);
+        pool.copy_within(from..at, kept);
+        kept += at - from;
+        // `v` itself is skipped (when it is there).
+        from = at + usize::from(pool.get(at) == Some(&v));
+    }
+    let end = pool.len();
+    pool.copy_within(from..end, kept);
+    pool.truncate(kept + end - from);
+}
 
 /// One segmented plane piece.
 #[derive(Clone, Debug, PartialEq)]
@@ -188,6 +213,7 @@ pub fn extract_planes(
             && p.offset >= config.min_ground_depth
     };
     let mut first_ground: Option<PlaneF32> = None;
+    let mut grid: Option<BandGrid> = None;
     for _ in 0..config.max_planes {
         if active.len() < config.min_points {
             break;
@@ -202,16 +228,25 @@ pub fn extract_planes(
         } else {
             0.0
         };
-        let Some((plane, inliers, rest)) = one_round(&pts, &active, &active, min_tilt, config, rng)
+        let Some((plane, inliers, rest)) =
+            one_round(&pts, &active, min_tilt, config, rng, grid.as_ref())
         else {
             break;
         };
-        active = rest;
+        match rest {
+            Some(rest) => active = rest,
+            None => remove_sorted(&mut active, &inliers),
+        }
+        if let Some(g) = grid.as_mut() {
+            g.remove(&inliers);
+        }
         if first_ground.is_none() && ground_like(&plane) {
             let g = PlaneF32::new(&plane);
             let clearance = config.ground_clearance as f32;
             active.retain(|&i| g.residual_signed(&pts[i as usize]) > clearance);
             first_ground = Some(g);
+            // The wall rounds' passes look for their points on a grid of this pool.
+            grid = Some(BandGrid::new(&pts, &active));
         }
         extracted.push((plane, inliers));
     }
@@ -397,6 +432,26 @@ mod tests {
                 .map(|k| origin[k] + s * a[k] + t * b[k] + e * normal[k])
                 .collect();
             cloud.push(p[0] as f32, p[1] as f32, p[2] as f32, 0.5);
+        }
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn removing_a_sorted_subsequence_keeps_the_rest_in_order(
+            pool in proptest::collection::btree_set(0u32..2000, 0..300),
+            mask in proptest::collection::vec(proptest::bool::weighted(0.1), 300),
+        ) {
+            let pool: Vec<u32> = pool.into_iter().collect();
+            let taken: Vec<u32> = pool
+                .iter()
+                .zip(&mask)
+                .filter(|(_, &t)| t)
+                .map(|(&v, _)| v)
+                .collect();
+            let want: Vec<u32> = pool.iter().copied().filter(|v| !taken.contains(v)).collect();
+            let mut got = pool.clone();
+            remove_sorted(&mut got, &taken);
+            proptest::prop_assert_eq!(got, want);
         }
     }
 

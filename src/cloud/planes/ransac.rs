@@ -4,6 +4,7 @@
 //!
 //! Not for: the sequence of rounds or the classification of planes (see the parent module).
 
+use super::band::BandGrid;
 use super::PlaneConfig;
 use crate::cloud::voxel_groups::VoxelGroups;
 use crate::geometry::Plane;
@@ -35,22 +36,32 @@ impl PlaneF32 {
         self.n[0] * p[0] + self.n[1] * p[1] + self.n[2] * p[2] + self.d
     }
     #[inline]
-    fn residual(&self, p: &[f32; 3]) -> f32 {
+    pub(super) fn residual(&self, p: &[f32; 3]) -> f32 {
         (self.n[0] * p[0] + self.n[1] * p[1] + self.n[2] * p[2] + self.d).abs()
+    }
+    /// The normal's coefficients, widened.
+    pub(super) fn normal_f64(&self) -> [f64; 3] {
+        self.n.map(f64::from)
+    }
+    /// The offset, widened.
+    pub(super) fn offset_f64(&self) -> f64 {
+        self.d as f64
     }
 }
 
 /// One RANSAC round on the pool `active` (ascending local indices): the refined plane, its
-/// inliers and the rest of `active` (both ascending), or `None` when no plane with
-/// `min_points` inliers is found.
+/// inliers (ascending) and, unless `grid` holds the pool, the rest of `active` (ascending),
+/// or `None` when no plane with `min_points` inliers is found. With `grid` (the same pool on
+/// a bird's-eye grid) the inlier passes visit only the cells near each plane.
 pub(super) fn one_round(
     pts: &[[f32; 3]],
     active: &[u32],
-    pool: &[u32],
     min_tilt: f64,
     config: &PlaneConfig,
     rng: &mut FilterRng,
-) -> Option<(Plane, Vec<u32>, Vec<u32>)> {
+    grid: Option<&BandGrid>,
+) -> Option<(Plane, Vec<u32>, Option<Vec<u32>>)> {
+    let pool = active;
     // 1. Subsample (with replacement when the pool is small) and voxel grid.
     let m = config.score_sample.min(pool.len());
     let sample: Vec<[f32; 3]> = if m == pool.len() {
@@ -139,7 +150,7 @@ pub(super) fn one_round(
     let mut plane = hyps[best];
     let mut fitted: Option<Plane> = None;
     let mut inliers: Vec<u32> = Vec::new();
-    let mut rest: Vec<u32> = Vec::new();
+    let mut rest: Option<Vec<u32>> = None;
     for (pool, least, last) in [
         (
             if stride > 1 { &part[..] } else { active },
@@ -151,7 +162,15 @@ pub(super) fn one_round(
         // The threshold never exceeds `max_threshold`, and residuals above it do not enter the
         // MSSE scale: only the points within it are kept, in pool order (and, on the whole
         // pool's pass, the others apart: they stay in the pool whatever the threshold).
-        let (near, residuals, far) = near_points(pts, pool, &plane, config.max_threshold, last);
+        let (near, residuals, far) = match grid {
+            // The grid holds the whole pool: the last pass's, and the first's when it is not
+            // made on a part.
+            Some(g) if last || stride == 1 => {
+                let (near, residuals) = g.near_points(&plane, config.max_threshold);
+                (near, residuals, Vec::new())
+            }
+            _ => near_points(pts, pool, &plane, config.max_threshold, last),
+        };
         let tau = msse_threshold(&residuals, config);
         inliers = Vec::with_capacity(near.len());
         let mut left = Vec::new();
@@ -165,8 +184,8 @@ pub(super) fn one_round(
         if inliers.len() < least {
             return None;
         }
-        if last {
-            rest = merge_ascending(far, &left);
+        if last && grid.is_none() {
+            rest = Some(merge_ascending(far, &left));
         }
         let p = fit_chunked(pts, &inliers)?;
         plane = PlaneF32::new(&p);

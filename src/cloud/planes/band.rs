@@ -1,0 +1,208 @@
+//! The wall rounds' pool on a bird's-eye grid, so that the points near a plane are found
+//! without a pass over the whole pool: a cell is visited only when the tight box of its points
+//! can reach the plane's band, and only its points still in the pool are tested. A steep plane's
+//! band crosses few cells, so a pass touches a small part of the pool.
+//!
+//! The answer is exactly the one a pass over the pool gives: the same points, with the same f32
+//! residuals, in the pool's (ascending) order. The box test is conservative by a margin far
+//! above the f32 rounding of a residual, and the points it lets through are tested as the pass
+//! tests them.
+//!
+//! Not for: the ground's round (its pool is the whole scan and its plane crosses every cell),
+//! or neighbour queries (see [`crate::cloud::cluster`]).
+
+use super::ransac::PlaneF32;
+use crate::numerics::floor::floor_f32_i32;
+
+/// Edge of a grid cell (m).
+const CELL: f32 = 2.0;
+
+/// The wall rounds' pool on a bird's-eye grid. See the module documentation.
+pub(super) struct BandGrid {
+    /// Points grouped by cell, ascending within a cell.
+    order: Vec<u32>,
+    /// The positions of `order`'s points, in its order (a cell's points are read in a row).
+    coords: Vec<[f32; 3]>,
+    /// Per occupied cell `c`: its slice of `order` is `start[c]..start[c + 1]`.
+    start: Vec<u32>,
+    /// Per occupied cell: the tight box of its points, `[lo, hi]` per axis (f64).
+    boxes: Vec<[[f64; 2]; 3]>,
+    /// Per local point index: whether it is still in the pool.
+    alive: Vec<bool>,
+}
+
+impl BandGrid {
+    /// The grid of the pool `pool` (ascending local indices into `pts`, finite points).
+    pub(super) fn new(pts: &[[f32; 3]], pool: &[u32]) -> Self {
+        let mut alive = vec![false; pts.len()];
+        let inv = 1.0 / CELL;
+        // The points' cells, read in pool order.
+        let keys: Vec<(i32, i32)> = pool
+            .iter()
+            .map(|&i| {
+                let p = pts[i as usize];
+                (floor_f32_i32(p[0] * inv), floor_f32_i32(p[1] * inv))
+            })
+            .collect();
+        let (mut lo, mut hi) = ((i32::MAX, i32::MAX), (i32::MIN, i32::MIN));
+        for (&(x, y), &i) in keys.iter().zip(pool) {
+            lo = (lo.0.min(x), lo.1.min(y));
+            hi = (hi.0.max(x), hi.1.max(y));
+            alive[i as usize] = true;
+        }
+        if pool.is_empty() {
+            (lo, hi) = ((0, 0), (0, 0));
+        }
+        let w = (hi.0 as i64 - lo.0 as i64 + 1) as usize;
+        let h = (hi.1 as i64 - lo.1 as i64 + 1) as usize;
+        let cells: Vec<u32> = keys
+            .iter()
+            .map(|&(x, y)| ((y - lo.1) as usize * w + (x - lo.0) as usize) as u32)
+            .collect();
+        // A counting sort over the dense cells, the boxes grown on the way, then the empty
+        // cells dropped.
+        let mut count = vec![0u32; w * h + 1];
+        let mut dense_boxes = vec![[[f64::INFINITY, f64::NEG_INFINITY]; 3]; w * h];
+        for (&c, &i) in cells.iter().zip(pool) {
+            count[c as usize + 1] += 1;
+            let b = &mut dense_boxes[c as usize];
+            for (a, v) in pts[i as usize].iter().enumerate() {
+                b[a][0] = b[a][0].min(*v as f64);
+                b[a][1] = b[a][1].max(*v as f64);
+            }
+        }
+        for c in 0..w * h {
+            count[c + 1] += count[c];
+        }
+        let mut next = count.clone();
+        let mut order = vec![0u32; pool.len()];
+        let mut coords = vec![[0.0f32; 3]; pool.len()];
+        for (&c, &i) in cells.iter().zip(pool) {
+            let at = &mut next[c as usize];
+            order[*at as usize] = i;
+            coords[*at as usize] = pts[i as usize];
+            *at += 1;
+        }
+        let mut start = vec![0u32];
+        let mut boxes = Vec::new();
+        for c in 0..w * h {
+            if count[c + 1] > count[c] {
+                boxes.push(dense_boxes[c]);
+                start.push(count[c + 1]);
+            }
+        }
+        BandGrid {
+            order,
+            coords,
+            start,
+            boxes,
+            alive,
+        }
+    }
+
+    /// Takes the points `taken` out of the pool.
+    pub(super) fn remove(&mut self, taken: &[u32]) {
+        for &i in taken {
+            self.alive[i as usize] = false;
+        }
+    }
+
+    /// The points of the pool whose absolute residual to `plane` is at most `max` (compared
+    /// in f64), with those residuals, both in ascending order of the points: what a pass over
+    /// the pool in its order gives.
+    pub(super) fn near_points(&self, plane: &PlaneF32, max: f64) -> (Vec<u32>, Vec<f32>) {
+        let n = plane.normal_f64();
+        let d = plane.offset_f64();
+        let mut found: Vec<(u32, f32)> = Vec::new();
+        for (c, b) in self.boxes.iter().enumerate() {
+            // The range of n·p + d over the box, widened by far more than the f32 rounding of
+            // a residual (a few units of 2⁻²³ of the largest term).
+            let (mut v_lo, mut v_hi, mut size) = (d, d, d.abs());
+            for a in 0..3 {
+                let (x, y) = (n[a] * b[a][0], n[a] * b[a][1]);
+                v_lo += x.min(y);
+                v_hi += x.max(y);
+                size += x.abs().max(y.abs());
+            }
+            let margin = 1e-5 * size + 1e-6;
+            if v_lo - margin > max || v_hi + margin < -max {
+                continue;
+            }
+            let run = self.start[c] as usize..self.start[c + 1] as usize;
+            for (&i, p) in self.order[run.clone()].iter().zip(&self.coords[run]) {
+                if self.alive[i as usize] {
+                    let r = plane.residual(p);
+                    if r as f64 <= max {
+                        found.push((i, r));
+                    }
+                }
+            }
+        }
+        radsort::sort_by_key(&mut found, |&(i, _)| i);
+        found.into_iter().unzip()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Plane;
+    use nalgebra::{Point3, Vector3};
+    use proptest::prelude::*;
+
+    /// What a pass over the pool gives.
+    fn by_pass(pts: &[[f32; 3]], pool: &[u32], plane: &PlaneF32, max: f64) -> (Vec<u32>, Vec<f32>) {
+        pool.iter()
+            .map(|&i| (i, plane.residual(&pts[i as usize])))
+            .filter(|&(_, r)| r as f64 <= max)
+            .unzip()
+    }
+
+    proptest! {
+        #[test]
+        fn the_grid_finds_what_a_pass_finds(
+            pts in proptest::collection::vec(
+                (-60.0f32..60.0, -60.0f32..60.0, -2.0f32..12.0), 1..400),
+            keep in proptest::collection::vec(proptest::bool::weighted(0.8), 400),
+            taken in proptest::collection::vec(proptest::bool::weighted(0.2), 400),
+            (nx, ny, nz) in (-1.0f64..1.0, -1.0f64..1.0, -0.3f64..0.3),
+            offset in -50.0f64..50.0,
+            max in 0.01f64..3.0,
+        ) {
+            prop_assume!(nx.abs() + ny.abs() + nz.abs() > 0.1);
+            let pts: Vec<[f32; 3]> = pts.into_iter().map(|(x, y, z)| [x, y, z]).collect();
+            let pool: Vec<u32> = (0..pts.len() as u32).filter(|&i| keep[i as usize]).collect();
+            let mut grid = BandGrid::new(&pts, &pool);
+            let gone: Vec<u32> = pool.iter().copied().filter(|&i| taken[i as usize]).collect();
+            grid.remove(&gone);
+            let left: Vec<u32> = pool.iter().copied().filter(|&i| !taken[i as usize]).collect();
+            let plane = Plane::from_point_normal(
+                &Point3::origin(),
+                Vector3::new(nx, ny, nz),
+            ).unwrap();
+            let plane = PlaneF32::new(&Plane { offset, ..plane });
+            prop_assert_eq!(grid.near_points(&plane, max), by_pass(&pts, &left, &plane, max));
+        }
+    }
+
+    #[test]
+    fn a_steep_plane_visits_few_cells_and_an_empty_pool_nothing() {
+        // A wall along x = 10 among points spread over 100 m × 100 m.
+        let mut pts = Vec::new();
+        for k in 0..2000 {
+            let t = k as f32 * 0.05;
+            pts.push([10.0 + 0.01 * (k % 3) as f32, t - 50.0, (k % 7) as f32]);
+            pts.push([t - 50.0, (k as f32 * 0.37) % 100.0 - 50.0, 1.0]);
+        }
+        let pool: Vec<u32> = (0..pts.len() as u32).collect();
+        let grid = BandGrid::new(&pts, &pool);
+        let plane = PlaneF32::new(
+            &Plane::from_point_normal(&Point3::new(10.0, 0.0, 0.0), Vector3::x()).unwrap(),
+        );
+        let (near, _) = grid.near_points(&plane, 0.1);
+        assert_eq!(near, by_pass(&pts, &pool, &plane, 0.1).0);
+        assert!(near.len() >= 2000, "{}", near.len());
+        let empty = BandGrid::new(&pts, &[]);
+        assert!(empty.near_points(&plane, 0.1).0.is_empty());
+    }
+}
