@@ -375,6 +375,46 @@ impl SensorOffset {
         let sz = c[0] * p[0] + c[1] * p[1] + c[2] * p[2] + self.t[2] - self.z[2];
         sx * sx + sy * sy + sz * sz
     }
+
+    /// [`SensorOffset::squared`] of every particle `(x[i], y[i], z[i])` into `out`, a NaN as
+    /// +∞ (such a particle explains nothing), and the smallest of them. The same values as
+    /// one [`SensorOffset::squared`] a particle: on x86-64 with AVX2 the loop runs four lanes
+    /// wide (the same operations, never fused), and the minimum is taken over four
+    /// interleaved running minima, which is exact in any order (no NaN is left, and no value
+    /// is −0).
+    fn squared_into(&self, x: &[f64], y: &[f64], z: &[f64], out: &mut [f64]) -> f64 {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has just been found to support AVX2.
+            return unsafe { self.squared_into_avx2(x, y, z, out) };
+        }
+        self.squared_into_lanes(x, y, z, out)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn squared_into_avx2(&self, x: &[f64], y: &[f64], z: &[f64], out: &mut [f64]) -> f64 {
+        self.squared_into_lanes(x, y, z, out)
+    }
+
+    #[inline(always)]
+    fn squared_into_lanes(&self, x: &[f64], y: &[f64], z: &[f64], out: &mut [f64]) -> f64 {
+        for (((d, &a), &b), &h) in out.iter_mut().zip(x).zip(y).zip(z) {
+            let v = self.squared([a, b, h]);
+            *d = if v.is_nan() { f64::INFINITY } else { v };
+        }
+        let n = out.len().min(x.len()).min(y.len()).min(z.len());
+        let mut lanes = [f64::INFINITY; 4];
+        let chunks = out[..n].chunks_exact(4);
+        let rest = chunks.remainder();
+        for c in chunks {
+            for (m, &v) in lanes.iter_mut().zip(c) {
+                *m = m.min(v);
+            }
+        }
+        let nearest = lanes[0].min(lanes[1]).min(lanes[2].min(lanes[3]));
+        rest.iter().fold(nearest, |m, &v| m.min(v))
+    }
 }
 
 impl MeasurementModel for MixedMeasurement {
@@ -471,14 +511,8 @@ impl MeasurementModel for MixedMeasurement {
             if kind_of_measurement(z) != kind {
                 continue;
             }
-            let c = offset.toward(z);
             // A particle whose distance is NaN explains nothing (as on the log path).
-            let mut nearest = f64::INFINITY;
-            for (((d, &a), &b), &h) in d2.iter_mut().zip(x).zip(y).zip(zc) {
-                let v = c.squared([a, b, h]);
-                *d = if v.is_nan() { f64::INFINITY } else { v };
-                nearest = nearest.min(*d);
-            }
+            let nearest = offset.toward(z).squared_into(x, y, zc, &mut d2);
             if !nearest.is_finite() {
                 continue;
             }
@@ -704,6 +738,38 @@ mod tests {
             cluster_sigma_position: 0.0,
             cluster_sigma_velocity: 0.0,
             cluster_sigma_vertical: 0.0,
+        }
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn squared_distances_on_lanes_match_one_particle_at_a_time(
+            pts in proptest::collection::vec(
+                (-80.0f64..80.0, -80.0f64..80.0, -3.0f64..5.0), 0..23),
+            nan_at in proptest::collection::vec(proptest::bool::weighted(0.1), 23),
+            yaw in -3.2f64..3.2,
+            z in (-40.0f64..40.0, -40.0f64..40.0, -2.0f64..2.0),
+        ) {
+            let pose = Isometry3::new(Vector3::new(3.0, -2.0, 0.5), Vector3::new(0.0, 0.0, yaw));
+            let c = SensorOffset::new(&ctx(pose), &[z.0, z.1, z.2]);
+            let x: Vec<f64> = pts
+                .iter()
+                .zip(&nan_at)
+                .map(|(p, &nan)| if nan { f64::NAN } else { p.0 })
+                .collect();
+            let y: Vec<f64> = pts.iter().map(|p| p.1).collect();
+            let h: Vec<f64> = pts.iter().map(|p| p.2).collect();
+            let mut out = vec![0.0; x.len()];
+            let nearest = c.squared_into(&x, &y, &h, &mut out);
+            let want: Vec<f64> = (0..x.len())
+                .map(|i| {
+                    let v = c.squared([x[i], y[i], h[i]]);
+                    if v.is_nan() { f64::INFINITY } else { v }
+                })
+                .collect();
+            proptest::prop_assert_eq!(&out, &want);
+            let smallest = want.iter().fold(f64::INFINITY, |m, &v| m.min(v));
+            proptest::prop_assert_eq!(nearest.to_bits(), smallest.to_bits());
         }
     }
 
