@@ -74,6 +74,7 @@ pub(super) fn one_round(
     let cells = VoxelGroups::new(&sample, config.sample_cell as f32);
 
     // 2. Hypotheses, drawn sequentially.
+    let tan_min = min_tilt.tan();
     let mut hyps: Vec<PlaneF32> = Vec::with_capacity(config.hypotheses);
     let mut attempts = 0usize;
     while hyps.len() < config.hypotheses && attempts < config.hypotheses * 20 {
@@ -95,7 +96,7 @@ pub(super) fn one_round(
             continue;
         }
         if let Ok(p) = Plane::from_point_normal(&Point3::from(pa), n) {
-            if p.tilt() >= min_tilt {
+            if steep_enough(&p, min_tilt, tan_min) {
                 hyps.push(PlaneF32::new(&p));
             }
         }
@@ -192,6 +193,26 @@ pub(super) fn one_round(
         fitted = Some(p);
     }
     fitted.map(|p| (p, inliers, rest))
+}
+
+/// Whether `plane.tilt() >= min_tilt` (`min_tilt` in [0, π/2), `tan_min` its tangent), with
+/// the arctangent only near the boundary: the tilt grows with |n_xy| / |n_z|, so away from a
+/// relative band of 10⁻⁹ around `tan_min` that ratio decides, as the arctangent (correct to
+/// an ulp or so) would; inside the band the tilt is computed as [`Plane::tilt`] does.
+fn steep_enough(plane: &Plane, min_tilt: f64, tan_min: f64) -> bool {
+    if min_tilt <= 0.0 {
+        return true;
+    }
+    let n = plane.normal;
+    let (h, c) = ((n.x * n.x + n.y * n.y).sqrt(), n.z.abs().min(1.0));
+    let edge = c * tan_min;
+    if h > edge * (1.0 + 1e-9) {
+        true
+    } else if h < edge * (1.0 - 1e-9) {
+        false
+    } else {
+        plane.tilt() >= min_tilt
+    }
 }
 
 /// Above twice this many points in its pool, a round makes its first refit on an evenly
@@ -457,6 +478,28 @@ mod tests {
     use rand_distr::{Distribution, Normal};
 
     proptest::proptest! {
+        #[test]
+        fn the_steepness_test_agrees_with_the_tilt(
+            (x, y, z) in (-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0),
+            min_tilt in 0.0f64..1.57,
+        ) {
+            proptest::prop_assume!(x.abs() + y.abs() + z.abs() > 1e-3);
+            let p = Plane::from_point_normal(&Point3::origin(), Vector3::new(x, y, z)).unwrap();
+            proptest::prop_assert_eq!(
+                steep_enough(&p, min_tilt, min_tilt.tan()),
+                p.tilt() >= min_tilt
+            );
+            // A plane exactly at the limit.
+            let limit = Plane::from_point_normal(
+                &Point3::origin(),
+                Vector3::new(min_tilt.sin(), 0.0, min_tilt.cos()),
+            ).unwrap();
+            proptest::prop_assert_eq!(
+                steep_enough(&limit, min_tilt, min_tilt.tan()),
+                limit.tilt() >= min_tilt
+            );
+        }
+
         #[test]
         fn merging_two_disjoint_ascending_lists_gives_their_sorted_union(
             all in proptest::collection::btree_set(0u32..500, 0..120),
