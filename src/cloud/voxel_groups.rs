@@ -109,19 +109,23 @@ const DENSE_CELLS: usize = 1 << 20;
 /// the keys' box.
 fn number_on_grid(keys: &[[i32; 3]], lo: [i32; 3], span: [usize; 3]) -> (Vec<u32>, Vec<u32>) {
     let mut id_at = vec![u32::MAX; span[0] * span[1] * span[2]];
-    let mut count: Vec<u32> = Vec::new();
-    let mut group_of = Vec::with_capacity(keys.len());
-    for k in keys {
+    let mut voxels = 0u32;
+    let mut group_of = vec![0u32; keys.len()];
+    for (g, k) in group_of.iter_mut().zip(keys) {
         let at = ((k[2] - lo[2]) as usize * span[1] + (k[1] - lo[1]) as usize) * span[0]
             + (k[0] - lo[0]) as usize;
-        let mut id = id_at[at];
-        if id == u32::MAX {
-            id = count.len() as u32;
-            id_at[at] = id;
-            count.push(0);
+        let slot = &mut id_at[at];
+        if *slot == u32::MAX {
+            *slot = voxels;
+            voxels += 1;
         }
-        count[id as usize] += 1;
-        group_of.push(id);
+        *g = *slot;
+    }
+    // The counts in a pass of their own: the numbering's loop then carries no store that
+    // the next point may have to wait for.
+    let mut count = vec![0u32; voxels as usize];
+    for &g in &group_of {
+        count[g as usize] += 1;
     }
     (group_of, count)
 }
