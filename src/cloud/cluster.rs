@@ -139,16 +139,20 @@ fn cluster_indices(cloud: &PointCloud, subset: &[u32], params: &ClusterParams) -
     // members: local positions ascend with cloud indices, so clusters come out ordered by
     // smallest index with ascending indices inside.
     let mut ordinal = vec![u32::MAX; points.len()];
-    let mut sizes: Vec<usize> = Vec::new();
-    let mut of_point = Vec::with_capacity(points.len());
-    for &l in &labels {
+    let mut components = 0u32;
+    let mut of_point = vec![0u32; points.len()];
+    for (of, &l) in of_point.iter_mut().zip(&labels) {
         let o = &mut ordinal[l as usize];
         if *o == u32::MAX {
-            *o = sizes.len() as u32;
-            sizes.push(0);
+            *o = components;
+            components += 1;
         }
-        sizes[*o as usize] += 1;
-        of_point.push(*o);
+        *of = *o;
+    }
+    // The sizes in a pass of their own (no store the numbering's next point waits for).
+    let mut sizes = vec![0usize; components as usize];
+    for &o in &of_point {
+        sizes[o as usize] += 1;
     }
     let mut buckets: Vec<Vec<u32>> = sizes
         .iter()
