@@ -228,15 +228,11 @@ pub fn extract_planes(
         } else {
             0.0
         };
-        let Some((plane, inliers, rest)) =
-            one_round(&pts, &active, min_tilt, config, rng, grid.as_ref())
+        let Some((plane, inliers)) = one_round(&pts, &active, min_tilt, config, rng, grid.as_ref())
         else {
             break;
         };
-        match rest {
-            Some(rest) => active = rest,
-            None => remove_sorted(&mut active, &inliers),
-        }
+        remove_sorted(&mut active, &inliers);
         if let Some(g) = grid.as_mut() {
             g.remove(&inliers);
         }

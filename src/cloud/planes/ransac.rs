@@ -49,10 +49,10 @@ impl PlaneF32 {
     }
 }
 
-/// One RANSAC round on the pool `active` (ascending local indices): the refined plane, its
-/// inliers (ascending) and, unless `grid` holds the pool, the rest of `active` (ascending),
-/// or `None` when no plane with `min_points` inliers is found. With `grid` (the same pool on
-/// a bird's-eye grid) the inlier passes visit only the cells near each plane.
+/// One RANSAC round on the pool `active` (ascending local indices): the refined plane and its
+/// inliers (ascending), or `None` when no plane with `min_points` inliers is found. With
+/// `grid` (the same pool on a bird's-eye grid) the inlier passes visit only the cells near
+/// each plane.
 pub(super) fn one_round(
     pts: &[[f32; 3]],
     active: &[u32],
@@ -60,15 +60,14 @@ pub(super) fn one_round(
     config: &PlaneConfig,
     rng: &mut FilterRng,
     grid: Option<&BandGrid>,
-) -> Option<(Plane, Vec<u32>, Option<Vec<u32>>)> {
-    let pool = active;
+) -> Option<(Plane, Vec<u32>)> {
     // 1. Subsample (with replacement when the pool is small) and voxel grid.
-    let m = config.score_sample.min(pool.len());
-    let sample: Vec<[f32; 3]> = if m == pool.len() {
-        pool.iter().map(|&i| pts[i as usize]).collect()
+    let m = config.score_sample.min(active.len());
+    let sample: Vec<[f32; 3]> = if m == active.len() {
+        active.iter().map(|&i| pts[i as usize]).collect()
     } else {
         (0..m)
-            .map(|_| pts[pool[rng.random_range(0..pool.len())] as usize])
+            .map(|_| pts[active[rng.random_range(0..active.len())] as usize])
             .collect()
     };
     let cells = VoxelGroups::new(&sample, config.sample_cell as f32);
@@ -134,7 +133,7 @@ pub(super) fn one_round(
         .max_by(|a, b| a.1.cmp(b.1).then(b.0.cmp(&a.0)))
         .map(|(i, s)| (i, *s))?;
     // Expected support in the whole pool far below min_points: stop early.
-    let expected = best_score as f64 * pool.len() as f64 / m as f64;
+    let expected = best_score as f64 * active.len() as f64 / m as f64;
     if expected < 0.5 * config.min_points as f64 {
         return None;
     }
@@ -151,48 +150,36 @@ pub(super) fn one_round(
     let mut plane = hyps[best];
     let mut fitted: Option<Plane> = None;
     let mut inliers: Vec<u32> = Vec::new();
-    let mut rest: Option<Vec<u32>> = None;
-    for (pool, least, last) in [
+    for (pool, least, whole) in [
         (
             if stride > 1 { &part[..] } else { active },
             config.min_points.div_ceil(stride),
-            false,
+            stride == 1,
         ),
         (active, config.min_points, true),
     ] {
         // The threshold never exceeds `max_threshold`, and residuals above it do not enter the
-        // MSSE scale: only the points within it are kept, in pool order (and, on the whole
-        // pool's pass, the others apart: they stay in the pool whatever the threshold).
-        let (near, residuals, far) = match grid {
-            // The grid holds the whole pool: the last pass's, and the first's when it is not
-            // made on a part.
-            Some(g) if last || stride == 1 => {
-                let (near, residuals) = g.near_points(&plane, config.max_threshold);
-                (near, residuals, Vec::new())
-            }
-            _ => near_points(pts, pool, &plane, config.max_threshold, last),
+        // MSSE scale: only the points within it are kept, in pool order. The grid holds the
+        // whole pool, so it serves the passes over all of it.
+        let (near, residuals) = match grid {
+            Some(g) if whole => g.near_points(&plane, config.max_threshold),
+            _ => near_points(pts, pool, &plane, config.max_threshold),
         };
         let tau = msse_threshold(&residuals, config);
-        inliers = Vec::with_capacity(near.len());
-        let mut left = Vec::new();
-        for (&i, &r) in near.iter().zip(&residuals) {
-            if r <= tau {
-                inliers.push(i);
-            } else if last {
-                left.push(i);
-            }
-        }
+        inliers = near
+            .iter()
+            .zip(&residuals)
+            .filter(|(_, &r)| r <= tau)
+            .map(|(&i, _)| i)
+            .collect();
         if inliers.len() < least {
             return None;
-        }
-        if last && grid.is_none() {
-            rest = Some(merge_ascending(far, &left));
         }
         let p = fit_chunked(pts, &inliers)?;
         plane = PlaneF32::new(&p);
         fitted = Some(p);
     }
-    fitted.map(|p| (p, inliers, rest))
+    fitted.map(|p| (p, inliers))
 }
 
 /// Whether `plane.tilt() >= min_tilt` (`min_tilt` in [0, π/2), `tan_min` its tangent), with
@@ -269,16 +256,9 @@ impl Columns {
 }
 
 /// The points of `idx` whose absolute residual to `plane` is at most `max` (compared in f64,
-/// as [`msse_threshold`] does), with those residuals, both in the order of `idx`; with
-/// `far`, also the other points of `idx`, in its order (else an empty list).
-fn near_points(
-    pts: &[[f32; 3]],
-    idx: &[u32],
-    plane: &PlaneF32,
-    max: f64,
-    far: bool,
-) -> (Vec<u32>, Vec<f32>, Vec<u32>) {
-    let parts: Vec<(Vec<u32>, Vec<f32>, Vec<u32>)> = idx
+/// as [`msse_threshold`] does), with those residuals, both in the order of `idx`.
+fn near_points(pts: &[[f32; 3]], idx: &[u32], plane: &PlaneF32, max: f64) -> (Vec<u32>, Vec<f32>) {
+    let parts: Vec<(Vec<u32>, Vec<f32>)> = idx
         .par_chunks(CHUNK)
         .map(|ix| {
             let mut all = [0.0f32; CHUNK];
@@ -286,63 +266,28 @@ fn near_points(
                 *r = plane.residual(&pts[i as usize]);
             }
             // Branch-free compaction: every point is written at the next free place, which
-            // only a near one keeps (and, in the other list, only a far one).
+            // only a near one keeps.
             let mut near = vec![0u32; ix.len()];
             let mut res = vec![0.0f32; ix.len()];
             let mut kept = 0;
-            let mut others = Vec::new();
-            if far {
-                others = vec![0u32; ix.len()];
-                let mut left = 0;
-                for (&r, &i) in all.iter().zip(ix) {
-                    let is_near = r as f64 <= max;
-                    near[kept] = i;
-                    res[kept] = r;
-                    others[left] = i;
-                    kept += is_near as usize;
-                    left += !is_near as usize;
-                }
-                others.truncate(left);
-            } else {
-                for (&r, &i) in all.iter().zip(ix) {
-                    near[kept] = i;
-                    res[kept] = r;
-                    kept += (r as f64 <= max) as usize;
-                }
+            for (&r, &i) in all.iter().zip(ix) {
+                near[kept] = i;
+                res[kept] = r;
+                kept += (r as f64 <= max) as usize;
             }
             near.truncate(kept);
             res.truncate(kept);
-            (near, res, others)
+            (near, res)
         })
         .collect();
-    let total = parts.iter().map(|(n, _, _)| n.len()).sum();
+    let total = parts.iter().map(|(n, _)| n.len()).sum();
     let mut near = Vec::with_capacity(total);
     let mut res = Vec::with_capacity(total);
-    let mut others = Vec::with_capacity(idx.len() - total);
-    for (n, r, o) in parts {
+    for (n, r) in parts {
         near.extend_from_slice(&n);
         res.extend_from_slice(&r);
-        others.extend_from_slice(&o);
     }
-    (near, res, others)
-}
-
-/// The union of the ascending lists `a` and `b` (no value in both), ascending: `a`'s runs
-/// between `b`'s values are copied whole (`b` is short: the near points a round leaves).
-fn merge_ascending(a: Vec<u32>, b: &[u32]) -> Vec<u32> {
-    if b.is_empty() {
-        return a;
-    }
-    let mut out = Vec::with_capacity(a.len() + b.len());
-    let mut from = 0;
-    for &v in b {
-        let to = from + a[from..].partition_point(|&x| x < v);
-        out.extend_from_slice(&a[from..to]);
-        out.push(v);
-        from = to;
-    }
-    out.extend_from_slice(&a[from..]);
-    out
+    (near, res)
 }
 
 /// Inlier threshold from the MSSE scale of the sorted residuals (see the module docs).
@@ -498,19 +443,6 @@ mod tests {
                 steep_enough(&limit, min_tilt, min_tilt.tan()),
                 limit.tilt() >= min_tilt
             );
-        }
-
-        #[test]
-        fn merging_two_disjoint_ascending_lists_gives_their_sorted_union(
-            all in proptest::collection::btree_set(0u32..500, 0..120),
-            to_b in proptest::collection::vec(proptest::bool::weighted(0.2), 120),
-        ) {
-            let (mut a, mut b) = (Vec::new(), Vec::new());
-            for (v, &in_b) in all.iter().zip(&to_b) {
-                if in_b { b.push(*v) } else { a.push(*v) }
-            }
-            let want: Vec<u32> = all.into_iter().collect();
-            proptest::prop_assert_eq!(merge_ascending(a, &b), want);
         }
     }
 
