@@ -461,8 +461,10 @@ impl MeasurementModel for MixedMeasurement {
         // logarithms; a − b ≤ ln((1 − ε)/ε) + 3 ln k, so e^(a − b) stays finite. Three passes
         // over the particles, the transcendental ones on vector lanes.
         let [(norm_a, half_a), (norm_b, half_b)] = self.cluster_terms();
-        // The squared distances once, for the first pass and the last.
-        let d2: Vec<f64> = points().map(|p| c.squared(p)).collect();
+        // The squared distances once, for the first pass and the last (a NaN one as +∞: its
+        // log-likelihood comes out −∞ all the same).
+        let mut d2 = vec![0.0; n];
+        c.squared_into(x, y, zc, &mut d2);
         for (o, &d) in out.iter_mut().zip(&d2) {
             *o = (norm_a - norm_b) - (half_a - half_b) * d;
         }
