@@ -12,7 +12,7 @@
 //! or neighbour queries (see [`crate::cloud::cluster`]).
 
 use super::ransac::PlaneF32;
-use crate::numerics::floor::floor_f32_i32;
+use crate::cloud::voxel_groups::VoxelGroups;
 
 /// Edge of a grid cell (m).
 const CELL: f32 = 2.0;
@@ -32,64 +32,39 @@ pub(super) struct BandGrid {
 }
 
 impl BandGrid {
-    /// The grid of the pool `pool` (ascending local indices into `pts`, finite points).
+    /// The grid of the pool `pool` (ascending local indices into `pts`, finite points): the
+    /// pool's points grouped by their cells as [`VoxelGroups`] groups them (a cell is a voxel
+    /// of the points laid flat).
     pub(super) fn new(pts: &[[f32; 3]], pool: &[u32]) -> Self {
         let mut alive = vec![false; pts.len()];
-        let inv = 1.0 / CELL;
-        // The points' cells, read in pool order.
-        let keys: Vec<(i32, i32)> = pool
+        let flat: Vec<[f32; 3]> = pool
             .iter()
             .map(|&i| {
+                alive[i as usize] = true;
                 let p = pts[i as usize];
-                (floor_f32_i32(p[0] * inv), floor_f32_i32(p[1] * inv))
+                [p[0], p[1], 0.0]
             })
             .collect();
-        let (mut lo, mut hi) = ((i32::MAX, i32::MAX), (i32::MIN, i32::MIN));
-        for (&(x, y), &i) in keys.iter().zip(pool) {
-            lo = (lo.0.min(x), lo.1.min(y));
-            hi = (hi.0.max(x), hi.1.max(y));
-            alive[i as usize] = true;
-        }
-        if pool.is_empty() {
-            (lo, hi) = ((0, 0), (0, 0));
-        }
-        let w = (hi.0 as i64 - lo.0 as i64 + 1) as usize;
-        let h = (hi.1 as i64 - lo.1 as i64 + 1) as usize;
-        let cells: Vec<u32> = keys
-            .iter()
-            .map(|&(x, y)| ((y - lo.1) as usize * w + (x - lo.0) as usize) as u32)
-            .collect();
-        // A counting sort over the dense cells, the boxes grown on the way, then the empty
-        // cells dropped.
-        let mut count = vec![0u32; w * h + 1];
-        let mut dense_boxes = vec![[[f64::INFINITY, f64::NEG_INFINITY]; 3]; w * h];
-        for (&c, &i) in cells.iter().zip(pool) {
-            count[c as usize + 1] += 1;
-            let b = &mut dense_boxes[c as usize];
-            for (a, v) in pts[i as usize].iter().enumerate() {
-                b[a][0] = b[a][0].min(*v as f64);
-                b[a][1] = b[a][1].max(*v as f64);
-            }
-        }
-        for c in 0..w * h {
-            count[c + 1] += count[c];
-        }
-        let mut next = count.clone();
-        let mut order = vec![0u32; pool.len()];
-        let mut coords = vec![[0.0f32; 3]; pool.len()];
-        for (&c, &i) in cells.iter().zip(pool) {
-            let at = &mut next[c as usize];
-            order[*at as usize] = i;
-            coords[*at as usize] = pts[i as usize];
-            *at += 1;
-        }
+        let cells = VoxelGroups::new(&flat, CELL);
+        let mut order = Vec::with_capacity(pool.len());
+        let mut coords = Vec::with_capacity(pool.len());
         let mut start = vec![0u32];
-        let mut boxes = Vec::new();
-        for c in 0..w * h {
-            if count[c + 1] > count[c] {
-                boxes.push(dense_boxes[c]);
-                start.push(count[c + 1]);
+        let mut boxes = Vec::with_capacity(cells.len());
+        for c in 0..cells.len() {
+            let mut b = [[f64::INFINITY, f64::NEG_INFINITY]; 3];
+            // Positions in the pool, ascending: so are the local indices.
+            for &k in cells.members(c) {
+                let i = pool[k as usize];
+                let p = pts[i as usize];
+                for (a, v) in p.iter().enumerate() {
+                    b[a][0] = b[a][0].min(*v as f64);
+                    b[a][1] = b[a][1].max(*v as f64);
+                }
+                order.push(i);
+                coords.push(p);
             }
+            boxes.push(b);
+            start.push(order.len() as u32);
         }
         BandGrid {
             order,
