@@ -4,7 +4,8 @@
 //! table), then the point indices are placed by a counting sort on that number. The members
 //! of a voxel are one contiguous, ascending slice.
 //!
-//! Used by the plane RANSAC's triple sampling (the points of a coarse cell).
+//! Used by the plane RANSAC's triple sampling (the points of a coarse cell) and by the wall
+//! rounds' bird's-eye grid (the pool's points laid flat).
 //!
 //! Not for: neighbour queries across voxels (see [`crate::cloud::cluster`]), or points with a
 //! non-finite coordinate (the caller drops them first).
