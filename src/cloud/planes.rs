@@ -98,6 +98,33 @@ fn remove_sorted(pool: &mut Vec<u32>, taken: &[u32]) {
     pool.truncate(kept + end - from);
 }
 
+/// The points with finite coordinates, as rows, and their indices in the columns. A scan
+/// whose coordinates are all finite (one branch-free check, the usual case) is copied by a
+/// plain map.
+fn finite_points(xs: &[f32], ys: &[f32], zs: &[f32]) -> (Vec<[f32; 3]>, Vec<u32>) {
+    let finite = |v: &f32| v.is_finite();
+    let all = |c: &[f32]| c.iter().fold(true, |ok, v| ok & finite(v));
+    if all(xs) && all(ys) && all(zs) {
+        let pts = xs
+            .iter()
+            .zip(ys)
+            .zip(zs)
+            .map(|((&x, &y), &z)| [x, y, z])
+            .collect();
+        return (pts, (0..xs.len() as u32).collect());
+    }
+    let mut pts = Vec::with_capacity(xs.len());
+    let mut orig = Vec::with_capacity(xs.len());
+    for i in 0..xs.len() {
+        let p = [xs[i], ys[i], zs[i]];
+        if p.iter().all(finite) {
+            pts.push(p);
+            orig.push(i as u32);
+        }
+    }
+    (pts, orig)
+}
+
 /// One segmented plane piece.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PlaneDetection {
@@ -189,15 +216,7 @@ pub fn extract_planes(
         return Err(Error::invalid("point cloud", "more than u32::MAX points"));
     }
     let (xs, ys, zs) = (cloud.xs(), cloud.ys(), cloud.zs());
-    let mut pts: Vec<[f32; 3]> = Vec::with_capacity(cloud.len());
-    let mut orig: Vec<u32> = Vec::with_capacity(cloud.len());
-    for i in 0..cloud.len() {
-        let p = [xs[i], ys[i], zs[i]];
-        if p.iter().all(|v| v.is_finite()) {
-            pts.push(p);
-            orig.push(i as u32);
-        }
-    }
+    let (pts, orig) = finite_points(xs, ys, zs);
     let mut out = PlaneSegmentation {
         skipped: cloud.len() - pts.len(),
         ..Default::default()
