@@ -51,19 +51,20 @@ impl BandGrid {
         let mut start = vec![0u32];
         let mut boxes = Vec::with_capacity(cells.len());
         for c in 0..cells.len() {
-            let mut b = [[f64::INFINITY, f64::NEG_INFINITY]; 3];
+            // The box in f32 (widening to f64 keeps the order, so the extremes are the same).
+            let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
             // Positions in the pool, ascending: so are the local indices.
             for &k in cells.members(c) {
                 let i = pool[k as usize];
                 let p = pts[i as usize];
-                for (a, v) in p.iter().enumerate() {
-                    b[a][0] = b[a][0].min(*v as f64);
-                    b[a][1] = b[a][1].max(*v as f64);
+                for a in 0..3 {
+                    lo[a] = lo[a].min(p[a]);
+                    hi[a] = hi[a].max(p[a]);
                 }
                 order.push(i);
                 coords.push(p);
             }
-            boxes.push(b);
+            boxes.push(std::array::from_fn(|a| [lo[a] as f64, hi[a] as f64]));
             start.push(order.len() as u32);
         }
         BandGrid {
