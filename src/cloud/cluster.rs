@@ -9,6 +9,7 @@
 //!
 //! Not for: ground or plane removal, shape fitting, or tracking the clusters over time.
 
+use super::voxel_groups::number_by_first_appearance;
 use super::PointCloud;
 use crate::error::{Error, Result};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
@@ -138,22 +139,9 @@ fn cluster_indices(cloud: &PointCloud, subset: &[u32], params: &ClusterParams) -
     // Number the components by their first (smallest) local position, then bucket the
     // members: local positions ascend with cloud indices, so clusters come out ordered by
     // smallest index with ascending indices inside.
-    let mut ordinal = vec![u32::MAX; points.len()];
-    let mut components = 0u32;
-    let mut of_point = vec![0u32; points.len()];
-    for (of, &l) in of_point.iter_mut().zip(&labels) {
-        let o = &mut ordinal[l as usize];
-        if *o == u32::MAX {
-            *o = components;
-            components += 1;
-        }
-        *of = *o;
-    }
-    // The sizes in a pass of their own (no store the numbering's next point waits for).
-    let mut sizes = vec![0usize; components as usize];
-    for &o in &of_point {
-        sizes[o as usize] += 1;
-    }
+    let (of_point, sizes) =
+        number_by_first_appearance(labels.iter().map(|&l| l as usize), points.len());
+    let sizes: Vec<usize> = sizes.into_iter().map(|n| n as usize).collect();
     let mut buckets: Vec<Vec<u32>> = sizes
         .iter()
         .map(|&n| {

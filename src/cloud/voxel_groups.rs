@@ -109,26 +109,38 @@ const DENSE_CELLS: usize = 1 << 20;
 /// Voxel numbers in order of first appearance, and each voxel's count, from a dense array over
 /// the keys' box.
 fn number_on_grid(keys: &[[i32; 3]], lo: [i32; 3], span: [usize; 3]) -> (Vec<u32>, Vec<u32>) {
-    let mut id_at = vec![u32::MAX; span[0] * span[1] * span[2]];
-    let mut voxels = 0u32;
-    let mut group_of = vec![0u32; keys.len()];
-    for (g, k) in group_of.iter_mut().zip(keys) {
-        let at = ((k[2] - lo[2]) as usize * span[1] + (k[1] - lo[1]) as usize) * span[0]
-            + (k[0] - lo[0]) as usize;
-        let slot = &mut id_at[at];
+    let slots = keys.iter().map(|k| {
+        ((k[2] - lo[2]) as usize * span[1] + (k[1] - lo[1]) as usize) * span[0]
+            + (k[0] - lo[0]) as usize
+    });
+    number_by_first_appearance(slots, span[0] * span[1] * span[2])
+}
+
+/// For items that each name a slot in `0..slot_count`: the slots numbered in the order their
+/// first item appears, every item's number, and how many items each number has. Used for the
+/// voxels of a dense grid and for the components of [`crate::cloud::cluster`].
+pub(crate) fn number_by_first_appearance(
+    slots: impl ExactSizeIterator<Item = usize>,
+    slot_count: usize,
+) -> (Vec<u32>, Vec<u32>) {
+    let mut number_at = vec![u32::MAX; slot_count];
+    let mut numbers = 0u32;
+    let mut number_of = vec![0u32; slots.len()];
+    for (n, at) in number_of.iter_mut().zip(slots) {
+        let slot = &mut number_at[at];
         if *slot == u32::MAX {
-            *slot = voxels;
-            voxels += 1;
+            *slot = numbers;
+            numbers += 1;
         }
-        *g = *slot;
+        *n = *slot;
     }
     // The counts in a pass of their own: the numbering's loop then carries no store that
-    // the next point may have to wait for.
-    let mut count = vec![0u32; voxels as usize];
-    for &g in &group_of {
-        count[g as usize] += 1;
+    // the next item may have to wait for.
+    let mut count = vec![0u32; numbers as usize];
+    for &n in &number_of {
+        count[n as usize] += 1;
     }
-    (group_of, count)
+    (number_of, count)
 }
 
 /// Voxel numbers in order of first appearance, and each voxel's count, by open addressing
