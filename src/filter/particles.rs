@@ -399,16 +399,25 @@ impl ParticleSet {
         }
         let step = 1.0 / n as f64;
         let u0: f64 = rng.random::<f64>() * step;
-        let mut idx = Vec::with_capacity(n);
-        let mut cum = self.weights[0];
+        // The running sums first (the same additions in the same order), so that the walk
+        // below carries only its position from one step to the next.
+        let cum: Vec<f64> = self
+            .weights
+            .iter()
+            .scan(0.0, |acc, &w| {
+                *acc += w;
+                Some(*acc)
+            })
+            .collect();
+        let mut idx = vec![0usize; n];
         let mut i = 0;
-        for k in 0..n {
+        let last = self.len - 1;
+        for (k, slot) in idx.iter_mut().enumerate() {
             let u = u0 + k as f64 * step;
-            while u > cum && i + 1 < self.len {
+            while i < last && u > cum[i] {
                 i += 1;
-                cum += self.weights[i];
             }
-            idx.push(i);
+            *slot = i;
         }
         let mut states = Vec::with_capacity(self.dim * n);
         for c in 0..self.dim {
