@@ -5,7 +5,8 @@
 //! of a voxel are one contiguous, ascending slice.
 //!
 //! Used by the plane RANSAC's triple sampling (the points of a coarse cell) and by the wall
-//! rounds' bird's-eye grid (the pool's points laid flat).
+//! rounds' bird's-eye grid (the pool's points laid flat); its numbering by first appearance
+//! (`number_by_first_appearance`) also numbers the exact clustering's components.
 //!
 //! Not for: neighbour queries across voxels (see [`crate::cloud::cluster`]), or points with a
 //! non-finite coordinate (the caller drops them first).
