@@ -251,17 +251,26 @@ pub fn extract_planes(
         else {
             break;
         };
-        remove_sorted(&mut active, &inliers);
-        if let Some(g) = grid.as_mut() {
-            g.remove(&inliers);
-        }
         if first_ground.is_none() && ground_like(&plane) {
+            // The pool keeps what is clearly above the ground and not its inlier, in one pass
+            // (the ground's inliers are most of the pool: one look-up each beats finding
+            // them in it).
             let g = PlaneF32::new(&plane);
             let clearance = config.ground_clearance as f32;
-            active.retain(|&i| g.residual_signed(&pts[i as usize]) > clearance);
+            let mut taken = vec![false; pts.len()];
+            for &i in &inliers {
+                taken[i as usize] = true;
+            }
+            active
+                .retain(|&i| !taken[i as usize] && g.residual_signed(&pts[i as usize]) > clearance);
             first_ground = Some(g);
             // The wall rounds' passes look for their points on a grid of this pool.
             grid = Some(BandGrid::new(&pts, &active));
+        } else {
+            remove_sorted(&mut active, &inliers);
+            if let Some(g) = grid.as_mut() {
+                g.remove(&inliers);
+            }
         }
         extracted.push((plane, inliers));
     }
