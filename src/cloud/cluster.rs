@@ -141,20 +141,19 @@ fn cluster_indices(cloud: &PointCloud, subset: &[u32], params: &ClusterParams) -
     // smallest index with ascending indices inside.
     let (of_point, sizes) =
         number_by_first_appearance(labels.iter().map(|&l| l as usize), points.len());
-    let sizes: Vec<usize> = sizes.into_iter().map(|n| n as usize).collect();
+    let kept = |n: u32| (params.min_points..=params.max_points).contains(&(n as usize));
     let mut buckets: Vec<Vec<u32>> = sizes
         .iter()
         .map(|&n| {
-            if n >= params.min_points && n <= params.max_points {
-                Vec::with_capacity(n)
+            if kept(n) {
+                Vec::with_capacity(n as usize)
             } else {
                 Vec::new()
             }
         })
         .collect();
     for (&o, &cloud_index) in of_point.iter().zip(&members) {
-        let n = sizes[o as usize];
-        if n >= params.min_points && n <= params.max_points {
+        if kept(sizes[o as usize]) {
             buckets[o as usize].push(cloud_index);
         }
     }
