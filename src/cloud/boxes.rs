@@ -408,10 +408,8 @@ pub fn lshape_heading(xy: &[f64], params: &BoxFitParams) -> f64 {
     let steps = ((FRAC_PI_2 / params.angle_step).ceil() as usize).max(1);
     let hull = hull_xy(xy);
     // The candidates below π/2 among `ks`, with their scores.
-    let scored = |ks: &mut dyn Iterator<Item = usize>| -> Vec<(f64, usize)> {
-        let ks: Vec<usize> = ks
-            .filter(|&k| (k as f64 * params.angle_step) < FRAC_PI_2)
-            .collect();
+    let scored = |mut ks: Vec<usize>| -> Vec<(f64, usize)> {
+        ks.retain(|&k| (k as f64 * params.angle_step) < FRAC_PI_2);
         let mut out = Vec::with_capacity(ks.len());
         for batch in ks.chunks(LANES) {
             let mut lanes = [Heading::default(); LANES];
@@ -434,9 +432,9 @@ pub fn lshape_heading(xy: &[f64], params: &BoxFitParams) -> f64 {
         }
     };
     if steps <= 4 * COARSE_STEPS {
-        consider(&scored(&mut (0..steps)));
+        consider(&scored((0..steps).collect()));
     } else {
-        let coarse = scored(&mut (0..steps).step_by(COARSE_STEPS));
+        let coarse = scored((0..steps).step_by(COARSE_STEPS).collect());
         consider(&coarse);
         let mut top = [(f64::NEG_INFINITY, 0); 2];
         for &c in &coarse {
@@ -454,7 +452,7 @@ pub fn lshape_heading(xy: &[f64], params: &BoxFitParams) -> f64 {
                 let hi = (kc + COARSE_STEPS - 1).min(steps - 1);
                 (lo..=hi).filter(|k| k % COARSE_STEPS != 0)
             });
-        consider(&scored(&mut fine.collect::<Vec<_>>().into_iter()));
+        consider(&scored(fine.collect()));
     }
     best.1 as f64 * params.angle_step
 }
