@@ -20,7 +20,11 @@
 //! 4. least-squares refit on the inliers, a second MSSE/inlier pass with the refitted plane,
 //!    and a final refit. The first refit only turns the drawn plane into a fitted one: in a
 //!    pool of more than 60,000 points (the ground's round, over the whole scan) it is made on
-//!    an evenly strided part of about 30,000 of them; the second pass is over the whole pool;
+//!    an evenly strided part of about 30,000 of them; the second pass is over the whole pool.
+//!    A wall round then makes up to `PlaneConfig::wall_refits` more passes over the whole pool,
+//!    each from the plane the one before fitted, until its inliers no longer change: after two
+//!    passes a fit still leans the way the drawn triple did, and the same wall in the next
+//!    scan would be cut at another slant;
 //! 5. the inliers leave the pool. Rounds stop when fewer than `min_points` inliers are found
 //!    or `max_planes` rounds have run.
 //!

@@ -32,6 +32,14 @@ pub struct PlaneConfig {
     pub min_threshold: f64,
     /// Ceiling of the per-plane inlier threshold (m).
     pub max_threshold: f64,
+    /// Wall rounds: passes over the pool (MSSE threshold, inliers, least-squares refit) made
+    /// after the round's two, each from the plane the one before fitted; they stop early once
+    /// the inliers no longer change. Two passes leave a fit that still depends on the drawn
+    /// triple (its band catches a tilted slice of a wall that is not quite flat); each further
+    /// pass moves it towards the fixed point of threshold and fit, which is the same from scan
+    /// to scan. At most [`MAX_WALL_REFITS`]. The ground's round makes none (its fit does not
+    /// change the walls measurably, and its passes cover the whole scan).
+    pub wall_refits: usize,
     /// Ground: maximum angle between the normal and the vertical (rad).
     pub max_ground_tilt: f64,
     /// Ground: the plane must lie at least this far below the sensor origin (m).
@@ -66,6 +74,9 @@ pub struct PlaneConfig {
     /// are the same either way.
     pub ground_outline: bool,
 }
+
+/// The most [`PlaneConfig::wall_refits`] [`PlaneConfig::validate`] accepts.
+pub const MAX_WALL_REFITS: usize = 100;
 
 /// A facade test for wall pieces that already pass the size limits, so that parked cars,
 /// hedges, fences and vegetation are not kept as walls.
@@ -118,6 +129,7 @@ impl Default for PlaneConfig {
             msse_t: 2.5,
             min_threshold: 0.05,
             max_threshold: 0.20,
+            wall_refits: 2,
             max_ground_tilt: 10f64.to_radians(),
             min_ground_depth: 0.5,
             ground_clearance: 0.3,
@@ -192,6 +204,12 @@ impl PlaneConfig {
                      non-negative",
                 ));
             }
+        }
+        if self.wall_refits > MAX_WALL_REFITS {
+            return Err(Error::invalid(
+                "plane config field wall_refits",
+                format!("at most {MAX_WALL_REFITS}, got {}", self.wall_refits),
+            ));
         }
         if !(self.max_threshold.is_finite() && self.max_threshold >= self.min_threshold) {
             return Err(Error::invalid(
