@@ -141,8 +141,8 @@ impl BandGrid {
         let (hx, hy, hz) = (&hi[0][..cells], &hi[1][..cells], &hi[2][..cells]);
         // Plain compares instead of `f64::min`/`max` (the boxes are finite), so that the
         // loop vectorises.
-        let min = |x: f64, y: f64| if x < y { x } else { y };
-        let max2 = |x: f64, y: f64| if x > y { x } else { y };
+        let smaller = |x: f64, y: f64| if x < y { x } else { y };
+        let larger = |x: f64, y: f64| if x > y { x } else { y };
         let mut reach = vec![false; cells];
         for c in 0..cells {
             let (mut v_lo, mut v_hi, mut size) = (d, d, d.abs());
@@ -151,9 +151,9 @@ impl BandGrid {
                 .enumerate()
             {
                 let (x, y) = (n[a] * l, n[a] * h);
-                v_lo += min(x, y);
-                v_hi += max2(x, y);
-                size += max2(x.abs(), y.abs());
+                v_lo += smaller(x, y);
+                v_hi += larger(x, y);
+                size += larger(x.abs(), y.abs());
             }
             let margin = 1e-5 * size + 1e-6;
             reach[c] = !(v_lo - margin > max || v_hi + margin < -max);

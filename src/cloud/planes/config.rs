@@ -37,8 +37,8 @@ pub struct PlaneConfig {
     /// the inliers no longer change. Two passes leave a fit that still depends on the drawn
     /// triple (its band catches a tilted slice of a wall that is not quite flat); each further
     /// pass moves it towards the fixed point of threshold and fit, which is the same from scan
-    /// to scan. At most [`MAX_WALL_REFITS`]. The ground's round makes none (its fit does not
-    /// change the walls measurably, and its passes cover the whole scan).
+    /// to scan. At most [`MAX_WALL_REFITS`]. The ground's round makes none (refitting it moved
+    /// the walls' normals by hundredths of a degree, and its passes cover the whole scan).
     pub wall_refits: usize,
     /// Ground: maximum angle between the normal and the vertical (rad).
     pub max_ground_tilt: f64,

@@ -536,7 +536,7 @@ mod tests {
         let (pts, active) = wavy_wall_scene();
         let grid = BandGrid::new(&pts, &active);
         let min_tilt = std::f64::consts::FRAC_PI_2 - 15f64.to_radians();
-        let normals = |refits: usize| -> Vec<(Plane, Vec<u32>)> {
+        let fits = |refits: usize| -> Vec<(Plane, Vec<u32>)> {
             let config = PlaneConfig {
                 wall_refits: refits,
                 ..PlaneConfig::default()
@@ -560,7 +560,7 @@ mod tests {
             }
             worst
         };
-        let (two, many) = (normals(0), normals(50));
+        let (two, many) = (fits(0), fits(50));
         let config = PlaneConfig::default();
         for (plane, inliers) in &many {
             // A fixed point: one more pass from the plane finds the same inliers.
