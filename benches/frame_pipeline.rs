@@ -8,6 +8,9 @@
 //! Groups:
 //! * `frame/read`: read and decode the `.bin`;
 //! * `frame/planes`: ground and wall segmentation (`extract_planes`, default configuration);
+//! * `frame/voxel_groups_flat`, `frame/voxel_groups_sample`: the frame's points grouped
+//!   by 2 m cells, laid flat in scan order (as the wall rounds' bird's-eye grid groups its
+//!   pool) and as a random subsample of 6,000 of them (as a RANSAC round groups its sample);
 //! * `frame/clusters`: Euclidean clustering of the points left after plane removal;
 //! * `frame/clusters_range_image`: the same points clustered on the scan's range image
 //!   (building the image included);
@@ -31,6 +34,7 @@ use nalgebra::Isometry3;
 use smc_lmb::cloud::boxes::{fit_box_of, outline_of, BoxFitParams, BoxScratch, SizePrior};
 use smc_lmb::cloud::planes::{extract_planes, PlaneConfig};
 use smc_lmb::cloud::range_image::{range_image_clusters, ImageClusterParams, RangeImage};
+use smc_lmb::cloud::voxel_groups::VoxelGroups;
 use smc_lmb::cloud::{euclidean_clusters_of, read_kitti_bin, Cluster, ClusterParams, PointCloud};
 use smc_lmb::pipeline::drive_tracking::{
     detect_objects, ClusterMethod, DriveTracker, FrameDetections, TrackingConfig,
@@ -77,6 +81,7 @@ fn frame(c: &mut Criterion) {
     g.bench_function("planes", |b| {
         b.iter(|| extract_planes(&cloud, &planes, &mut seeded(1)).unwrap())
     });
+    voxel_groups(&mut g, &cloud);
     g.bench_function("clusters", |b| {
         b.iter(|| euclidean_clusters_of(&cloud, &seg.remaining, &clusters).unwrap())
     });
@@ -103,6 +108,29 @@ fn frame(c: &mut Criterion) {
     boxes(&mut g, &cloud, &found);
     filter_update(&mut g, &path, &cloud);
     g.finish();
+}
+
+/// The frame's points grouped by 2 m cells: laid flat in scan order, and a random subsample.
+fn voxel_groups(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    cloud: &PointCloud,
+) {
+    use rand::RngExt;
+    let points: Vec<[f32; 3]> = (0..cloud.len())
+        .map(|i| [cloud.xs()[i], cloud.ys()[i], cloud.zs()[i]])
+        .filter(|p| p.iter().all(|v| v.is_finite()))
+        .collect();
+    let flat: Vec<[f32; 3]> = points.iter().map(|p| [p[0], p[1], 0.0]).collect();
+    let mut rng = seeded(1);
+    let sample: Vec<[f32; 3]> = (0..6000)
+        .map(|_| points[rng.random_range(0..points.len())])
+        .collect();
+    g.bench_function("voxel_groups_flat", |b| {
+        b.iter(|| VoxelGroups::new(&flat, 2.0))
+    });
+    g.bench_function("voxel_groups_sample", |b| {
+        b.iter(|| VoxelGroups::new(&sample, 2.0))
+    });
 }
 
 /// Every cluster's box bare and with a car's footprint: one heading search or two fits.

@@ -55,10 +55,17 @@ impl VoxelGroups {
         start.push(acc);
         let mut next = start.clone();
         let mut order = vec![0u32; m];
-        for (i, &id) in group_of.iter().enumerate() {
-            let id = id as usize;
-            order[next[id] as usize] = i as u32;
-            next[id] += 1;
+        // Run by run: points in scan order come in runs of one voxel, and an increment per
+        // point would wait for the one before it.
+        let mut first = 0u32;
+        for run in group_of.chunk_by(|a, b| a == b) {
+            let id = run[0] as usize;
+            let to = next[id] as usize;
+            for (k, slot) in (first..).zip(&mut order[to..to + run.len()]) {
+                *slot = k;
+            }
+            next[id] += run.len() as u32;
+            first += run.len() as u32;
         }
         VoxelGroups {
             order,
@@ -135,11 +142,12 @@ pub(crate) fn number_by_first_appearance(
         }
         *n = *slot;
     }
-    // The counts in a pass of their own: the numbering's loop then carries no store that
-    // the next item may have to wait for.
+    // The counts in a pass of their own, run by run: the numbering's loop then carries no
+    // store that the next item may have to wait for, and neither does this one (items in
+    // scan order come in runs of one number).
     let mut count = vec![0u32; numbers as usize];
-    for &n in &number_of {
-        count[n as usize] += 1;
+    for run in number_of.chunk_by(|a, b| a == b) {
+        count[run[0] as usize] += run.len() as u32;
     }
     (number_of, count)
 }
