@@ -29,20 +29,11 @@ impl VoxelGroups {
     /// `edge` (positive). A coordinate beyond `edge · 2³¹` shares the outermost voxel of its
     /// axis.
     pub fn new(points: &[[f32; 3]], edge: f32) -> Self {
-        let inv = 1.0 / edge;
-        let keys: Vec<[i32; 3]> = points
-            .iter()
-            .map(|p| {
-                [
-                    floor_f32_i32(p[0] * inv),
-                    floor_f32_i32(p[1] * inv),
-                    floor_f32_i32(p[2] * inv),
-                ]
-            })
-            .collect();
-        let (group_of, count) = match dense_extent(&keys) {
-            Some((lo, span)) => number_on_grid(&keys, lo, span),
-            None => number_by_hash(&keys),
+        let coords = floor_scaled(points.as_flattened(), 1.0 / edge);
+        let (keys, _) = coords.as_chunks::<3>();
+        let (group_of, count) = match dense_extent(keys) {
+            Some((lo, span)) => number_on_grid(keys, lo, span),
+            None => number_by_hash(keys),
         };
         let m = points.len();
         // Start of every voxel's run, then the indices in ascending order into their runs.
@@ -93,6 +84,24 @@ impl VoxelGroups {
     pub fn group_of(&self, i: usize) -> usize {
         self.group_of[i] as usize
     }
+}
+
+/// `⌊v · inv⌋` of every coordinate, as `floor_f32_i32` gives it; on x86-64 with AVX2 eight
+/// lanes at a time (a rounding instruction and a saturating conversion: the same integers).
+fn floor_scaled(v: &[f32], inv: f32) -> Vec<i32> {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has just been found to support AVX2.
+        return unsafe { floor_scaled_avx2(v, inv) };
+    }
+    v.iter().map(|&x| floor_f32_i32(x * inv)).collect()
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn floor_scaled_avx2(v: &[f32], inv: f32) -> Vec<i32> {
+    // With AVX2 (and so SSE4.1) `floor` is an instruction, not a call.
+    v.iter().map(|&x| (x * inv).floor() as i32).collect()
 }
 
 /// The keys' smallest corner and their extent per axis, when a dense array over that box
