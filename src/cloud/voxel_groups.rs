@@ -242,6 +242,16 @@ mod tests {
     }
 
     proptest! {
+        /// The lanes' floors are `floor_f32_i32`'s, out to the saturated ends.
+        #[test]
+        fn lane_floors_are_the_scalar_ones(
+            v in prop::collection::vec(prop_oneof![-5.0f32..5.0, -1e12f32..1e12], 0..100),
+            inv in prop_oneof![Just(0.5f32), 0.01f32..100.0],
+        ) {
+            let want: Vec<i32> = v.iter().map(|&x| floor_f32_i32(x * inv)).collect();
+            prop_assert_eq!(floor_scaled(&v, inv), want);
+        }
+
         /// Against the definition: two points share a group exactly when their floored
         /// coordinates agree; groups are numbered by first appearance.
         #[test]
