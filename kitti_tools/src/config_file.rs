@@ -14,7 +14,13 @@ pub fn tracking_config(
     particles: Option<usize>,
 ) -> Result<smc_lmb::pipeline::drive_tracking::TrackingConfig> {
     let mut config: smc_lmb::pipeline::drive_tracking::TrackingConfig = match path {
-        Some(p) => read_config(p)?,
+        Some(p) => {
+            let config: smc_lmb::pipeline::drive_tracking::TrackingConfig = read_config(p)?;
+            config
+                .validate()
+                .with_context(|| format!("{}", p.display()))?;
+            config
+        }
         None => Default::default(),
     };
     if let Some(n) = particles {

@@ -56,6 +56,14 @@ pub struct Args {
     /// lidar odometry otherwise). Lidar odometry predicts with the measured motion.
     #[arg(long, value_enum, default_value_t = Ego::Auto)]
     ego: Ego,
+    /// Plane segmentation settings, a TOML or JSON file with any subset of the library's
+    /// `PlaneConfig` fields (the others keep their defaults).
+    #[arg(long, value_name = "FILE")]
+    planes_config: Option<PathBuf>,
+    /// Passes a wall round makes after its two, towards the fit that no longer depends on
+    /// the drawn triple (overrides the settings; default 2, at most 100).
+    #[arg(long, value_name = "N")]
+    wall_refits: Option<usize>,
 }
 
 /// Source of the ego motion.
@@ -104,10 +112,19 @@ impl Input {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
+    let mut planes: smc_lmb::cloud::planes::PlaneConfig = match &args.planes_config {
+        Some(path) => crate::config_file::read_config(path)?,
+        None => Default::default(),
+    };
+    if let Some(n) = args.wall_refits {
+        planes.wall_refits = n;
+    }
     let config = PlanePredictionConfig {
+        planes,
         use_vehicle_model: !args.measured,
         ..PlanePredictionConfig::default()
     };
+    config.validate().context("plane segmentation settings")?;
     let frames = if args.all {
         None
     } else {

@@ -67,9 +67,14 @@ pub struct Args {
     /// The frame `--frame-plot` draws (default: the first tracked frame).
     #[arg(long, requires = "frame_plot")]
     frame_plot_at: Option<usize>,
-    /// Models and tuning (.toml or .json); see `TrackingConfig`.
+    /// Models and tuning (.toml or .json); see `TrackingConfig` (its `planes` section is the
+    /// plane segmentation's).
     #[arg(long)]
     config: Option<PathBuf>,
+    /// Passes a wall round makes after its two, towards the fit that no longer depends on
+    /// the drawn triple (overrides the config's `planes.wall_refits`; default 2, at most 100).
+    #[arg(long, value_name = "N")]
+    wall_refits: Option<usize>,
     /// Move walls by a per-particle draw of the vehicle model instead of the measured poses.
     #[arg(long)]
     ect: bool,
@@ -148,6 +153,9 @@ pub fn run(args: Args) -> Result<()> {
     }
     config.poses = args.ego.into();
     config.all_clusters = args.all_clusters;
+    if let Some(n) = args.wall_refits {
+        config.planes.wall_refits = n;
+    }
     let baseline = std::cell::RefCell::new(BaselineBoxes::new());
     let frames = args.frames.as_deref().map(parse_range).transpose()?;
     for dir in [&args.las, &args.ply].into_iter().flatten() {

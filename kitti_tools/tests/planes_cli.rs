@@ -160,3 +160,62 @@ fn ego_motion_source_is_chosen_and_said() {
     let stderr = String::from_utf8_lossy(&huge.stderr);
     assert!(stderr.contains("18446744073709551615"), "{stderr}");
 }
+
+#[test]
+fn segmentation_settings_come_from_a_file_and_a_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    ok(&run(&[
+        "synth",
+        "--out",
+        out.to_str().unwrap(),
+        "--frames",
+        "2",
+        "--seed",
+        "4",
+        "--quiet",
+    ]));
+    let d = out.join("2020_01_01/2020_01_01_drive_0001_sync");
+    let d = d.to_str().unwrap();
+    let pairs = |extra: &[&str]| -> u64 {
+        let mut args = vec![
+            "planes",
+            "--drive",
+            d,
+            "--frame",
+            "0",
+            "--measured",
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        let text = ok(&run(&args));
+        let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+        json["summary"]["pairs"].as_u64().unwrap()
+    };
+    // The simulated street's walls are found with the defaults, and none when a file allows
+    // one round only (the ground's).
+    assert!(pairs(&[]) >= 3);
+    let one_round = dir.path().join("one_round.toml");
+    std::fs::write(&one_round, "max_planes = 1\n").unwrap();
+    assert_eq!(pairs(&["--planes-config", one_round.to_str().unwrap()]), 0);
+    assert!(pairs(&["--wall-refits", "0"]) >= 3);
+    // A misspelt field names the file; a refit count past the limit is refused.
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, "max_plane = 1\n").unwrap();
+    let refused = run(&[
+        "planes",
+        "--drive",
+        d,
+        "--planes-config",
+        bad.to_str().unwrap(),
+    ]);
+    assert!(!refused.status.success());
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        stderr.contains("bad.toml") && stderr.contains("max_plane"),
+        "{stderr}"
+    );
+    let refused = run(&["planes", "--drive", d, "--wall-refits", "101"]);
+    assert!(!refused.status.success());
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("wall_refits"));
+}

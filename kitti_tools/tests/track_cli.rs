@@ -110,6 +110,32 @@ fn bad_inputs_fail_with_clear_messages() {
         "{stderr}"
     );
 
+    // The plane segmentation's section: checked, and named with the file.
+    std::fs::write(&config, "[planes]\nwall_refits = 101\n").unwrap();
+    let (ok, _, stderr) = run(&[
+        "track",
+        "--drive",
+        drive.to_str().unwrap(),
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && stderr.contains("bad.toml") && stderr.contains("wall_refits"),
+        "{stderr}"
+    );
+    let (ok, _, stderr) = run(&[
+        "track",
+        "--drive",
+        drive.to_str().unwrap(),
+        "--wall-refits",
+        "101",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!ok && stderr.contains("wall_refits"), "{stderr}");
+
     let bin = drive.join("velodyne_points/data/0000000001.bin");
     let bytes = std::fs::read(&bin).unwrap();
     std::fs::write(&bin, &bytes[..bytes.len() - 3]).unwrap();

@@ -6,7 +6,13 @@
 use crate::error::{Error, Result};
 
 /// Parameters of [`extract_planes`](super::extract_planes). Lengths in metres, areas in m², angles in radians.
-#[derive(Clone, Debug, PartialEq)]
+///
+/// A configuration file (the `planes` section of `track`'s, or `planes --planes-config`) may
+/// set any subset of the fields; the others keep their defaults. `wall_quality = null` (JSON)
+/// turns the facade test off; TOML has no null, so there a file can only change the test's
+/// limits.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct PlaneConfig {
     /// Maximum number of RANSAC rounds (planes extracted, accepted or not).
     pub max_planes: usize,
@@ -92,7 +98,8 @@ pub const MAX_WALL_REFITS: usize = 100;
 ///   normal), up to the slope of the road the ground was fitted to. The fitted plane of a hedge,
 ///   a tree row or a car side leans by several degrees, and leans differently from scan to
 ///   scan, which is what makes such "walls" unrepeatable.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct WallQuality {
     /// The patch's top must be at least this high above the sensor's horizontal plane
     /// (z = 0 of the sensor frame), m; negative values admit tops below the sensor.
@@ -102,6 +109,13 @@ pub struct WallQuality {
     /// Largest angle between the piece's plane and the local vertical (rad): the normal's
     /// elevation above the ground plane (or, without a ground, above the sensor's x-y plane).
     pub max_lean: f64,
+}
+
+impl Default for WallQuality {
+    /// [`WallQuality::BUILDING`].
+    fn default() -> Self {
+        WallQuality::BUILDING
+    }
 }
 
 impl WallQuality {
@@ -230,5 +244,38 @@ impl PlaneConfig {
             ));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_file_sets_a_subset_and_the_rest_keeps_the_defaults() {
+        let c: PlaneConfig = serde_json::from_str(r#"{"wall_refits": 4}"#).unwrap();
+        assert_eq!(
+            c,
+            PlaneConfig {
+                wall_refits: 4,
+                ..PlaneConfig::default()
+            }
+        );
+        let c: PlaneConfig =
+            serde_json::from_str(r#"{"wall_quality": {"max_rms": 0.1}}"#).unwrap();
+        assert_eq!(
+            c.wall_quality,
+            Some(WallQuality {
+                max_rms: 0.1,
+                ..WallQuality::BUILDING
+            })
+        );
+        let c: PlaneConfig = serde_json::from_str(r#"{"wall_quality": null}"#).unwrap();
+        assert_eq!(c.wall_quality, None);
+        let back: PlaneConfig =
+            serde_json::from_str(&serde_json::to_string(&PlaneConfig::default()).unwrap())
+                .unwrap();
+        assert_eq!(back, PlaneConfig::default());
+        assert!(serde_json::from_str::<PlaneConfig>(r#"{"wall_refit": 4}"#).is_err());
     }
 }

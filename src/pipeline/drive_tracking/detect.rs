@@ -21,7 +21,7 @@ use crate::cloud::boxes::BoxScratch;
 use crate::cloud::classes::ClassModel;
 use crate::cloud::cluster::{euclidean_clusters_of, ClusterParams};
 use crate::cloud::fragments::merge_grazing_fragments;
-use crate::cloud::planes::extract_planes;
+use crate::cloud::planes::{extract_planes, PlaneConfig};
 use crate::cloud::range_image::{
     range_image_clusters, ImageClusterParams, RangeImage, RangeImageConfig,
 };
@@ -188,7 +188,12 @@ pub(super) fn segment_here(
     rng: &mut FilterRng,
 ) -> Result<Segmented> {
     let start = Instant::now();
-    let seg = extract_planes(cloud, &config.planes, rng)?;
+    // The tracker uses the ground's plane and inliers, never its rectangle.
+    let planes = PlaneConfig {
+        ground_outline: false,
+        ..config.planes.clone()
+    };
+    let seg = extract_planes(cloud, &planes, rng)?;
     let planes_ms = start.elapsed().as_secs_f64() * 1e3;
 
     let start = Instant::now();

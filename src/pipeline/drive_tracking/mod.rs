@@ -312,8 +312,8 @@ pub const DUPLICATE_MERGE_THRESHOLD: f64 = 9.0;
 pub const REPORT_MIN_EXISTENCE: f64 = 0.9;
 
 /// Everything [`track_drive`] needs besides the drive and the seed. Every field has a default;
-/// a JSON or TOML file may set any subset. The plane segmentation uses
-/// [`PlaneConfig::default`] (not part of the file).
+/// a JSON or TOML file may set any subset (in `planes` too: the fields it leaves out keep
+/// [`PlaneConfig::default`]'s values).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct TrackingConfig {
@@ -350,8 +350,9 @@ pub struct TrackingConfig {
     /// for a frame or two after their object left, at existence 0.5–0.9). Not applied with
     /// `all_clusters`. Default [`REPORT_MIN_EXISTENCE`].
     pub report_min_existence: f64,
-    /// Plane segmentation.
-    #[serde(skip)]
+    /// Plane segmentation. Default: [`PlaneConfig::default`]. The tracker never computes the
+    /// ground's rectangle (it uses the ground's plane and inliers only), whatever
+    /// `ground_outline` says.
     pub planes: PlaneConfig,
 }
 
@@ -374,11 +375,7 @@ impl Default for TrackingConfig {
             dt: 0.1,
             all_clusters: false,
             report_min_existence: REPORT_MIN_EXISTENCE,
-            // The tracker uses the ground's plane and inliers, never its rectangle.
-            planes: PlaneConfig {
-                ground_outline: false,
-                ..PlaneConfig::default()
-            },
+            planes: PlaneConfig::default(),
         }
     }
 }
