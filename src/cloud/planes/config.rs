@@ -261,8 +261,7 @@ mod tests {
                 ..PlaneConfig::default()
             }
         );
-        let c: PlaneConfig =
-            serde_json::from_str(r#"{"wall_quality": {"max_rms": 0.1}}"#).unwrap();
+        let c: PlaneConfig = serde_json::from_str(r#"{"wall_quality": {"max_rms": 0.1}}"#).unwrap();
         assert_eq!(
             c.wall_quality,
             Some(WallQuality {
@@ -273,8 +272,7 @@ mod tests {
         let c: PlaneConfig = serde_json::from_str(r#"{"wall_quality": null}"#).unwrap();
         assert_eq!(c.wall_quality, None);
         let back: PlaneConfig =
-            serde_json::from_str(&serde_json::to_string(&PlaneConfig::default()).unwrap())
-                .unwrap();
+            serde_json::from_str(&serde_json::to_string(&PlaneConfig::default()).unwrap()).unwrap();
         assert_eq!(back, PlaneConfig::default());
         assert!(serde_json::from_str::<PlaneConfig>(r#"{"wall_refit": 4}"#).is_err());
     }

@@ -66,9 +66,13 @@ pub(super) fn one_round(
     let sample: Vec<[f32; 3]> = if m == active.len() {
         active.iter().map(|&i| pts[i as usize]).collect()
     } else {
-        (0..m)
-            .map(|_| pts[active[rng.random_range(0..active.len())] as usize])
-            .collect()
+        // The draws first, then the two look-ups, each in a loop of its own: the loads of one
+        // loop do not wait on each other or on the generator, so many are in flight at once.
+        let draws: Vec<u32> = (0..m)
+            .map(|_| rng.random_range(0..active.len()) as u32)
+            .collect();
+        let ids: Vec<u32> = draws.iter().map(|&k| active[k as usize]).collect();
+        ids.iter().map(|&i| pts[i as usize]).collect()
     };
     let cells = VoxelGroups::new(&sample, config.sample_cell as f32);
 
