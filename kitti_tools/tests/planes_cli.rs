@@ -104,21 +104,27 @@ fn paper_tables_on_the_papers_drive_find_its_three_walls() {
     );
 }
 
-#[test]
-fn ego_motion_source_is_chosen_and_said() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("out");
+/// A simulated street of `frames` frames (seed 4) written under `dir` as a raw drive.
+fn street_drive(dir: &std::path::Path, frames: usize) -> PathBuf {
+    let out = dir.join("out");
+    let frames = frames.to_string();
     ok(&run(&[
         "synth",
         "--out",
         out.to_str().unwrap(),
         "--frames",
-        "3",
+        &frames,
         "--seed",
         "4",
         "--quiet",
     ]));
-    let drive = out.join("2020_01_01/2020_01_01_drive_0001_sync");
+    out.join("2020_01_01/2020_01_01_drive_0001_sync")
+}
+
+#[test]
+fn ego_motion_source_is_chosen_and_said() {
+    let dir = tempfile::tempdir().unwrap();
+    let drive = street_drive(dir.path(), 3);
     let d = drive.to_str().unwrap();
     let text = ok(&run(&[
         "planes", "--drive", d, "--frame", "0", "--runs", "2",
@@ -164,19 +170,8 @@ fn ego_motion_source_is_chosen_and_said() {
 #[test]
 fn segmentation_settings_come_from_a_file_and_a_flag() {
     let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("out");
-    ok(&run(&[
-        "synth",
-        "--out",
-        out.to_str().unwrap(),
-        "--frames",
-        "2",
-        "--seed",
-        "4",
-        "--quiet",
-    ]));
-    let d = out.join("2020_01_01/2020_01_01_drive_0001_sync");
-    let d = d.to_str().unwrap();
+    let drive = street_drive(dir.path(), 2);
+    let d = drive.to_str().unwrap();
     let pairs = |extra: &[&str]| -> u64 {
         let mut args = vec![
             "planes",

@@ -94,37 +94,27 @@ fn bad_inputs_fail_with_clear_messages() {
     ]);
     assert!(!ok && stderr.contains("--frames"), "{stderr}");
 
+    // A config file that fails is named with the field at fault.
     let config = tmp.path().join("bad.toml");
-    std::fs::write(&config, "[plane]\nsigma_angel = 0.1\n").unwrap();
-    let (ok, _, stderr) = run(&[
-        "track",
-        "--drive",
-        drive.to_str().unwrap(),
-        "--config",
-        config.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(
-        !ok && stderr.contains("bad.toml") && stderr.contains("sigma_angel"),
-        "{stderr}"
-    );
-
-    // The plane segmentation's section: checked, and named with the file.
-    std::fs::write(&config, "[planes]\nwall_refits = 101\n").unwrap();
-    let (ok, _, stderr) = run(&[
-        "track",
-        "--drive",
-        drive.to_str().unwrap(),
-        "--config",
-        config.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(
-        !ok && stderr.contains("bad.toml") && stderr.contains("wall_refits"),
-        "{stderr}"
-    );
+    let with_config = |text: &str, field: &str| {
+        std::fs::write(&config, text).unwrap();
+        let (ok, _, stderr) = run(&[
+            "track",
+            "--drive",
+            drive.to_str().unwrap(),
+            "--config",
+            config.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(
+            !ok && stderr.contains("bad.toml") && stderr.contains(field),
+            "{stderr}"
+        );
+    };
+    with_config("[plane]\nsigma_angel = 0.1\n", "sigma_angel");
+    // The plane segmentation's section is checked as well.
+    with_config("[planes]\nwall_refits = 101\n", "wall_refits");
     let (ok, _, stderr) = run(&[
         "track",
         "--drive",
