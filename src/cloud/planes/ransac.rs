@@ -174,10 +174,7 @@ pub(super) fn one_round(
             .as_ref()
             .map_or(hyps[best], |(p, _)| PlaneF32::new(p));
         let inliers = band_inliers(pts, pool, grid.filter(|_| whole), &plane, config);
-        if inliers.len() < least {
-            // A refit pass that loses the plane keeps the fit before it.
-            return if pass < 2 { None } else { fitted };
-        }
+        // A fixed point (the inliers the fit before had, so at least `min_points` of them).
         if pass >= 2
             && fitted
                 .as_ref()
@@ -185,7 +182,13 @@ pub(super) fn one_round(
         {
             break;
         }
-        let Some(p) = fit_chunked(pts, &inliers) else {
+        let fit = if inliers.len() < least {
+            None
+        } else {
+            fit_chunked(pts, &inliers)
+        };
+        let Some(p) = fit else {
+            // A refit pass that loses the plane keeps the fit before it.
             return if pass < 2 { None } else { fitted };
         };
         fitted = Some((p, inliers));
