@@ -14,18 +14,25 @@ pub fn tracking_config(
     particles: Option<usize>,
 ) -> Result<smc_lmb::pipeline::drive_tracking::TrackingConfig> {
     let mut config: smc_lmb::pipeline::drive_tracking::TrackingConfig = match path {
-        Some(p) => {
-            let config: smc_lmb::pipeline::drive_tracking::TrackingConfig = read_config(p)?;
-            config
-                .validate()
-                .with_context(|| format!("{}", p.display()))?;
-            config
-        }
+        Some(p) => read_checked(
+            p,
+            |c: &smc_lmb::pipeline::drive_tracking::TrackingConfig| c.validate(),
+        )?,
         None => Default::default(),
     };
     if let Some(n) = particles {
         config.filter.particles = n;
     }
+    Ok(config)
+}
+
+/// [`read_config`], then `check` (the type's own validation), whose error names the file.
+pub fn read_checked<T: DeserializeOwned>(
+    path: &Path,
+    check: impl FnOnce(&T) -> smc_lmb::Result<()>,
+) -> Result<T> {
+    let config = read_config(path)?;
+    check(&config).with_context(|| format!("{}", path.display()))?;
     Ok(config)
 }
 

@@ -4,6 +4,7 @@
 
 use crate::paper_tables;
 use anyhow::{bail, Context, Result};
+use smc_lmb::cloud::planes::PlaneConfig;
 use smc_lmb::kitti::{OdometrySequence, RawDrive, TrackingSequence};
 use smc_lmb::metrics::{PlanePairError, PlanePredictionSummary};
 use smc_lmb::pipeline::{
@@ -112,8 +113,8 @@ impl Input {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    let mut planes: smc_lmb::cloud::planes::PlaneConfig = match &args.planes_config {
-        Some(path) => crate::config_file::read_config(path)?,
+    let mut planes: PlaneConfig = match &args.planes_config {
+        Some(path) => crate::config_file::read_checked(path, |c: &PlaneConfig| c.validate())?,
         None => Default::default(),
     };
     if let Some(n) = args.wall_refits {

@@ -210,6 +210,21 @@ fn segmentation_settings_come_from_a_file_and_a_flag() {
         stderr.contains("bad.toml") && stderr.contains("max_plane"),
         "{stderr}"
     );
+    // So is one in a file, which the error names.
+    std::fs::write(&bad, "wall_refits = 101\n").unwrap();
+    let refused = run(&[
+        "planes",
+        "--drive",
+        d,
+        "--planes-config",
+        bad.to_str().unwrap(),
+    ]);
+    assert!(!refused.status.success());
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        stderr.contains("bad.toml") && stderr.contains("wall_refits"),
+        "{stderr}"
+    );
     let refused = run(&["planes", "--drive", d, "--wall-refits", "101"]);
     assert!(!refused.status.success());
     assert!(String::from_utf8_lossy(&refused.stderr).contains("wall_refits"));
