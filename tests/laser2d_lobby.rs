@@ -61,7 +61,7 @@ fn scores(seeds: std::ops::RangeInclusive<u64>) -> [(f64, usize); 3] {
 }
 
 /// The target for the lobby: the LMB's OSPA(2) (c = 2 m, p = 1) below both GNN's and
-/// ML-RANSAC's. Seeds 1–2 (the README reports seeds 1–8 and 11–18); a tracker that splits
+/// ML-RANSAC's. Seeds 1–2 (`docs/laser2d.md` reports seeds 1–8 and 11–18); a tracker that splits
 /// people into many labels or loses them sits near the cut-off.
 #[test]
 fn in_the_lobby_the_lmb_beats_gnn_and_ml_ransac_on_ospa2() {

@@ -302,12 +302,12 @@ impl Default for ClusterDetectionConfig {
 /// merge when their posterior means lie within a squared distance of 9 (3 standard deviations
 /// of the two tracks' summed spread along one component, or less along several). Measured on
 /// sequence 0000's frames 0–49 and the 22 simulated sequences against 4, 16, 36 and 100 (the
-/// README's road-user section): 4 and 16 score about the same, from 36 up the simulated
+/// measurements in `docs/road_users.md`): 4 and 16 score about the same, from 36 up the simulated
 /// pedestrians' HOTA falls (0.761 → 0.737 at 36) and at 100 distinct objects merge.
 pub const DUPLICATE_MERGE_THRESHOLD: f64 = 9.0;
 
 /// The default [`TrackingConfig::report_min_existence`]: 0.9. On sequence 0000's frames 0–49
-/// and the 22 simulated sequences (README, road users) reporting every line of the MAP
+/// and the 22 simulated sequences (`docs/road_users.md`) reporting every line of the MAP
 /// estimate, or only those at 0.99, both scored lower.
 pub const REPORT_MIN_EXISTENCE: f64 = 0.9;
 
