@@ -67,11 +67,17 @@ fn street_road_users_are_boxed_classed_and_scored_beside_the_baseline() {
             sb.clear.idsw
         );
         assert!(ca.truth_objects > 40, "{ca:?}");
-        // The street's road users within 40 m in view: most are tracked, few reports are
-        // false, and labels do not switch more often than the baseline's.
+        // The street's road users within 40 m in view: most are tracked, and labels do not
+        // switch more often than the baseline's.
         assert!(sa.clear.recall >= 0.6, "{:?}: {:?}", ca.class, sa.clear);
-        assert!(sa.clear.precision >= 0.9, "{:?}: {:?}", ca.class, sa.clear);
         assert!(sa.clear.idsw <= sb.clear.idsw, "{:?}", ca.class);
+        if !EvalClass::ALL.contains(&ca.class) {
+            // The groups also count the reports of their other types (vans, cyclists), which
+            // KITTI's two classes leave out.
+            continue;
+        }
+        // Few of the class's reports are false.
+        assert!(sa.clear.precision >= 0.9, "{:?}: {:?}", ca.class, sa.clear);
         if ca.class == EvalClass::Car {
             assert!(sa.hota.hota > 0.6, "{:?}", sa.hota);
         }

@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use smc_lmb::kitti::labels::label_frame_count;
 use smc_lmb::kitti::{read_tracking_labels, TrackingSequence};
 use smc_lmb::pipeline::kitti_tracking_eval::{
-    evaluate_kitti_tracking, EvalClass, KittiEvalConfig, KittiTrackingEvaluation,
+    evaluate_kitti_tracking, KittiEvalConfig, KittiTrackingEvaluation,
 };
 use std::path::{Path, PathBuf};
 
@@ -132,10 +132,7 @@ fn print_table(path: &Path, e: &KittiTrackingEvaluation) {
     for c in &e.classes {
         let (h, cl, id) = (&c.scores.hota, &c.scores.clear, &c.scores.identity);
         let p = |v: f64| format!("{:.2}", 100.0 * v);
-        let name = match c.class {
-            EvalClass::Car => "Car",
-            EvalClass::Pedestrian => "Pedestrian",
-        };
+        let name = c.class.name();
         println!(
             "{:<11}{:>7}{:>7}{:>7}{:>7}{:>9}{:>7}{:>6}{:>6}{:>5}{:>5}{:>7}{:>7}{:>7}{:>7}{:>7}",
             name,

@@ -312,6 +312,18 @@ fn track_writes_kitti_results_of_the_lmb_and_the_baseline_which_eval_scores() {
             scores.contains("HOTA") && scores.contains("Car"),
             "{scores}"
         );
+        // The groups: these frames' van, cyclist and pedestrians are road users to score
+        // (KITTI's Car class has none of them), and something of them is found.
+        let row = |name: &str| -> Vec<f64> {
+            let line = scores.lines().find(|l| l.starts_with(name)).expect(name);
+            line[name.len()..]
+                .split_whitespace()
+                .map(|v| v.parse().unwrap())
+                .collect()
+        };
+        let (road, car_van) = (row("Road users"), row("Car+Van"));
+        assert!(road[13] > 0.0 && car_van[13] > 0.0, "{scores}");
+        assert!(road[12] > 0.0, "no road user found: {scores}");
     }
     // Results need the tracking layout's calibration.
     let out = common::output(&[

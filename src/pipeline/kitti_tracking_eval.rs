@@ -2,9 +2,11 @@
 //! count, per class, before the scores of [`crate::metrics::tracking`] are computed.
 //!
 //! Per frame and class (Car, or Pedestrian), following TrackEval's `Kitti2DBox`
-//! preprocessing:
+//! preprocessing, and by the same rules for two groups KITTI's benchmark does not score
+//! (Car+Van, and every road user whatever its type; see [`EvalClass`]):
 //! 1. Truth objects of the class and of its distractor class (Van for Car, Person_sitting for
-//!    Pedestrian) take part; tracker objects of the class only; negative ids are dropped.
+//!    Pedestrian; the groups have none) take part; tracker objects of the class only (of any
+//!    type the group holds); negative ids are dropped.
 //! 2. Truth and tracker objects are matched one-to-one (Hungarian, similarity at least the
 //!    match threshold). A tracker object matched to a truth object that does not count — a
 //!    distractor, occluded beyond level 2, truncated at all (truncation level > 0), or outside
@@ -129,7 +131,12 @@ fn overlap(a: &[f64; 4], b: &[f64; 4]) -> f64 {
     (a[2].min(b[2]) - a[0].max(b[0])).max(0.0) * (a[3].min(b[3]) - a[1].max(b[1])).max(0.0)
 }
 
-/// The classes KITTI's tracking benchmark scores.
+/// What is scored: KITTI's tracking benchmark classes (Car, Pedestrian) and two groups of
+/// labelled types that it does not score but a road-user tracker is judged by.
+///
+/// A group has no distractor: every truth object of its types counts, and a tracker object of
+/// any of its types may match any of them (a van reported as a car is found in `CarVan`, a
+/// cyclist reported as a pedestrian in `RoadUser`).
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum EvalClass {
@@ -137,25 +144,62 @@ pub enum EvalClass {
     Car,
     /// Pedestrians; sitting persons are distractors.
     Pedestrian,
+    /// Cars and vans together.
+    CarVan,
+    /// Every labelled road user: Car, Van, Truck, Pedestrian, Person_sitting, Cyclist, Tram.
+    RoadUser,
 }
 
+/// The types of [`EvalClass::RoadUser`].
+const ROAD_USER_TYPES: [ObjectType; 7] = [
+    ObjectType::Car,
+    ObjectType::Van,
+    ObjectType::Truck,
+    ObjectType::Pedestrian,
+    ObjectType::PersonSitting,
+    ObjectType::Cyclist,
+    ObjectType::Tram,
+];
+
 impl EvalClass {
-    /// Both classes, in KITTI's order.
+    /// KITTI's benchmark classes, in KITTI's order.
     pub const ALL: [EvalClass; 2] = [EvalClass::Car, EvalClass::Pedestrian];
 
-    /// The scored label type.
-    pub fn object_type(self) -> ObjectType {
+    /// Everything [`evaluate_kitti_tracking`] scores: KITTI's classes, then the two groups.
+    pub const SCORED: [EvalClass; 4] = [
+        EvalClass::Car,
+        EvalClass::Pedestrian,
+        EvalClass::CarVan,
+        EvalClass::RoadUser,
+    ];
+
+    /// The name printed in tables.
+    pub fn name(self) -> &'static str {
         match self {
-            EvalClass::Car => ObjectType::Car,
-            EvalClass::Pedestrian => ObjectType::Pedestrian,
+            EvalClass::Car => "Car",
+            EvalClass::Pedestrian => "Pedestrian",
+            EvalClass::CarVan => "Car+Van",
+            EvalClass::RoadUser => "Road users",
         }
     }
 
-    /// The truth type whose matches are neither rewarded nor punished.
-    pub fn distractor(self) -> ObjectType {
+    /// Whether truth and tracker objects of type `t` belong to the class.
+    pub fn holds(self, t: ObjectType) -> bool {
         match self {
-            EvalClass::Car => ObjectType::Van,
-            EvalClass::Pedestrian => ObjectType::PersonSitting,
+            EvalClass::Car => t == ObjectType::Car,
+            EvalClass::Pedestrian => t == ObjectType::Pedestrian,
+            EvalClass::CarVan => matches!(t, ObjectType::Car | ObjectType::Van),
+            EvalClass::RoadUser => ROAD_USER_TYPES.contains(&t),
+        }
+    }
+
+    /// Whether truth objects of type `t` are distractors: a tracker object matched to one is
+    /// neither rewarded nor punished.
+    pub fn is_distractor(self, t: ObjectType) -> bool {
+        match self {
+            EvalClass::Car => t == ObjectType::Van,
+            EvalClass::Pedestrian => t == ObjectType::PersonSitting,
+            EvalClass::CarVan | EvalClass::RoadUser => false,
         }
     }
 }
@@ -303,19 +347,19 @@ pub fn class_frames(
         if l.object_type == ObjectType::DontCare {
             dontcare[l.frame].push(l.bbox);
         } else if l.track_id >= 0
-            && (l.object_type == class.object_type() || l.object_type == class.distractor())
+            && (class.holds(l.object_type) || class.is_distractor(l.object_type))
         {
             gt_by_frame[l.frame].push(l);
         }
     }
     let mut tr_by_frame: Vec<Vec<&TrackingLabel>> = vec![Vec::new(); frames];
     for l in results.iter().filter(|l| l.frame < frames) {
-        if l.track_id >= 0 && l.object_type == class.object_type() {
+        if l.track_id >= 0 && class.holds(l.object_type) {
             tr_by_frame[l.frame].push(l);
         }
     }
     let counts = |l: &TrackingLabel| {
-        l.object_type == class.object_type()
+        class.holds(l.object_type)
             && l.occluded <= config.max_occlusion
             && (l.truncated.trunc() as i64) <= config.max_truncation
             && region.contains(l)
@@ -379,7 +423,8 @@ pub fn class_frames(
     Ok((out, removed_total))
 }
 
-/// Scores `results` against `truth` over frames 0 .. `frames`, per class, with KITTI's rules;
+/// Scores `results` against `truth` over frames 0 .. `frames`, per class of
+/// [`EvalClass::SCORED`], with KITTI's rules;
 /// `camera_view` (a calibration) limits both to what camera 2 sees.
 pub fn evaluate_kitti_tracking(
     truth: &[TrackingLabel],
@@ -393,7 +438,7 @@ pub fn evaluate_kitti_tracking(
         identity_threshold: config.match_threshold,
     };
     let mut classes = Vec::new();
-    for class in EvalClass::ALL {
+    for class in EvalClass::SCORED {
         let (f, removed) = class_frames(truth, results, class, frames, config, camera_view)?;
         classes.push(ClassScores {
             class,
@@ -607,6 +652,50 @@ mod tests {
             (c.truth_objects, c.tracker_objects, c.tracker_removed),
             (0, 1, 5)
         );
+    }
+
+    #[test]
+    fn the_groups_score_every_type_they_hold_whatever_the_reported_type() {
+        // A van, a cyclist and a sitting person; the results: a car on the van, a pedestrian on
+        // the cyclist, a cyclist on the sitting person and a car where nothing is.
+        let truth = vec![
+            label(0, 1, ObjectType::Van, B, 0.0, 10.0),
+            label(0, 2, ObjectType::Cyclist, B, 5.0, 10.0),
+            label(0, 3, ObjectType::PersonSitting, B, -5.0, 10.0),
+        ];
+        let results = vec![
+            label(0, 10, ObjectType::Car, B, 0.5, 10.0),
+            label(0, 11, ObjectType::Pedestrian, B, 5.0, 10.5),
+            label(0, 12, ObjectType::Cyclist, B, -5.0, 10.0),
+            label(0, 13, ObjectType::Car, B, 0.0, 30.0),
+        ];
+        let e =
+            evaluate_kitti_tracking(&truth, &results, 1, &KittiEvalConfig::bev(2.0), None).unwrap();
+        let counts = |c: EvalClass| {
+            let s = class(&e, c);
+            let cl = &s.scores.clear;
+            (
+                s.truth_objects,
+                s.tracker_objects,
+                cl.tp,
+                cl.fp,
+                cl.fn_count,
+            )
+        };
+        // Car: the van is a distractor, so the car on it is removed; the other car is false.
+        assert_eq!(counts(EvalClass::Car), (0, 1, 0, 1, 0));
+        // Pedestrian: the sitting person is a distractor, but only pedestrian reports take
+        // part, and the one on the cyclist matches nothing of the class.
+        assert_eq!(counts(EvalClass::Pedestrian), (0, 1, 0, 1, 0));
+        // Car+Van: the van is found by the car on it; the far car is false.
+        assert_eq!(counts(EvalClass::CarVan), (1, 2, 1, 1, 0));
+        // Every road user: three found, whatever their reported types, one false.
+        assert_eq!(counts(EvalClass::RoadUser), (3, 4, 3, 1, 0));
+        let r = &class(&e, EvalClass::RoadUser).scores.clear;
+        assert!((r.mota - (1.0 - 1.0 / 3.0)).abs() < 1e-12);
+        assert!((r.precision - 0.75).abs() < 1e-12 && (r.recall - 1.0).abs() < 1e-12);
+        let names: Vec<_> = e.classes.iter().map(|c| c.class.name()).collect();
+        assert_eq!(names, ["Car", "Pedestrian", "Car+Van", "Road users"]);
     }
 
     #[test]
