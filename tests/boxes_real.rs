@@ -337,6 +337,9 @@ fn boxes_and_classes_on_the_simulated_street() {
             let class = match obj.kind {
                 ObjectKind::Pedestrian => ObjectClass::Pedestrian,
                 ObjectKind::Car | ObjectKind::ParkedCar => ObjectClass::Car,
+                ObjectKind::Van | ObjectKind::ParkedVan => ObjectClass::Van,
+                ObjectKind::Truck => ObjectClass::Truck,
+                ObjectKind::Cyclist => ObjectClass::Cyclist,
             };
             let speed = Some(state.velocity[0].hypot(state.velocity[1]));
             let bare = fit_box(&ox, &oy, &oz, Some(ground), None, &params, &mut scratch).unwrap();

@@ -1,11 +1,12 @@
 //! `kitti-tools synth`: simulate a street drive (HDL-64E-like lidar, OXTS, walls, cars,
-//! pedestrians) and write it in the KITTI raw layout with `truth.json`, or in the KITTI
-//! tracking layout with the cars and pedestrians as `label_02` labels.
+//! pedestrians; on the urban street also vans, trucks, cyclists and street clutter) and write
+//! it in the KITTI raw layout with `truth.json`, or in the KITTI tracking layout with the road
+//! users as `label_02` labels.
 
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use smc_lmb::sim::street::{
-    write_drive, write_tracking_sequence, ObjectKind, StreetConfig, StreetTruth,
+    write_drive, write_tracking_sequence, ClutterKind, ObjectKind, StreetConfig, StreetTruth,
 };
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -17,6 +18,16 @@ pub enum Layout {
     Raw,
     /// KITTI tracking: OUT/{velodyne/NNNN, oxts, calib, label_02} (OUT is the split folder).
     Tracking,
+}
+
+/// The built-in streets.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Street {
+    /// Cars and pedestrians between building walls (`StreetConfig::default`).
+    Plain,
+    /// A city street: cars, vans, a truck, cyclists and pedestrians, with poles, tree trunks,
+    /// hedges and low walls (`StreetConfig::urban`).
+    Urban,
 }
 
 /// Flags of `synth`.
@@ -38,7 +49,12 @@ pub struct Args {
     /// Random seed (scene and lidar noise).
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Street configuration (.toml or .json); defaults for everything not given.
+    /// Built-in street [default: `urban` for the tracking layout, which exists to score road
+    /// users, `plain` for the raw layout].
+    #[arg(long, value_enum, conflicts_with = "config")]
+    street: Option<Street>,
+    /// Street configuration (.toml or .json); the plain street's defaults for everything not
+    /// given.
     #[arg(long)]
     config: Option<PathBuf>,
     /// No progress bar.
@@ -60,9 +76,14 @@ pub fn run(args: Args) -> Result<()> {
     if args.frames == 0 {
         bail!("--frames must be at least 1");
     }
-    let config = match &args.config {
-        Some(path) => read_config(path)?,
-        None => StreetConfig::default(),
+    let street = args.street.unwrap_or(match args.layout {
+        Layout::Raw => Street::Plain,
+        Layout::Tracking => Street::Urban,
+    });
+    let config = match (&args.config, street) {
+        (Some(path), _) => read_config(path)?,
+        (None, Street::Plain) => StreetConfig::default(),
+        (None, Street::Urban) => StreetConfig::urban(),
     };
     let bar = if args.quiet {
         ProgressBar::hidden()
@@ -138,6 +159,26 @@ pub fn run(args: Args) -> Result<()> {
         count(ObjectKind::Car),
         count(ObjectKind::Pedestrian)
     );
+    let more = count(ObjectKind::ParkedVan)
+        + count(ObjectKind::Van)
+        + count(ObjectKind::Truck)
+        + count(ObjectKind::Cyclist)
+        + truth.clutter.len();
+    if more > 0 {
+        let clutter = |kind: ClutterKind| truth.clutter.iter().filter(|c| c.kind == kind).count();
+        println!(
+            "         {} parked vans, {} moving vans, {} trucks, {} cyclists; clutter: {} poles, \
+             {} tree trunks, {} hedges, {} low walls",
+            count(ObjectKind::ParkedVan),
+            count(ObjectKind::Van),
+            count(ObjectKind::Truck),
+            count(ObjectKind::Cyclist),
+            clutter(ClutterKind::Pole),
+            clutter(ClutterKind::Trunk),
+            clutter(ClutterKind::Hedge),
+            clutter(ClutterKind::LowWall)
+        );
+    }
     println!(
         "ego      {:.1} m/s, heading {:.1}° → {:.1}°",
         config.speed,

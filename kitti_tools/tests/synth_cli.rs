@@ -71,3 +71,85 @@ fn bad_arguments_are_refused_clearly() {
     let err = String::from_utf8_lossy(&bad.stderr);
     assert!(err.contains("lidar.dropout"), "{err}");
 }
+
+#[test]
+fn the_tracking_layout_gets_the_urban_street_and_the_raw_layout_the_plain_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let synth = |sub: &str, extra: &[&str]| {
+        let out = dir.path().join(sub);
+        let mut args = vec![
+            "synth",
+            "--out",
+            out.to_str().unwrap(),
+            "--frames",
+            "3",
+            "--seed",
+            "3",
+            "--quiet",
+        ];
+        args.extend_from_slice(extra);
+        (ok(&run(&args)), out)
+    };
+    let (urban, root) = synth("trk", &["--layout", "tracking", "--sequence", "3"]);
+    assert!(urban.contains("cyclists; clutter:"), "{urban}");
+    let labels = std::fs::read_to_string(root.join("label_02/0003.txt")).unwrap();
+    for l in labels.lines() {
+        let kind = l.split_whitespace().nth(2).unwrap();
+        // Road users only: poles, trunks, hedges and low walls are not labelled.
+        assert!(
+            ["Car", "Van", "Truck", "Pedestrian", "Cyclist"].contains(&kind),
+            "{l}"
+        );
+    }
+    assert!(
+        labels.contains(" Van ") && labels.contains(" Cyclist "),
+        "{labels}"
+    );
+    let (plain, _) = synth(
+        "plain",
+        &[
+            "--layout",
+            "tracking",
+            "--sequence",
+            "3",
+            "--street",
+            "plain",
+        ],
+    );
+    assert!(!plain.contains("clutter:"), "{plain}");
+    let (raw, _) = synth("raw", &[]);
+    assert!(!raw.contains("clutter:"), "{raw}");
+    // A configuration file is its own street.
+    let config = dir.path().join("street.toml");
+    std::fs::write(&config, "[clutter]\npoles = 2\n").unwrap();
+    let out = dir.path().join("both");
+    let both = run(&[
+        "synth",
+        "--out",
+        out.to_str().unwrap(),
+        "--street",
+        "urban",
+        "--config",
+        config.to_str().unwrap(),
+    ]);
+    assert!(!both.status.success());
+    let err = String::from_utf8_lossy(&both.stderr);
+    assert!(
+        err.contains("--config") && err.contains("--street"),
+        "{err}"
+    );
+    let (poles, _) = synth("poles", &["--config", config.to_str().unwrap()]);
+    assert!(poles.contains("clutter: 2 poles"), "{poles}");
+    // A clutter size that does not fit its row is refused, naming the field.
+    std::fs::write(&config, "[clutter]\ntrunk_radius = [0.2, 0.5]\n").unwrap();
+    let bad = run(&[
+        "synth",
+        "--out",
+        out.to_str().unwrap(),
+        "--config",
+        config.to_str().unwrap(),
+    ]);
+    assert!(!bad.status.success());
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(err.contains("clutter.trunk_radius"), "{err}");
+}

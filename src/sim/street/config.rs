@@ -1,9 +1,12 @@
-//! A simulated street as data: the street's layout, traffic, ground, body motion, lidar and
-//! recording, each with defaults, and their validation.
+//! A simulated street as data: the street's layout, traffic, clutter, ground, body motion,
+//! lidar and recording, each with defaults, and their validation. The default is the plain
+//! street (cars and pedestrians between walls); [`StreetConfig::urban`] adds vans, trucks,
+//! cyclists and street clutter in numbers like a KITTI city drive's.
 //!
 //! Not for: simulating (see [`super::StreetSimulator`]).
 
 use super::body::BodyMotionConfig;
+use super::clutter::ClutterConfig;
 use super::ego::LegSpec;
 use super::ground::GroundConfig;
 use super::lidar::LidarConfig;
@@ -54,7 +57,9 @@ impl Default for StreetLayout {
     }
 }
 
-/// Cars and pedestrians.
+/// Road users: cars, vans, trucks, cyclists and pedestrians. Vehicles and cyclists drive in
+/// the lanes other than the ego's at their lane's speed (cyclists at their own), parked cars
+/// and vans stand at the kerb, pedestrians walk along the sidewalks.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct TrafficConfig {
@@ -64,16 +69,35 @@ pub struct TrafficConfig {
     pub moving_cars: usize,
     /// Number of pedestrians.
     pub pedestrians: usize,
+    /// Number of parked vans.
+    pub parked_vans: usize,
+    /// Number of moving vans.
+    pub moving_vans: usize,
+    /// Number of (moving) trucks.
+    pub trucks: usize,
+    /// Number of cyclists.
+    pub cyclists: usize,
     /// Car length, width, height, metres.
     pub car_size: [f64; 3],
-    /// Range of moving car speeds, m/s.
+    /// Van length, width, height, metres.
+    pub van_size: [f64; 3],
+    /// Truck length, width, height, metres.
+    pub truck_size: [f64; 3],
+    /// A cyclist with the bicycle: length, width, height, metres.
+    pub cyclist_size: [f64; 3],
+    /// Range of moving car speeds, m/s (vans and trucks too: a lane has one speed).
     pub car_speed: [f64; 2],
+    /// Range of cycling speeds, m/s.
+    pub cyclist_speed: [f64; 2],
     /// Pedestrian radius, metres.
     pub pedestrian_radius: f64,
     /// Pedestrian height, metres.
     pub pedestrian_height: f64,
     /// Range of walking speeds, m/s.
     pub pedestrian_speed: [f64; 2],
+    /// Distances from the building line of the sidewalks' two walking rows (the first walks
+    /// in the ego's direction, the second against it), metres.
+    pub pedestrian_rows: [f64; 2],
     /// Objects keep this far from street corners (moving ones vanish there), metres.
     pub corner_clearance: f64,
     /// Objects start within this distance of the ego's path, metres.
@@ -86,11 +110,22 @@ impl Default for TrafficConfig {
             parked_cars: 8,
             moving_cars: 5,
             pedestrians: 8,
+            parked_vans: 0,
+            moving_vans: 0,
+            trucks: 0,
+            cyclists: 0,
             car_size: [4.5, 1.8, 1.5],
+            // KITTI's mean labelled sizes (van 5.1 × 1.9 × 2.2 m, truck 10.1 × 2.6 × 3.3 m,
+            // cyclist 1.8 × 0.6 × 1.7 m), the truck a little shorter for a city street.
+            van_size: [5.1, 1.9, 2.2],
+            truck_size: [8.5, 2.5, 3.3],
+            cyclist_size: [1.8, 0.6, 1.7],
             car_speed: [5.0, 12.0],
+            cyclist_speed: [3.0, 7.0],
             pedestrian_radius: 0.3,
             pedestrian_height: 1.75,
             pedestrian_speed: [1.2, 1.4],
+            pedestrian_rows: [1.0, 2.0],
             corner_clearance: 20.0,
             spawn_radius: 60.0,
         }
@@ -146,8 +181,10 @@ pub struct StreetConfig {
     pub ground: GroundConfig,
     /// The vehicle body's roll, pitch and heave.
     pub body: BodyMotionConfig,
-    /// Cars and pedestrians.
+    /// Road users.
     pub traffic: TrafficConfig,
+    /// Poles, tree trunks, hedges and low walls.
+    pub clutter: ClutterConfig,
     /// The lidar.
     pub lidar: LidarConfig,
     /// Place and time.
@@ -181,6 +218,7 @@ impl Default for StreetConfig {
             ground: GroundConfig::default(),
             body: BodyMotionConfig::default(),
             traffic: TrafficConfig::default(),
+            clutter: ClutterConfig::default(),
             lidar: LidarConfig::default(),
             recording: Recording::default(),
         }
@@ -200,6 +238,35 @@ fn ensure_range(what: &str, r: [f64; 2]) -> Result<()> {
 }
 
 impl StreetConfig {
+    /// A city street with a KITTI drive's mix of road users and clutter: per drive 12 parked
+    /// cars and 3 parked vans, 6 moving cars, 2 vans and a truck, 3 cyclists and 10
+    /// pedestrians, and along the sidewalks 14 poles, 10 tree trunks, 4 hedges and 3 low
+    /// walls ([`ClutterConfig::urban`]). Its sidewalks are 4.5 m wide, with the walking rows
+    /// 1.6 and 2.6 m from the building line, so that people pass hedges, low walls, poles and
+    /// trunks with more than a clusterer's 0.5 m between them; everything else as the default
+    /// street.
+    pub fn urban() -> Self {
+        StreetConfig {
+            street: StreetLayout {
+                sidewalk_width: 4.5,
+                ..StreetLayout::default()
+            },
+            traffic: TrafficConfig {
+                pedestrian_rows: [1.6, 2.6],
+                parked_cars: 12,
+                moving_cars: 6,
+                pedestrians: 10,
+                parked_vans: 3,
+                moving_vans: 2,
+                trucks: 1,
+                cyclists: 3,
+                ..TrafficConfig::default()
+            },
+            clutter: ClutterConfig::urban(),
+            ..StreetConfig::default()
+        }
+    }
+
     /// Checks every field; errors name the field.
     pub fn validate(&self) -> Result<()> {
         ensure_positive("speed", self.speed)?;
@@ -236,15 +303,36 @@ impl StreetConfig {
         self.ground.validate()?;
         self.body.validate()?;
         let t = &self.traffic;
-        for (i, v) in t.car_size.iter().enumerate() {
-            ensure_positive(&format!("traffic.car_size[{i}]"), *v)?;
+        for (name, size) in [
+            ("car_size", t.car_size),
+            ("van_size", t.van_size),
+            ("truck_size", t.truck_size),
+            ("cyclist_size", t.cyclist_size),
+        ] {
+            for (i, v) in size.iter().enumerate() {
+                ensure_positive(&format!("traffic.{name}[{i}]"), *v)?;
+            }
         }
         ensure_range("traffic.car_speed", t.car_speed)?;
+        ensure_range("traffic.cyclist_speed", t.cyclist_speed)?;
         ensure_positive("traffic.pedestrian_radius", t.pedestrian_radius)?;
         ensure_positive("traffic.pedestrian_height", t.pedestrian_height)?;
         ensure_range("traffic.pedestrian_speed", t.pedestrian_speed)?;
+        for (i, d) in t.pedestrian_rows.iter().enumerate() {
+            let r = t.pedestrian_radius;
+            if !(*d >= r && *d <= s.sidewalk_width - r) {
+                return Err(Error::invalid(
+                    format!("traffic.pedestrian_rows[{i}]"),
+                    format!(
+                        "{d} m from the building line is not on the {} m sidewalk",
+                        s.sidewalk_width
+                    ),
+                ));
+            }
+        }
         ensure_non_negative("traffic.corner_clearance", t.corner_clearance)?;
         ensure_positive("traffic.spawn_radius", t.spawn_radius)?;
+        self.clutter.validate()?;
         let l = &self.lidar;
         if l.beams < 2 || !l.beams.is_multiple_of(2) || l.beams > 256 {
             return Err(Error::invalid(

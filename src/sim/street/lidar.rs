@@ -7,7 +7,9 @@
 //! [`LidarConfig::elevations`]. The scan is instantaneous at the given pose (no motion
 //! distortion). A hit at range r within [min_range, max_range] is kept unless a dropout draw
 //! removes it; the reported point is the ray direction times r + n, n ~ N(0, σ²) (range noise
-//! along the ray), in the sensor frame. Reflectance is the surface's value scaled by the cosine
+//! along the ray), in the sensor frame. A porous shape (a hedge: [`Shape::scatter`] > 0) lets a
+//! ray in before it returns: its range grows by `scatter·u`, u uniform in [0, 1), drawn after
+//! the other draws of that ray. Reflectance is the surface's value scaled by the cosine
 //! of the incidence angle (0.5 + 0.5·|cos|), with a little noise, clamped to [0, 1].
 //!
 //! **Speed.** Each shape gets its azimuth interval as seen in the sensor frame (the hull of its
@@ -38,6 +40,8 @@ pub enum Surface {
     Wall(u32),
     /// The object with this id.
     Object(u32),
+    /// The piece of street furniture or vegetation with this id (see [`super::clutter`]).
+    Clutter(u32),
 }
 
 /// A shape's geometry in the world frame; every shape stands on the ground (z from 0).
@@ -89,6 +93,8 @@ pub struct Shape {
     pub geometry: Geometry,
     /// Base reflectance in [0, 1].
     pub reflectance: f32,
+    /// How deep a ray may enter before it returns, metres (0: a solid surface).
+    pub scatter: f64,
 }
 
 /// The lidar's beams, resolution, range and noise.
@@ -430,11 +436,16 @@ pub fn cast_scan(
                 if keep < lidar.dropout {
                     continue;
                 }
-                let r = t + lidar.range_noise * noise;
+                let mut r = t + lidar.range_noise * noise;
                 let (surface, base) = if i == usize::MAX {
                     (Surface::Ground, GROUND_REFLECTANCE)
                 } else {
-                    (shapes[i].surface, shapes[i].reflectance as f64)
+                    let shape = &shapes[i];
+                    if shape.scatter > 0.0 {
+                        let u: f64 = rng.random();
+                        r += shape.scatter * u;
+                    }
+                    (shape.surface, shape.reflectance as f64)
                 };
                 let refl = (base * (0.5 + 0.5 * cos) + 0.02 * shade).clamp(0.0, 1.0);
                 out[b] = Hit {
@@ -520,6 +531,7 @@ mod tests {
                 normal: [-1.0, 0.0],
             },
             reflectance: 0.5,
+            scatter: 0.0,
         };
         let person = Shape {
             surface: Surface::Object(1),
@@ -529,6 +541,7 @@ mod tests {
                 height: 1.75,
             },
             reflectance: 0.5,
+            scatter: 0.0,
         };
         let car = Shape {
             surface: Surface::Object(2),
@@ -540,10 +553,31 @@ mod tests {
                 height: 1.5,
             },
             reflectance: 0.5,
+            scatter: 0.0,
+        };
+        // A hedge to the left, taller than the sensor, whose returns scatter 0.3 m into it.
+        let hedge = Shape {
+            surface: Surface::Clutter(0),
+            geometry: Geometry::Box {
+                centre: [0.0, 6.0],
+                yaw: 0.0,
+                half_length: 3.0,
+                half_width: 0.3,
+                height: 2.5,
+            },
+            reflectance: 0.3,
+            scatter: 0.3,
         };
         let pose = Isometry3::translation(0.0, 0.0, 1.73);
-        let scan = cast_scan(&[wall, person, car], &Ground::flat(), &pose, &small(), 2);
+        let scan = cast_scan(
+            &[wall, person, car, hedge],
+            &Ground::flat(),
+            &pose,
+            &small(),
+            2,
+        );
         let mut seen = [0usize; 3];
+        let mut hedge_y: Vec<f64> = Vec::new();
         for (p, s) in scan.cloud.iter().zip(&scan.surfaces) {
             let (x, y, z) = (p.x as f64, p.y as f64, p.z as f64 + 1.73);
             match s {
@@ -561,10 +595,25 @@ mod tests {
                     seen[2] += 1;
                     assert!(x < -5.0 && z <= 1.5 + 1e-6);
                 }
+                Surface::Clutter(_) => {
+                    // Entered through the face at y = 5.7 and no deeper than 0.3 m along the ray.
+                    assert!(
+                        x.abs() <= 3.3 && (5.7 - 1e-4..=6.0 + 1e-4).contains(&y),
+                        "{x} {y} {z}"
+                    );
+                    hedge_y.push(y);
+                }
                 Surface::Ground => assert!(z.abs() < 1e-4),
             }
         }
         assert!(seen.iter().all(|&n| n > 10), "{seen:?}");
+        assert!(hedge_y.len() > 10, "{}", hedge_y.len());
+        let (lo, hi) = hedge_y
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &y| {
+                (a.min(y), b.max(y))
+            });
+        assert!(hi - lo > 0.2, "hedge returns from {lo} to {hi} m");
     }
 
     #[test]

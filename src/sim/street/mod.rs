@@ -1,13 +1,14 @@
 //! A simulated street drive in the KITTI raw layout: an ego vehicle with an HDL-64E-like lidar
 //! and an OXTS unit drives at about 10 m/s along a street with turns, between building walls,
-//! past parked cars, moving cars and pedestrians. [`write_drive`] writes it as
+//! past parked cars, moving cars and pedestrians (and, on [`StreetConfig::urban`], vans,
+//! trucks, cyclists, poles, tree trunks, hedges and low walls). [`write_drive`] writes it as
 //! `DIR/DATE/DATE_drive_NNNN_sync/` that [`crate::kitti::RawDrive`] opens unchanged, plus
 //! `truth.json` ([`StreetTruth`]); [`write_tracking_sequence`] writes it in the KITTI tracking
-//! layout with its cars and pedestrians as `label_02` labels; [`generate`] keeps it in memory
+//! layout with its road users as `label_02` labels; [`generate`] keeps it in memory
 //! with per-point labels.
 //!
 //! The pieces: [`ego`] (the vehicle's planar motion), [`body`] (its roll, pitch and heave),
-//! [`world`] (the scene), [`ground`] (the road surface's relief), [`lidar`] (the ray caster),
+//! [`world`] (the scene), [`clutter`] (street furniture and vegetation), [`ground`] (the road surface's relief), [`lidar`] (the ray caster),
 //! [`truth`] (what is written as ground truth), [`writer`] (the raw layout's files),
 //! [`tracking_writer`] (the tracking layout's).
 //!
@@ -30,6 +31,7 @@
 
 pub mod body;
 pub mod calib_files;
+pub mod clutter;
 pub mod config;
 pub mod ego;
 pub mod ground;
@@ -40,6 +42,7 @@ pub mod world;
 pub mod writer;
 
 pub use body::{BodyMotion, BodyMotionConfig};
+pub use clutter::{Clutter, ClutterConfig, ClutterKind};
 pub use config::{Recording, StreetConfig, StreetLayout, TrafficConfig};
 pub use ego::{EgoState, EgoTrajectory, LegSpec};
 pub use ground::{Ground, GroundConfig, ReliefOctave};
@@ -331,6 +334,7 @@ impl StreetSimulator {
             frames,
             walls,
             objects,
+            clutter: self.street.clutter.clone(),
         }
     }
 
@@ -345,6 +349,7 @@ impl StreetSimulator {
                 Surface::Ground => frame.ground_points += 1,
                 Surface::Wall(i) => walls[i as usize] += 1,
                 Surface::Object(i) => objects[i as usize] += 1,
+                Surface::Clutter(_) => {}
             }
         }
         for (w, n) in truth.walls.iter_mut().zip(walls) {

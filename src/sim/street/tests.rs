@@ -56,15 +56,16 @@ fn objects_keep_clear_of_the_ego_and_move_as_configured() {
     );
     let truth = sim.truth();
     for o in &truth.objects {
-        assert!(!o.states.is_empty() || o.kind != ObjectKind::ParkedCar);
+        assert!(!o.states.is_empty() || !o.kind.is_parked());
         for s in &o.states {
             let e = sim.ego(s.frame);
             let gap = (s.position[0] - e.x).hypot(s.position[1] - e.y);
             assert!(gap > 4.0, "object {} {gap} m from the ego", o.id);
             let v = s.velocity[0].hypot(s.velocity[1]);
             let ok = match o.kind {
-                ObjectKind::ParkedCar => v == 0.0,
-                ObjectKind::Car => (5.0..=12.0).contains(&v),
+                ObjectKind::ParkedCar | ObjectKind::ParkedVan => v == 0.0,
+                ObjectKind::Car | ObjectKind::Van | ObjectKind::Truck => (5.0..=12.0).contains(&v),
+                ObjectKind::Cyclist => (3.0..=7.0).contains(&v),
                 ObjectKind::Pedestrian => (1.2..=1.4).contains(&v),
             };
             assert!(ok, "{o:?}");
@@ -108,4 +109,140 @@ fn oxts_packets_agree_with_the_positions_they_encode() {
         assert!(((xy[k].1 - xy[0].1) - e.y).abs() < 1e-6);
     }
     assert!(packets.iter().any(|p| p.wu.abs() > 0.2), "no turn in 6 s");
+}
+
+#[test]
+fn the_urban_street_holds_every_road_user_kind_and_clutter_off_their_rows() {
+    let config = StreetConfig::urban();
+    config.validate().unwrap();
+    let sim = StreetSimulator::new(&config, 60, 3).unwrap();
+    let street = sim.street();
+    let t = &config.traffic;
+    let count = |k: ObjectKind| street.objects.iter().filter(|o| o.kind == k).count();
+    for (kind, n) in [
+        (ObjectKind::ParkedCar, t.parked_cars),
+        (ObjectKind::Car, t.moving_cars),
+        (ObjectKind::Pedestrian, t.pedestrians),
+        (ObjectKind::ParkedVan, t.parked_vans),
+        (ObjectKind::Van, t.moving_vans),
+        (ObjectKind::Truck, t.trucks),
+        (ObjectKind::Cyclist, t.cyclists),
+    ] {
+        assert_eq!(count(kind), n, "{kind:?}");
+    }
+    let c = &config.clutter;
+    let pieces = |k: ClutterKind| street.clutter.iter().filter(|p| p.kind == k).count();
+    assert_eq!(
+        [
+            pieces(ClutterKind::Pole),
+            pieces(ClutterKind::Trunk),
+            pieces(ClutterKind::Hedge),
+            pieces(ClutterKind::LowWall)
+        ],
+        [c.poles, c.trunks, c.hedges, c.low_walls]
+    );
+    // Every piece stands on the sidewalk, between the kerb and the building line, and no road
+    // user comes near it at any frame (footprints apart by half their diagonals' sum).
+    let half_diagonal = |s: [f64; 3]| 0.5 * s[0].hypot(s[1]);
+    let (kerb, building) = (
+        config.street.road_half_width,
+        config.street.road_half_width + config.street.sidewalk_width,
+    );
+    for p in &street.clutter {
+        let on_sidewalk = street.segments.iter().any(|s| {
+            let (dx, dy) = (p.centre[0] - s.point[0], p.centre[1] - s.point[1]);
+            let along = dx * s.dir[0] + dy * s.dir[1];
+            let l = s.left();
+            let lateral = (dx * l[0] + dy * l[1]).abs();
+            (s.s_start..=s.s_end).contains(&along)
+                && lateral - 0.5 * p.size[1] >= kerb - 1e-9
+                && lateral + 0.5 * p.size[1] <= building + 1e-9
+        });
+        assert!(on_sidewalk, "{p:?}");
+        for k in 0..sim.frames() {
+            for o in &street.objects {
+                if let Some((q, _)) = o.state_at(&street.segments, sim.time(k)) {
+                    let d = (q[0] - p.centre[0]).hypot(q[1] - p.centre[1]);
+                    // A long hedge's diagonal overstates its half-width; test across it.
+                    let across = if p.size[0] > 2.0 * p.size[1] {
+                        0.5 * p.size[1]
+                    } else {
+                        half_diagonal(p.size)
+                    };
+                    let near = d < across + 0.5 * o.size[1].min(o.size[0]) - 1e-9;
+                    assert!(!near, "object {} meets {p:?} at frame {k}", o.id);
+                }
+            }
+        }
+    }
+    // The scans see the clutter; a hedge's returns scatter into it, a low wall's do not.
+    let truth = sim.truth();
+    assert_eq!(truth.clutter, street.clutter);
+    let mut depth: std::collections::HashMap<u32, Vec<f64>> = Default::default();
+    for k in [10, 30, 50] {
+        let scan = sim.scan(k);
+        let pose = sim.velodyne_pose(k);
+        for (i, s) in scan.surfaces.iter().enumerate() {
+            if let Surface::Clutter(id) = *s {
+                let piece = &street.clutter[id as usize];
+                let p = scan.cloud.get(i).unwrap();
+                let w = pose * Point3::new(p.x as f64, p.y as f64, p.z as f64);
+                // Returns through the long faces only (not the top or the ends): their depth
+                // behind the face they entered, across the street.
+                let (u, n) = (
+                    [piece.yaw.cos(), piece.yaw.sin()],
+                    [-piece.yaw.sin(), piece.yaw.cos()],
+                );
+                let (dx, dy) = (w.x - piece.centre[0], w.y - piece.centre[1]);
+                let along = dx * u[0] + dy * u[1];
+                let off = dx * n[0] + dy * n[1];
+                // Shapes stand on z = 0 whatever the ground's relief.
+                let side_face =
+                    along.abs() < 0.5 * piece.size[0] - 0.4 && w.z < piece.size[2] - 0.4;
+                if side_face {
+                    depth
+                        .entry(id)
+                        .or_default()
+                        .push(0.5 * piece.size[1] - off.abs());
+                }
+            }
+        }
+    }
+    assert!(!depth.is_empty(), "no clutter in view");
+    let spread = |kind: ClutterKind| -> Option<f64> {
+        let all: Vec<f64> = street
+            .clutter
+            .iter()
+            .filter(|p| p.kind == kind)
+            .filter_map(|p| depth.get(&p.id))
+            .flatten()
+            .copied()
+            .collect();
+        (all.len() > 20).then(|| {
+            let mean = all.iter().sum::<f64>() / all.len() as f64;
+            (all.iter().map(|d| (d - mean).powi(2)).sum::<f64>() / all.len() as f64).sqrt()
+        })
+    };
+    // Uniform over 0.3 m: σ ≈ 0.087 m (with 0.02 m range noise); a solid face: about the noise.
+    let hedge = spread(ClutterKind::Hedge).expect("hedges in view");
+    assert!((0.06..0.12).contains(&hedge), "hedge depth spread {hedge}");
+    if let Some(wall) = spread(ClutterKind::LowWall) {
+        assert!(wall < 0.05, "low wall depth spread {wall}");
+    }
+}
+
+#[test]
+fn the_plain_street_has_no_clutter_and_its_objects_do_not_move_when_other_kinds_are_added() {
+    let plain = StreetSimulator::new(&StreetConfig::default(), 60, 5).unwrap();
+    assert!(plain.street().clutter.is_empty());
+    let mut more = StreetConfig::default();
+    more.traffic.cyclists = 2;
+    more.traffic.moving_vans = 1;
+    more.clutter.poles = 3;
+    let sim = StreetSimulator::new(&more, 60, 5).unwrap();
+    let n = plain.street().objects.len();
+    assert_eq!(&sim.street().objects[..n], &plain.street().objects[..]);
+    assert_eq!(sim.street().walls, plain.street().walls);
+    assert_eq!(sim.street().objects.len(), n + 3);
+    assert_eq!(sim.street().clutter.len(), 3);
 }

@@ -44,6 +44,9 @@ pub struct WrittenSequence {
 pub fn object_type(kind: ObjectKind) -> ObjectType {
     match kind {
         ObjectKind::Car | ObjectKind::ParkedCar => ObjectType::Car,
+        ObjectKind::Van | ObjectKind::ParkedVan => ObjectType::Van,
+        ObjectKind::Truck => ObjectType::Truck,
+        ObjectKind::Cyclist => ObjectType::Cyclist,
         ObjectKind::Pedestrian => ObjectType::Pedestrian,
     }
 }

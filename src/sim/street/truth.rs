@@ -11,6 +11,7 @@
 //!
 //! Not for: producing the truth (see [`super::generate`]) or scoring against it.
 
+use super::clutter::Clutter;
 use super::ego::EgoState;
 use super::world::ObjectKind;
 use super::StreetConfig;
@@ -112,7 +113,7 @@ pub struct ObjectState {
     pub points: usize,
 }
 
-/// A car or pedestrian.
+/// A road user.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ObjectTruth {
     /// Identifier (matches `Surface::Object`).
@@ -142,8 +143,11 @@ pub struct StreetTruth {
     pub frames: Vec<FrameTruth>,
     /// Building walls.
     pub walls: Vec<WallTruth>,
-    /// Cars and pedestrians.
+    /// Road users.
     pub objects: Vec<ObjectTruth>,
+    /// Poles, trunks, hedges and low walls (not road users; absent from older files).
+    #[serde(default)]
+    pub clutter: Vec<Clutter>,
 }
 
 impl StreetTruth {

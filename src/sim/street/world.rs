@@ -1,6 +1,7 @@
 //! The simulated street scene in the world frame (x east, y north, z up, ground near z = 0,
 //! see [`super::ground`]): the street segments that follow the ego route, building walls along
-//! both sides, and the parked cars, moving cars and pedestrians with their motion.
+//! both sides, the road users (parked cars and vans, moving cars, vans, trucks and cyclists,
+//! pedestrians) with their motion, and the street clutter of [`super::clutter`].
 //!
 //! **Layout.** Each straight stretch of the ego route is one street segment; its centreline is
 //! the ego's straight line shifted by the ego lane offset. Consecutive segments meet at a
@@ -10,15 +11,17 @@
 //! consecutive segments meet at building corners), cut into pieces of random length with random
 //! gaps, each piece a vertical rectangle of random height.
 //!
-//! **Objects.** Parked cars stand at the kerb; moving cars drive at constant speed in a lane
-//! (right of the centreline in the ego's direction, left against it), never in the ego's lane;
-//! pedestrians walk along the sidewalks. Positions are drawn at random near the ego's path and
+//! **Objects.** Parked cars and vans stand at the kerb; moving cars, vans and trucks drive at
+//! their lane's constant speed and cyclists at their own in a lane (right of the centreline in
+//! the ego's direction, left against it), never in the ego's lane; pedestrians walk along the
+//! sidewalks. Positions are drawn at random near the ego's path and
 //! rejected when too close to a corner, to another object of the same row, or (at any frame)
 //! to the ego vehicle. A moving object exists while it is on its segment and more than the
 //! corner clearance away from the segment's corners.
 //!
 //! Not for: ray casting (see [`super::lidar`]) or the ego motion (see [`super::ego`]).
 
+use super::clutter::{place_clutter, Clutter};
 use super::lidar::{Geometry, Shape, Surface};
 use super::StreetConfig;
 use crate::error::{Error, Result};
@@ -105,6 +108,21 @@ pub enum ObjectKind {
     Pedestrian,
     /// A parked car (oriented box, never moves).
     ParkedCar,
+    /// A moving van (oriented box).
+    Van,
+    /// A parked van (oriented box, never moves).
+    ParkedVan,
+    /// A moving truck (oriented box).
+    Truck,
+    /// A cyclist on a bicycle (oriented box).
+    Cyclist,
+}
+
+impl ObjectKind {
+    /// Whether the object never moves.
+    pub fn is_parked(self) -> bool {
+        matches!(self, ObjectKind::ParkedCar | ObjectKind::ParkedVan)
+    }
 }
 
 /// A car or pedestrian moving at constant velocity along its street segment.
@@ -154,7 +172,7 @@ impl Object {
                 radius: 0.5 * self.size[0],
                 height: self.size[2],
             },
-            ObjectKind::Car | ObjectKind::ParkedCar => Geometry::Box {
+            _ => Geometry::Box {
                 centre: p,
                 yaw: self.yaw,
                 half_length: 0.5 * self.size[0],
@@ -166,6 +184,7 @@ impl Object {
             surface: Surface::Object(self.id),
             geometry,
             reflectance: self.reflectance,
+            scatter: 0.0,
         })
     }
 }
@@ -177,8 +196,12 @@ pub struct Street {
     pub segments: Vec<Segment>,
     /// Building walls.
     pub walls: Vec<Wall>,
-    /// Cars and pedestrians.
+    /// Road users.
     pub objects: Vec<Object>,
+    /// Poles, trunks, hedges and low walls.
+    pub clutter: Vec<Clutter>,
+    /// How deep a ray enters a hedge (the configuration's `clutter.hedge_scatter`).
+    pub hedge_scatter: f64,
 }
 
 impl Street {
@@ -194,12 +217,14 @@ impl Street {
                 normal: w.normal,
             },
             reflectance: w.reflectance,
+            scatter: 0.0,
         });
         let objects = self
             .objects
             .iter()
             .filter_map(|o| o.shape_at(&self.segments, t));
-        walls.chain(objects).collect()
+        let clutter = self.clutter.iter().map(|c| c.shape(self.hedge_scatter));
+        walls.chain(objects).chain(clutter).collect()
     }
 }
 
@@ -324,10 +349,13 @@ pub fn build_street(
     }
 
     let objects = place_objects(config, &segments, ego, times, rng);
+    let clutter = place_clutter(config, &segments, ego, rng);
     Ok(Street {
         segments,
         walls,
         objects,
+        clutter,
+        hedge_scatter: config.clutter.hedge_scatter,
     })
 }
 
@@ -373,14 +401,33 @@ fn place_objects(
                 .collect()
         })
         .collect();
-    let kerb = layout.road_half_width - 0.5 * traffic.car_size[1] - 0.1;
+    let kerb = |width: f64| layout.road_half_width - 0.5 * width - 0.1;
+    let size_of = |kind: ObjectKind| match kind {
+        ObjectKind::Pedestrian => [
+            2.0 * traffic.pedestrian_radius,
+            2.0 * traffic.pedestrian_radius,
+            traffic.pedestrian_height,
+        ],
+        ObjectKind::Car | ObjectKind::ParkedCar => traffic.car_size,
+        ObjectKind::Van | ObjectKind::ParkedVan => traffic.van_size,
+        ObjectKind::Truck => traffic.truck_size,
+        ObjectKind::Cyclist => traffic.cyclist_size,
+    };
     let mut objects: Vec<Object> = Vec::new();
+    // The plain street's kinds first, so that adding the others leaves its objects as they were.
     let kinds = std::iter::repeat_n(ObjectKind::ParkedCar, traffic.parked_cars)
         .chain(std::iter::repeat_n(ObjectKind::Car, traffic.moving_cars))
         .chain(std::iter::repeat_n(
             ObjectKind::Pedestrian,
             traffic.pedestrians,
-        ));
+        ))
+        .chain(std::iter::repeat_n(
+            ObjectKind::ParkedVan,
+            traffic.parked_vans,
+        ))
+        .chain(std::iter::repeat_n(ObjectKind::Van, traffic.moving_vans))
+        .chain(std::iter::repeat_n(ObjectKind::Truck, traffic.trucks))
+        .chain(std::iter::repeat_n(ObjectKind::Cyclist, traffic.cyclists));
     for kind in kinds {
         for _attempt in 0..2000 {
             let j = rng.random_range(0..segments.len());
@@ -390,35 +437,46 @@ fn place_objects(
             } else {
                 -1.0
             };
+            let size = size_of(kind);
             let row = match kind {
-                ObjectKind::ParkedCar => Row {
+                ObjectKind::ParkedCar | ObjectKind::ParkedVan => Row {
                     kind,
-                    lateral: side * kerb,
+                    lateral: side * kerb(size[1]),
                     speed: 0.0,
-                    min_spacing: traffic.car_size[0] + 1.5,
+                    min_spacing: size[0] + 1.5,
                     clearance_to_ego: 2.0,
                 },
-                ObjectKind::Car => {
+                ObjectKind::Car | ObjectKind::Van | ObjectKind::Truck | ObjectKind::Cyclist => {
                     if lanes.is_empty() {
                         break;
                     }
                     let i = rng.random_range(0..lanes.len());
                     let lateral = lanes[i];
-                    let v = lane_speeds[j][i];
+                    let v = if kind == ObjectKind::Cyclist {
+                        uniform(rng, traffic.cyclist_speed)
+                    } else {
+                        lane_speeds[j][i]
+                    };
                     Row {
                         kind,
                         lateral,
                         // Right of the centreline: the ego's direction; left: against it.
                         speed: if lateral < 0.0 { v } else { -v },
-                        min_spacing: 2.0 * traffic.car_size[0],
-                        clearance_to_ego: 4.0,
+                        // Clear of a car (or a truck) ahead and behind at every frame.
+                        min_spacing: 2.0 * traffic.car_size[0]
+                            + (size[0] - traffic.car_size[0]).max(0.0),
+                        clearance_to_ego: if kind == ObjectKind::Cyclist {
+                            3.0
+                        } else {
+                            4.0
+                        },
                     }
                 }
                 ObjectKind::Pedestrian => {
                     let forward = rng.random_range(0..2) == 0;
                     let v = uniform(rng, traffic.pedestrian_speed);
                     // Two walking rows per sidewalk, one per direction.
-                    let depth = if forward { 1.0 } else { 2.0 };
+                    let depth = traffic.pedestrian_rows[usize::from(!forward)];
                     Row {
                         kind,
                         lateral: side * (wall_offset - depth),
@@ -453,14 +511,7 @@ fn place_objects(
             let mut object = Object {
                 id: objects.len() as u32,
                 kind: row.kind,
-                size: match kind {
-                    ObjectKind::Pedestrian => [
-                        2.0 * traffic.pedestrian_radius,
-                        2.0 * traffic.pedestrian_radius,
-                        traffic.pedestrian_height,
-                    ],
-                    _ => traffic.car_size,
-                },
+                size,
                 segment: j,
                 s0,
                 lateral: row.lateral,

@@ -1,0 +1,324 @@
+//! Street clutter: poles, tree trunks, hedges and low walls along the sidewalks, the static
+//! things a lidar clusters that are not road users (KITTI labels none of them, so neither
+//! does the tracking layout's `label_02`).
+//!
+//! **Shapes.** Poles and tree trunks are vertical cylinders, low walls boxes, hedges boxes that
+//! a ray enters before it returns ([`Shape::scatter`]: a hedge's returns scatter through its
+//! outer 0.3 m, as foliage's do).
+//!
+//! **Rows.** Every piece stands in one of two rows on each side of the street, clear of the
+//! road users' rows (parked cars at the kerb, pedestrians 1 and 2 m from the building line):
+//! poles and trunks 0.4 m behind the kerb, hedges and low walls against the building line. A
+//! piece is drawn at random along a segment (away from its corners by the traffic's
+//! `corner_clearance`, within `spawn_radius` of the ego's path) and redrawn when it would come
+//! within 1 m of another piece of its row.
+//!
+//! Not for: road users (see [`super::world`]) or building walls.
+
+use super::lidar::{Geometry, Shape, Surface};
+use super::world::Segment;
+use super::StreetConfig;
+use crate::error::{ensure_non_negative, ensure_positive, Error, Result};
+use crate::rng::FilterRng;
+use rand::RngExt;
+use serde::{Deserialize, Serialize};
+
+/// What a piece of clutter is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ClutterKind {
+    /// A street-lamp or sign pole (thin cylinder).
+    Pole,
+    /// A tree trunk (cylinder).
+    Trunk,
+    /// A hedge (porous box).
+    Hedge,
+    /// A low garden or boundary wall (box).
+    LowWall,
+}
+
+/// How many pieces of each kind and their sizes (ranges drawn uniformly), metres.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ClutterConfig {
+    /// Number of poles.
+    pub poles: usize,
+    /// Number of tree trunks.
+    pub trunks: usize,
+    /// Number of hedges.
+    pub hedges: usize,
+    /// Number of low walls.
+    pub low_walls: usize,
+    /// Pole radius.
+    pub pole_radius: [f64; 2],
+    /// Pole height.
+    pub pole_height: [f64; 2],
+    /// Trunk radius.
+    pub trunk_radius: [f64; 2],
+    /// Trunk height (up to the crown, which the lidar's upward field of view barely reaches).
+    pub trunk_height: [f64; 2],
+    /// Hedge length along the street.
+    pub hedge_length: [f64; 2],
+    /// Hedge depth across the street.
+    pub hedge_width: [f64; 2],
+    /// Hedge height.
+    pub hedge_height: [f64; 2],
+    /// How deep a ray enters a hedge before it returns.
+    pub hedge_scatter: f64,
+    /// Low wall length along the street.
+    pub low_wall_length: [f64; 2],
+    /// Low wall thickness.
+    pub low_wall_width: [f64; 2],
+    /// Low wall height.
+    pub low_wall_height: [f64; 2],
+}
+
+impl Default for ClutterConfig {
+    /// No clutter (the plain street), with the sizes [`ClutterConfig::urban`] uses.
+    fn default() -> Self {
+        ClutterConfig {
+            poles: 0,
+            trunks: 0,
+            hedges: 0,
+            low_walls: 0,
+            pole_radius: [0.06, 0.12],
+            pole_height: [3.0, 8.0],
+            trunk_radius: [0.12, 0.22],
+            trunk_height: [2.5, 4.5],
+            hedge_length: [3.0, 10.0],
+            hedge_width: [0.5, 0.6],
+            hedge_height: [0.8, 1.8],
+            hedge_scatter: 0.3,
+            low_wall_length: [4.0, 15.0],
+            low_wall_width: [0.25, 0.35],
+            low_wall_height: [0.5, 1.1],
+        }
+    }
+}
+
+impl ClutterConfig {
+    /// A city street's clutter: 14 poles, 10 trunks, 4 hedges and 3 low walls a drive.
+    pub fn urban() -> Self {
+        ClutterConfig {
+            poles: 14,
+            trunks: 10,
+            hedges: 4,
+            low_walls: 3,
+            ..ClutterConfig::default()
+        }
+    }
+
+    /// Checks every field; errors name the field.
+    pub fn validate(&self) -> Result<()> {
+        let ranges = [
+            ("pole_radius", self.pole_radius),
+            ("pole_height", self.pole_height),
+            ("trunk_radius", self.trunk_radius),
+            ("trunk_height", self.trunk_height),
+            ("hedge_length", self.hedge_length),
+            ("hedge_width", self.hedge_width),
+            ("hedge_height", self.hedge_height),
+            ("low_wall_length", self.low_wall_length),
+            ("low_wall_width", self.low_wall_width),
+            ("low_wall_height", self.low_wall_height),
+        ];
+        for (name, r) in ranges {
+            let what = format!("clutter.{name}");
+            ensure_positive(&what, r[0])?;
+            ensure_positive(&what, r[1])?;
+            if r[1] < r[0] {
+                return Err(Error::invalid(
+                    what,
+                    format!("[{}, {}] is decreasing", r[0], r[1]),
+                ));
+            }
+        }
+        ensure_non_negative("clutter.hedge_scatter", self.hedge_scatter)?;
+        // Poles and trunks stand in a row 0.4 m behind the kerb, before the pedestrians' row.
+        for (name, r) in [
+            ("pole_radius", self.pole_radius),
+            ("trunk_radius", self.trunk_radius),
+        ] {
+            if r[1] > 0.25 {
+                return Err(Error::invalid(
+                    format!("clutter.{name}"),
+                    format!(
+                        "{} m (at most 0.25 m: the row is 0.4 m behind the kerb)",
+                        r[1]
+                    ),
+                ));
+            }
+        }
+        for (name, r) in [
+            ("hedge_width", self.hedge_width),
+            ("low_wall_width", self.low_wall_width),
+        ] {
+            if r[1] > 0.6 {
+                return Err(Error::invalid(
+                    format!("clutter.{name}"),
+                    format!(
+                        "{} m (at most 0.6 m: it stands against the building line)",
+                        r[1]
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One piece of clutter in the world frame.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Clutter {
+    /// Identifier (matches `Surface::Clutter`).
+    pub id: u32,
+    /// Kind.
+    pub kind: ClutterKind,
+    /// Centre of the footprint in the world, metres.
+    pub centre: [f64; 2],
+    /// Heading of the long side, rad counter-clockwise from the world x axis.
+    pub yaw: f64,
+    /// Length, width, height, metres (a cylinder: diameter, diameter, height).
+    pub size: [f64; 3],
+    /// Reflectance of the surface.
+    pub reflectance: f32,
+}
+
+impl Clutter {
+    /// The piece as a shape for the ray caster; a hedge scatters its returns by `hedge_scatter`.
+    pub fn shape(&self, hedge_scatter: f64) -> Shape {
+        let [length, width, height] = self.size;
+        let geometry = match self.kind {
+            ClutterKind::Pole | ClutterKind::Trunk => Geometry::Cylinder {
+                centre: self.centre,
+                radius: 0.5 * width,
+                height,
+            },
+            ClutterKind::Hedge | ClutterKind::LowWall => Geometry::Box {
+                centre: self.centre,
+                yaw: self.yaw,
+                half_length: 0.5 * length,
+                half_width: 0.5 * width,
+                height,
+            },
+        };
+        Shape {
+            surface: Surface::Clutter(self.id),
+            geometry,
+            reflectance: self.reflectance,
+            scatter: if self.kind == ClutterKind::Hedge {
+                hedge_scatter
+            } else {
+                0.0
+            },
+        }
+    }
+}
+
+fn uniform(rng: &mut FilterRng, range: [f64; 2]) -> f64 {
+    if range[1] > range[0] {
+        rng.random_range(range[0]..range[1])
+    } else {
+        range[0]
+    }
+}
+
+/// Places the configured clutter along `segments` (see the module notes) near the ego's
+/// positions `ego`. A piece that finds no free place in 2000 draws is left out.
+pub fn place_clutter(
+    config: &StreetConfig,
+    segments: &[Segment],
+    ego: &[[f64; 2]],
+    rng: &mut FilterRng,
+) -> Vec<Clutter> {
+    let c = &config.clutter;
+    let layout = &config.street;
+    let traffic = &config.traffic;
+    let kerb_row = layout.road_half_width + 0.4;
+    let building_row = layout.road_half_width + layout.sidewalk_width;
+    let kinds = std::iter::repeat_n(ClutterKind::Pole, c.poles)
+        .chain(std::iter::repeat_n(ClutterKind::Trunk, c.trunks))
+        .chain(std::iter::repeat_n(ClutterKind::Hedge, c.hedges))
+        .chain(std::iter::repeat_n(ClutterKind::LowWall, c.low_walls));
+    let mut out: Vec<(usize, f64, Clutter)> = Vec::new();
+    for kind in kinds {
+        let size = match kind {
+            ClutterKind::Pole => {
+                let d = 2.0 * uniform(rng, c.pole_radius);
+                [d, d, uniform(rng, c.pole_height)]
+            }
+            ClutterKind::Trunk => {
+                let d = 2.0 * uniform(rng, c.trunk_radius);
+                [d, d, uniform(rng, c.trunk_height)]
+            }
+            ClutterKind::Hedge => [
+                uniform(rng, c.hedge_length),
+                uniform(rng, c.hedge_width),
+                uniform(rng, c.hedge_height),
+            ],
+            ClutterKind::LowWall => [
+                uniform(rng, c.low_wall_length),
+                uniform(rng, c.low_wall_width),
+                uniform(rng, c.low_wall_height),
+            ],
+        };
+        let (lateral_abs, reflectance) = match kind {
+            ClutterKind::Pole => (kerb_row, rng.random_range(0.3f32..0.6)),
+            ClutterKind::Trunk => (kerb_row, rng.random_range(0.2f32..0.4)),
+            // Against the building line, 5 cm in front of it.
+            ClutterKind::Hedge | ClutterKind::LowWall => (
+                building_row - 0.5 * size[1] - 0.05,
+                rng.random_range(0.15f32..0.5),
+            ),
+        };
+        for _attempt in 0..2000 {
+            let j = rng.random_range(0..segments.len());
+            let seg = &segments[j];
+            let side = if rng.random_range(0..2) == 0 {
+                1.0
+            } else {
+                -1.0
+            };
+            let clear = traffic.corner_clearance;
+            let (lo, hi) = (seg.s_start + clear, seg.s_end - clear);
+            if hi <= lo {
+                continue;
+            }
+            let s = rng.random_range(lo..hi);
+            let lateral = side * lateral_abs;
+            let centre = seg.at(s, lateral);
+            let near_path = ego
+                .iter()
+                .any(|e| (e[0] - centre[0]).hypot(e[1] - centre[1]) <= traffic.spawn_radius);
+            if !near_path {
+                continue;
+            }
+            let crowded = out.iter().any(|(k, other_s, o)| {
+                let other_lateral = seg_lateral(&segments[*k], o.centre);
+                *k == j
+                    && (other_lateral - lateral).abs() < 1.0
+                    && (other_s - s).abs() < 0.5 * (o.size[0] + size[0]) + 1.0
+            });
+            if crowded {
+                continue;
+            }
+            let piece = Clutter {
+                id: out.len() as u32,
+                kind,
+                centre,
+                yaw: seg.dir[1].atan2(seg.dir[0]),
+                size,
+                reflectance,
+            };
+            out.push((j, s, piece));
+            break;
+        }
+    }
+    out.into_iter().map(|(_, _, p)| p).collect()
+}
+
+/// Signed lateral offset (left > 0) of a world point from a segment's centreline.
+fn seg_lateral(seg: &Segment, p: [f64; 2]) -> f64 {
+    let l = seg.left();
+    (p[0] - seg.point[0]) * l[0] + (p[1] - seg.point[1]) * l[1]
+}
