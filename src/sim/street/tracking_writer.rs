@@ -1,5 +1,5 @@
-//! Writes a simulated street drive in the KITTI tracking layout, with its cars and pedestrians
-//! as `label_02` labels:
+//! Writes a simulated street drive in the KITTI tracking layout, with its road users (cars,
+//! vans, trucks, pedestrians, cyclists; not the clutter) as `label_02` labels:
 //!
 //! ```text
 //! ROOT/velodyne/NNNN/000000.bin ...
