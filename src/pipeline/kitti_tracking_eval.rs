@@ -150,17 +150,6 @@ pub enum EvalClass {
     RoadUser,
 }
 
-/// The types of [`EvalClass::RoadUser`].
-const ROAD_USER_TYPES: [ObjectType; 7] = [
-    ObjectType::Car,
-    ObjectType::Van,
-    ObjectType::Truck,
-    ObjectType::Pedestrian,
-    ObjectType::PersonSitting,
-    ObjectType::Cyclist,
-    ObjectType::Tram,
-];
-
 impl EvalClass {
     /// KITTI's benchmark classes, in KITTI's order.
     pub const ALL: [EvalClass; 2] = [EvalClass::Car, EvalClass::Pedestrian];
@@ -189,7 +178,8 @@ impl EvalClass {
             EvalClass::Car => t == ObjectType::Car,
             EvalClass::Pedestrian => t == ObjectType::Pedestrian,
             EvalClass::CarVan => matches!(t, ObjectType::Car | ObjectType::Van),
-            EvalClass::RoadUser => ROAD_USER_TYPES.contains(&t),
+            // Every labelled object but `Misc` (and `DontCare`, a region, not an object).
+            EvalClass::RoadUser => !matches!(t, ObjectType::Misc | ObjectType::DontCare),
         }
     }
 
