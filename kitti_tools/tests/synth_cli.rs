@@ -121,7 +121,11 @@ fn the_tracking_layout_gets_the_urban_street_and_the_raw_layout_the_plain_one() 
     assert!(!raw.contains("clutter:"), "{raw}");
     // A configuration file is its own street.
     let config = dir.path().join("street.toml");
-    std::fs::write(&config, "[clutter]\npoles = 2\n").unwrap();
+    std::fs::write(
+        &config,
+        "[clutter]\npoles = 2\n[street]\nsidewalk_width = 4.5\n",
+    )
+    .unwrap();
     let out = dir.path().join("both");
     let both = run(&[
         "synth",

@@ -8,7 +8,8 @@
 //!
 //! **Rows.** Every piece stands in one of two rows on each side of the street, clear of the
 //! road users' rows (parked cars at the kerb, pedestrians 1 and 2 m from the building line):
-//! poles and trunks 0.4 m behind the kerb, hedges and low walls against the building line. A
+//! poles and trunks [`KERB_SETBACK`] behind the kerb, hedges and low walls against the building
+//! line. A
 //! piece is drawn at random along a segment (away from its corners by the traffic's
 //! `corner_clearance`, within `spawn_radius` of the ego's path) and redrawn when it would come
 //! within 1 m of another piece of its row.
@@ -22,6 +23,10 @@ use crate::error::{ensure_non_negative, ensure_positive, Error, Result};
 use crate::rng::FilterRng;
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
+
+/// How far behind the kerb poles and tree trunks stand (m): a street lamp's usual setback, which
+/// also leaves a parked car (0.1 m from the kerb) more than a clusterer's 0.5 m from them.
+pub const KERB_SETBACK: f64 = 0.8;
 
 /// What a piece of clutter is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -134,7 +139,7 @@ impl ClutterConfig {
             }
         }
         ensure_non_negative("clutter.hedge_scatter", self.hedge_scatter)?;
-        // Poles and trunks stand in a row 0.4 m behind the kerb, before the pedestrians' row.
+        // Poles and trunks stand in a row `KERB_SETBACK` behind the kerb.
         for (name, r) in [
             ("pole_radius", self.pole_radius),
             ("trunk_radius", self.trunk_radius),
@@ -143,7 +148,7 @@ impl ClutterConfig {
                 return Err(Error::invalid(
                     format!("clutter.{name}"),
                     format!(
-                        "{} m (at most 0.25 m: the row is 0.4 m behind the kerb)",
+                        "{} m (at most 0.25 m: the row is {KERB_SETBACK} m behind the kerb)",
                         r[1]
                     ),
                 ));
@@ -234,7 +239,7 @@ pub fn place_clutter(
     let c = &config.clutter;
     let layout = &config.street;
     let traffic = &config.traffic;
-    let kerb_row = layout.road_half_width + 0.4;
+    let kerb_row = layout.road_half_width + KERB_SETBACK;
     let building_row = layout.road_half_width + layout.sidewalk_width;
     let kinds = std::iter::repeat_n(ClutterKind::Pole, c.poles)
         .chain(std::iter::repeat_n(ClutterKind::Trunk, c.trunks))

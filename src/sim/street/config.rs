@@ -6,7 +6,7 @@
 //! Not for: simulating (see [`super::StreetSimulator`]).
 
 use super::body::BodyMotionConfig;
-use super::clutter::ClutterConfig;
+use super::clutter::{ClutterConfig, KERB_SETBACK};
 use super::ego::LegSpec;
 use super::ground::GroundConfig;
 use super::lidar::LidarConfig;
@@ -333,6 +333,45 @@ impl StreetConfig {
         ensure_non_negative("traffic.corner_clearance", t.corner_clearance)?;
         ensure_positive("traffic.spawn_radius", t.spawn_radius)?;
         self.clutter.validate()?;
+        // Clutter keeps out of the pedestrians' rows (0.5 m clear of a walker's shoulder).
+        let c = &self.clutter;
+        let walker = |d: f64| s.sidewalk_width - d;
+        let nearest_walk = t
+            .pedestrian_rows
+            .iter()
+            .map(|&d| walker(d) - t.pedestrian_radius)
+            .fold(f64::INFINITY, f64::min);
+        let furthest_walk = t
+            .pedestrian_rows
+            .iter()
+            .map(|&d| d - t.pedestrian_radius)
+            .fold(f64::INFINITY, f64::min);
+        if c.poles + c.trunks > 0 {
+            let edge = KERB_SETBACK + c.pole_radius[1].max(c.trunk_radius[1]);
+            if edge + 0.5 > nearest_walk {
+                return Err(Error::invalid(
+                    "clutter.poles / clutter.trunks",
+                    format!(
+                        "reach {edge:.2} m onto the sidewalk, within 0.5 m of the walkers \
+                         {nearest_walk:.2} m from the kerb (widen street.sidewalk_width or move \
+                         traffic.pedestrian_rows)"
+                    ),
+                ));
+            }
+        }
+        if c.hedges + c.low_walls > 0 {
+            let depth = 0.05 + c.hedge_width[1].max(c.low_wall_width[1]);
+            if depth + 0.5 > furthest_walk {
+                return Err(Error::invalid(
+                    "clutter.hedges / clutter.low_walls",
+                    format!(
+                        "reach {depth:.2} m from the building line, within 0.5 m of the walkers \
+                         {furthest_walk:.2} m from it (widen street.sidewalk_width or move \
+                         traffic.pedestrian_rows)"
+                    ),
+                ));
+            }
+        }
         let l = &self.lidar;
         if l.beams < 2 || !l.beams.is_multiple_of(2) || l.beams > 256 {
             return Err(Error::invalid(

@@ -238,11 +238,24 @@ fn the_plain_street_has_no_clutter_and_its_objects_do_not_move_when_other_kinds_
     let mut more = StreetConfig::default();
     more.traffic.cyclists = 2;
     more.traffic.moving_vans = 1;
-    more.clutter.poles = 3;
     let sim = StreetSimulator::new(&more, 60, 5).unwrap();
     let n = plain.street().objects.len();
     assert_eq!(&sim.street().objects[..n], &plain.street().objects[..]);
     assert_eq!(sim.street().walls, plain.street().walls);
     assert_eq!(sim.street().objects.len(), n + 3);
-    assert_eq!(sim.street().clutter.len(), 3);
+    // The plain sidewalk is too narrow for poles beside its walkers.
+    more.clutter.poles = 3;
+    let err = more.validate().unwrap_err().to_string();
+    assert!(err.contains("clutter.poles"), "{err}");
+    // Clutter comes after the road users: more of it moves none of them.
+    let urban = StreetConfig::urban();
+    let mut more_poles = urban.clone();
+    more_poles.clutter.poles += 2;
+    let (a, b) = (
+        StreetSimulator::new(&urban, 60, 5).unwrap(),
+        StreetSimulator::new(&more_poles, 60, 5).unwrap(),
+    );
+    assert_eq!(a.street().objects, b.street().objects);
+    assert_eq!(a.street().walls, b.street().walls);
+    assert_eq!(b.street().clutter.len(), a.street().clutter.len() + 2);
 }
