@@ -36,6 +36,37 @@ pub fn read_checked<T: DeserializeOwned>(
     Ok(config)
 }
 
+/// Reads `path` over `base`: the fields the file sets replace `base`'s (tables field by field),
+/// the others keep `base`'s values. The file is first read as a `T` of its own, so that a
+/// misspelt field or a bad value is reported with its file and line.
+pub fn read_config_over<T: DeserializeOwned + serde::Serialize>(
+    path: &Path,
+    base: &T,
+) -> Result<T> {
+    read_config::<T>(path)?;
+    let file: serde_json::Value = read_config(path)?;
+    let mut merged = serde_json::to_value(base).context("configuration as a table")?;
+    overlay(&mut merged, file);
+    serde_json::from_value(merged).with_context(|| format!("{}", path.display()))
+}
+
+/// Puts `top` over `base`: tables merge key by key, anything else replaces.
+fn overlay(base: &mut serde_json::Value, top: serde_json::Value) {
+    match (base, top) {
+        (serde_json::Value::Object(b), serde_json::Value::Object(t)) => {
+            for (k, v) in t {
+                match b.get_mut(&k) {
+                    Some(slot) => overlay(slot, v),
+                    None => {
+                        b.insert(k, v);
+                    }
+                }
+            }
+        }
+        (slot, v) => *slot = v,
+    }
+}
+
 /// Reads `path` as TOML (`.toml`) or JSON (`.json`) into `T`.
 pub fn read_config<T: DeserializeOwned>(path: &Path) -> Result<T> {
     let text =
@@ -70,6 +101,51 @@ fn line_of(text: &str, offset: usize) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_file_over_a_base_replaces_only_what_it_sets() {
+        #[derive(serde::Serialize, serde::Deserialize, Debug, PartialEq)]
+        #[serde(default, deny_unknown_fields)]
+        struct Inner {
+            a: f64,
+            b: Vec<u32>,
+        }
+        impl Default for Inner {
+            fn default() -> Self {
+                Inner { a: 1.0, b: vec![1] }
+            }
+        }
+        #[derive(serde::Serialize, serde::Deserialize, Debug, PartialEq, Default)]
+        #[serde(default, deny_unknown_fields)]
+        struct Outer {
+            n: u32,
+            inner: Inner,
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("c.toml");
+        std::fs::write(&path, "[inner]\nb = [7, 8]\n").unwrap();
+        let base = Outer {
+            n: 5,
+            inner: Inner { a: 2.5, b: vec![] },
+        };
+        let read = read_config_over(&path, &base).unwrap();
+        assert_eq!(
+            read,
+            Outer {
+                n: 5,
+                inner: Inner {
+                    a: 2.5,
+                    b: vec![7, 8]
+                }
+            }
+        );
+        std::fs::write(&path, "[inner]\nc = 1\n").unwrap();
+        let err = format!("{:#}", read_config_over(&path, &base).unwrap_err());
+        assert!(
+            err.contains("c.toml:2") && err.contains("unknown field"),
+            "{err}"
+        );
+    }
 
     #[test]
     fn line_numbers_count_from_one_and_include_the_offsets_own_line() {

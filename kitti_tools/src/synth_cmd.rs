@@ -51,10 +51,10 @@ pub struct Args {
     seed: u64,
     /// Built-in street [default: `urban` for the tracking layout, which exists to score road
     /// users, `plain` for the raw layout].
-    #[arg(long, value_enum, conflicts_with = "config")]
+    #[arg(long, value_enum)]
     street: Option<Street>,
-    /// Street configuration (.toml or .json); the plain street's defaults for everything not
-    /// given.
+    /// Street configuration (.toml or .json) over the built-in street: the fields it sets
+    /// replace the street's, the others keep them.
     #[arg(long)]
     config: Option<PathBuf>,
     /// No progress bar.
@@ -62,9 +62,10 @@ pub struct Args {
     quiet: bool,
 }
 
-/// Reads a TOML or JSON street configuration, naming the file and line of any problem.
-fn read_config(path: &Path) -> Result<StreetConfig> {
-    let config: StreetConfig = crate::config_file::read_config(path)?;
+/// Reads a TOML or JSON street configuration over `base`, naming the file and line of any
+/// problem.
+fn read_config(path: &Path, base: &StreetConfig) -> Result<StreetConfig> {
+    let config = crate::config_file::read_config_over(path, base)?;
     config
         .validate()
         .with_context(|| format!("checking {}", path.display()))?;
@@ -80,10 +81,13 @@ pub fn run(args: Args) -> Result<()> {
         Layout::Raw => Street::Plain,
         Layout::Tracking => Street::Urban,
     });
-    let config = match (&args.config, street) {
-        (Some(path), _) => read_config(path)?,
-        (None, Street::Plain) => StreetConfig::default(),
-        (None, Street::Urban) => StreetConfig::urban(),
+    let base = match street {
+        Street::Plain => StreetConfig::default(),
+        Street::Urban => StreetConfig::urban(),
+    };
+    let config = match &args.config {
+        Some(path) => read_config(path, &base)?,
+        None => base,
     };
     let bar = if args.quiet {
         ProgressBar::hidden()

@@ -119,33 +119,29 @@ fn the_tracking_layout_gets_the_urban_street_and_the_raw_layout_the_plain_one() 
     assert!(!plain.contains("clutter:"), "{plain}");
     let (raw, _) = synth("raw", &[]);
     assert!(!raw.contains("clutter:"), "{raw}");
-    // A configuration file is its own street.
+    // A configuration file lies over the built-in street: what it sets replaces the street's.
     let config = dir.path().join("street.toml");
     std::fs::write(
         &config,
         "[clutter]\npoles = 2\n[street]\nsidewalk_width = 4.5\n",
     )
     .unwrap();
-    let out = dir.path().join("both");
-    let both = run(&[
-        "synth",
-        "--out",
-        out.to_str().unwrap(),
-        "--street",
-        "urban",
-        "--config",
-        config.to_str().unwrap(),
-    ]);
-    assert!(!both.status.success());
-    let err = String::from_utf8_lossy(&both.stderr);
+    let (plain_poles, _) = synth("poles", &["--config", config.to_str().unwrap()]);
     assert!(
-        err.contains("--config") && err.contains("--street"),
-        "{err}"
+        plain_poles.contains("clutter: 2 poles, 0 tree trunks"),
+        "{plain_poles}"
     );
-    let (poles, _) = synth("poles", &["--config", config.to_str().unwrap()]);
-    assert!(poles.contains("clutter: 2 poles"), "{poles}");
+    let (urban_poles, _) = synth(
+        "urban_poles",
+        &["--street", "urban", "--config", config.to_str().unwrap()],
+    );
+    assert!(
+        urban_poles.contains("clutter: 2 poles, 10 tree trunks"),
+        "{urban_poles}"
+    );
+    let out = dir.path().join("bad");
     // A clutter size that does not fit its row is refused, naming the field.
-    std::fs::write(&config, "[clutter]\ntrunk_radius = [0.2, 0.5]\n").unwrap();
+    std::fs::write(&config, "[clutter]\ntrunk_radius = [0.2, 0.9]\n").unwrap();
     let bad = run(&[
         "synth",
         "--out",

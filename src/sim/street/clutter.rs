@@ -8,8 +8,8 @@
 //!
 //! **Rows.** Every piece stands in one of two rows on each side of the street, clear of the
 //! road users' rows (parked cars at the kerb, pedestrians 1 and 2 m from the building line):
-//! poles and trunks [`KERB_SETBACK`] behind the kerb, hedges and low walls against the building
-//! line. A
+//! poles and trunks [`ClutterConfig::kerb_setback`] behind the kerb, hedges and low walls
+//! against the building line. A
 //! piece is drawn at random along a segment (away from its corners by the traffic's
 //! `corner_clearance`, within `spawn_radius` of the ego's path) and redrawn when it would come
 //! within 1 m of another piece of its row.
@@ -23,10 +23,6 @@ use crate::error::{ensure_non_negative, ensure_positive, Error, Result};
 use crate::rng::FilterRng;
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
-
-/// How far behind the kerb poles and tree trunks stand (m): a street lamp's usual setback, which
-/// also leaves a parked car (0.1 m from the kerb) more than a clusterer's 0.5 m from them.
-pub const KERB_SETBACK: f64 = 0.8;
 
 /// What a piece of clutter is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -54,6 +50,11 @@ pub struct ClutterConfig {
     pub hedges: usize,
     /// Number of low walls.
     pub low_walls: usize,
+    /// How far behind the kerb poles and tree trunks stand (axis to kerb, m). The default,
+    /// 0.8 m, is a street lamp's usual setback and leaves a parked car (0.1 m from the kerb)
+    /// more than a clusterer's 0.5 m from them; 0.4 m puts them within reach, so that parked
+    /// cars and poles merge into one cluster.
+    pub kerb_setback: f64,
     /// Pole radius.
     pub pole_radius: [f64; 2],
     /// Pole height.
@@ -86,6 +87,7 @@ impl Default for ClutterConfig {
             trunks: 0,
             hedges: 0,
             low_walls: 0,
+            kerb_setback: 0.8,
             pole_radius: [0.06, 0.12],
             pole_height: [3.0, 8.0],
             trunk_radius: [0.12, 0.22],
@@ -139,17 +141,18 @@ impl ClutterConfig {
             }
         }
         ensure_non_negative("clutter.hedge_scatter", self.hedge_scatter)?;
-        // Poles and trunks stand in a row `KERB_SETBACK` behind the kerb.
+        ensure_non_negative("clutter.kerb_setback", self.kerb_setback)?;
+        // Poles and trunks stand on the sidewalk, behind the kerb.
         for (name, r) in [
             ("pole_radius", self.pole_radius),
             ("trunk_radius", self.trunk_radius),
         ] {
-            if r[1] > 0.25 {
+            if r[1] > self.kerb_setback {
                 return Err(Error::invalid(
                     format!("clutter.{name}"),
                     format!(
-                        "{} m (at most 0.25 m: the row is {KERB_SETBACK} m behind the kerb)",
-                        r[1]
+                        "{} m (at most clutter.kerb_setback, {} m: the row stands behind the kerb)",
+                        r[1], self.kerb_setback
                     ),
                 ));
             }
@@ -239,7 +242,7 @@ pub fn place_clutter(
     let c = &config.clutter;
     let layout = &config.street;
     let traffic = &config.traffic;
-    let kerb_row = layout.road_half_width + KERB_SETBACK;
+    let kerb_row = layout.road_half_width + c.kerb_setback;
     let building_row = layout.road_half_width + layout.sidewalk_width;
     let kinds = std::iter::repeat_n(ClutterKind::Pole, c.poles)
         .chain(std::iter::repeat_n(ClutterKind::Trunk, c.trunks))

@@ -6,7 +6,7 @@
 //! Not for: simulating (see [`super::StreetSimulator`]).
 
 use super::body::BodyMotionConfig;
-use super::clutter::{ClutterConfig, KERB_SETBACK};
+use super::clutter::ClutterConfig;
 use super::ego::LegSpec;
 use super::ground::GroundConfig;
 use super::lidar::LidarConfig;
@@ -347,7 +347,7 @@ impl StreetConfig {
             .map(|&d| d - t.pedestrian_radius)
             .fold(f64::INFINITY, f64::min);
         if c.poles + c.trunks > 0 {
-            let edge = KERB_SETBACK + c.pole_radius[1].max(c.trunk_radius[1]);
+            let edge = c.kerb_setback + c.pole_radius[1].max(c.trunk_radius[1]);
             if edge + 0.5 > nearest_walk {
                 return Err(Error::invalid(
                     "clutter.poles / clutter.trunks",
