@@ -33,8 +33,8 @@
 
 use crate::cloud::boxes::{outline_of, BoxFitParams, BoxScratch};
 use crate::cloud::classes::{
-    default_prior, speed_log_likelihoods, ClassBelief, ClassFeatures, ClassModel, ObjectClass,
-    CLASS_COUNT, DEFAULT_FORGETTING, FRAME_EVIDENCE_WEIGHT,
+    cap_frame_evidence, default_prior, speed_log_likelihoods, ClassBelief, ClassFeatures,
+    ClassModel, ObjectClass, CLASS_COUNT, DEFAULT_FORGETTING, FRAME_EVIDENCE_WEIGHT,
 };
 use crate::cloud::PointCloud;
 use crate::error::Result;
@@ -257,7 +257,7 @@ impl RoadUserState {
             travel_angle: travel.and_then(|t| travel_angle(&shape.fitted, t)),
             ..shape.features
         };
-        let ll = model.log_likelihoods(&features)?.map(|l| weight * l);
+        let ll = cap_frame_evidence(model.log_likelihoods(&features)?).map(|l| weight * l);
         let mut belief = self.belief;
         belief.update(&ll, DEFAULT_FORGETTING)?;
         let mut current = belief;
