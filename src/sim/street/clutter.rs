@@ -17,7 +17,7 @@
 //! Not for: road users (see [`super::world`]) or building walls.
 
 use super::lidar::{Geometry, Shape, Surface};
-use super::world::Segment;
+use super::world::{uniform, Segment};
 use super::StreetConfig;
 use crate::error::{ensure_non_negative, ensure_positive, Error, Result};
 use crate::rng::FilterRng;
@@ -220,14 +220,6 @@ impl Clutter {
                 0.0
             },
         }
-    }
-}
-
-fn uniform(rng: &mut FilterRng, range: [f64; 2]) -> f64 {
-    if range[1] > range[0] {
-        rng.random_range(range[0]..range[1])
-    } else {
-        range[0]
     }
 }
 

@@ -241,7 +241,8 @@ fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
 }
 
-fn uniform(rng: &mut FilterRng, range: [f64; 2]) -> f64 {
+/// A draw uniform in `[range[0], range[1])`, or `range[0]` for an empty range.
+pub(super) fn uniform(rng: &mut FilterRng, range: [f64; 2]) -> f64 {
     if range[1] > range[0] {
         rng.random_range(range[0]..range[1])
     } else {
