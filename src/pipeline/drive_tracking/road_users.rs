@@ -477,7 +477,8 @@ mod tests {
             &mut BoxScratch::default(),
         )
         .unwrap();
-        let ll = model.log_likelihoods(&shape.features).unwrap();
+        // Each frame's shape evidence is capped (`FRAME_EVIDENCE_CAP`).
+        let ll = cap_frame_evidence(model.log_likelihoods(&shape.features).unwrap());
         let none = [0.0; CLASS_COUNT];
         let standing = speed_log_likelihoods([(0.0, 1.0)]).unwrap();
         let normalise = |v: [f64; CLASS_COUNT]| {
