@@ -16,6 +16,7 @@
 //!
 //! Not for: road users (see [`super::world`]) or building walls.
 
+use super::config::ensure_range;
 use super::lidar::{Geometry, Shape, Surface};
 use super::world::{uniform, Segment};
 use super::StreetConfig;
@@ -132,13 +133,7 @@ impl ClutterConfig {
         for (name, r) in ranges {
             let what = format!("clutter.{name}");
             ensure_positive(&what, r[0])?;
-            ensure_positive(&what, r[1])?;
-            if r[1] < r[0] {
-                return Err(Error::invalid(
-                    what,
-                    format!("[{}, {}] is decreasing", r[0], r[1]),
-                ));
-            }
+            ensure_range(&what, r)?;
         }
         ensure_non_negative("clutter.hedge_scatter", self.hedge_scatter)?;
         ensure_non_negative("clutter.kerb_setback", self.kerb_setback)?;
@@ -240,7 +235,8 @@ pub fn place_clutter(
         .chain(std::iter::repeat_n(ClutterKind::Trunk, c.trunks))
         .chain(std::iter::repeat_n(ClutterKind::Hedge, c.hedges))
         .chain(std::iter::repeat_n(ClutterKind::LowWall, c.low_walls));
-    let mut out: Vec<(usize, f64, Clutter)> = Vec::new();
+    // Each piece placed with its segment, along- and signed lateral coordinates.
+    let mut out: Vec<(usize, f64, f64, Clutter)> = Vec::new();
     for kind in kinds {
         let size = match kind {
             ClutterKind::Pole => {
@@ -293,8 +289,7 @@ pub fn place_clutter(
             if !near_path {
                 continue;
             }
-            let crowded = out.iter().any(|(k, other_s, o)| {
-                let other_lateral = seg_lateral(&segments[*k], o.centre);
+            let crowded = out.iter().any(|(k, other_s, other_lateral, o)| {
                 *k == j
                     && (other_lateral - lateral).abs() < 1.0
                     && (other_s - s).abs() < 0.5 * (o.size[0] + size[0]) + 1.0
@@ -310,15 +305,9 @@ pub fn place_clutter(
                 size,
                 reflectance,
             };
-            out.push((j, s, piece));
+            out.push((j, s, lateral, piece));
             break;
         }
     }
-    out.into_iter().map(|(_, _, p)| p).collect()
-}
-
-/// Signed lateral offset (left > 0) of a world point from a segment's centreline.
-fn seg_lateral(seg: &Segment, p: [f64; 2]) -> f64 {
-    let l = seg.left();
-    (p[0] - seg.point[0]) * l[0] + (p[1] - seg.point[1]) * l[1]
+    out.into_iter().map(|(_, _, _, p)| p).collect()
 }

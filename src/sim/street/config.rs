@@ -225,7 +225,8 @@ impl Default for StreetConfig {
     }
 }
 
-fn ensure_range(what: &str, r: [f64; 2]) -> Result<()> {
+/// Checks that a `[low, high]` range has no negative end and does not decrease.
+pub(super) fn ensure_range(what: &str, r: [f64; 2]) -> Result<()> {
     ensure_non_negative(what, r[0])?;
     ensure_non_negative(what, r[1])?;
     if r[1] < r[0] {
