@@ -227,3 +227,115 @@ fn seed_drive_walls_repeat_with_lidar_odometry() {
     assert!(s.p90_normal_angle_deg <= 3.0, "{s:?}");
     assert!(s.median_vertex_distance_m <= 0.3, "{s:?}");
 }
+
+/// For every wall of at least `min_area` m² in scan k, the best match among scan k + 1's
+/// walls after moving its plane by the relative pose of the two scans: (area, normal angle
+/// in degrees, offset difference in metres), `None` when scan k + 1 has no wall at all.
+fn walls_again(
+    clouds: &[smc_lmb::cloud::PointCloud],
+    poses: &[nalgebra::Isometry3<f64>],
+    min_area: f64,
+) -> Vec<(f64, Option<(f64, f64)>)> {
+    let segs: Vec<PlaneSegmentation> = clouds
+        .iter()
+        .map(|c| extract_planes(c, &PlaneConfig::default(), &mut seeded(1)).expect("segment"))
+        .collect();
+    let mut out = Vec::new();
+    for k in 0..clouds.len() - 1 {
+        // Scan k's coordinates to scan k + 1's.
+        let step = poses[k + 1].inverse() * poses[k];
+        for w in segs[k].walls.iter().filter(|w| w.patch.area >= min_area) {
+            let moved = w.patch.plane.transform(&step);
+            let best = segs[k + 1]
+                .walls
+                .iter()
+                .map(|v| {
+                    let p = &v.patch.plane;
+                    // The same plane may come out with the opposite normal.
+                    let same = moved.normal.dot(&p.normal) >= 0.0;
+                    let (n, d) = if same {
+                        (p.normal, p.offset)
+                    } else {
+                        (-p.normal, -p.offset)
+                    };
+                    let angle = moved.normal.dot(&n).clamp(-1.0, 1.0).acos().to_degrees();
+                    (angle, (moved.offset - d).abs())
+                })
+                .min_by(|a, b| (a.0 + 5.0 * a.1).total_cmp(&(b.0 + 5.0 * b.1)));
+            out.push((w.patch.area, best));
+        }
+    }
+    out
+}
+
+/// The walls target on the four shared scans: registered by lidar odometry (KISS-ICP's
+/// recipe), every wall of 20 m² or more is segmented again in the next scan with its normal
+/// within 1° and its offset within 0.2 m. The scans were taken standing still, and the
+/// registration must say so. Their vertical planes are vegetation that the facade test
+/// rejects (see `full_frames`), so today no wall reaches the check; every wall the
+/// segmentation keeps there in future must repeat.
+#[test]
+fn shared_scans_registered_by_icp_repeat_their_walls() {
+    use smc_lmb::cloud::odometry::{odometry_of_frames, OdometryConfig};
+    let Some(dir) = common::shared_data(DRIVE) else {
+        return;
+    };
+    let clouds: Vec<_> = (0..4)
+        .map(|k| read_kitti_bin(dir.join(format!("{k:010}.bin"))).expect("readable frame"))
+        .collect();
+    let load = |k: usize| Ok(clouds[k].clone());
+    let poses = odometry_of_frames(4, &load, &OdometryConfig::default()).unwrap();
+    for (k, p) in poses.iter().enumerate() {
+        let moved = p.translation.vector.norm();
+        let turned = p.rotation.angle().to_degrees();
+        println!("scan {k}: {moved:.4} m, {turned:.4}° from scan 0");
+        assert!(
+            moved < 0.05 && turned < 0.1,
+            "scan {k}: {moved} m, {turned}°"
+        );
+    }
+    let walls = walls_again(&clouds, &poses, 20.0);
+    println!("{} walls of 20 m² or more", walls.len());
+    for (area, best) in walls {
+        let (angle, offset) = best.unwrap_or((f64::INFINITY, f64::INFINITY));
+        println!("wall of {area:.1} m²: again within {angle:.2}°, {offset:.3} m");
+        assert!(
+            angle <= 1.0 && offset <= 0.2,
+            "{area} m²: {angle}°, {offset} m"
+        );
+    }
+}
+
+/// The same criterion on seed 001's drive (frames 0–49, registered by lidar odometry): how
+/// many walls of 20 m² or more are segmented again in the next scan with their normal within
+/// 1° and their offset within 0.2 m. 138 of 205 are (67 %, measured 2026-11-30). Of the other
+/// 67, 27 come out again 1–4° or 0.2–0.7 m apart (the upper tail of the pairs' errors), 15
+/// fail the facade test in the next scan although a plane within about 1° is there (their RMS
+/// near its 0.08 m limit), 9 are far facades behind the car whose next scan finds only a
+/// parallel facade 6 m away, and 16 have no counterpart. The tracker keeps walls through the
+/// scans that miss them. The floor of 60 % guards today's rate.
+#[test]
+fn seed_drive_walls_are_segmented_again() {
+    use smc_lmb::cloud::odometry::{odometry_of_frames, OdometryConfig};
+    use smc_lmb::kitti::RawDrive;
+    let Some(dir) = common::shared_data(SEED_DRIVE) else {
+        return;
+    };
+    let drive = RawDrive::open(&dir).expect("drive");
+    let count = drive.velodyne_count();
+    let clouds: Vec<_> = (0..count).map(|k| drive.velodyne(k).unwrap()).collect();
+    let load = |k: usize| Ok(clouds[k].clone());
+    let poses = odometry_of_frames(count, &load, &OdometryConfig::default()).unwrap();
+    let walls = walls_again(&clouds, &poses, 20.0);
+    let again = walls
+        .iter()
+        .filter(|(_, b)| b.is_some_and(|(a, o)| a <= 1.0 && o <= 0.2))
+        .count();
+    println!("{again} of {} walls of 20 m² or more again", walls.len());
+    assert!(walls.len() >= 3 * (count - 1), "{} walls", walls.len());
+    assert!(
+        again as f64 >= 0.6 * walls.len() as f64,
+        "{again} of {}",
+        walls.len()
+    );
+}
