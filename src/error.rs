@@ -109,11 +109,45 @@ pub fn ensure_non_negative(what: &str, v: f64) -> Result<()> {
     }
 }
 
+/// Checks a `[low, high]` range: both ends finite and ≥ 0, and not decreasing.
+pub fn ensure_range(what: &str, r: [f64; 2]) -> Result<()> {
+    ensure_non_negative(what, r[0])?;
+    ensure_non_negative(what, r[1])?;
+    if r[1] < r[0] {
+        return Err(Error::invalid(
+            what,
+            format!("[{}, {}] is decreasing", r[0], r[1]),
+        ));
+    }
+    Ok(())
+}
+
 /// Checks a probability (in [0, 1]; NaN fails).
 pub fn ensure_probability(what: &str, p: f64) -> Result<()> {
     if (0.0..=1.0).contains(&p) {
         Ok(())
     } else {
         Err(Error::invalid(what, format!("{p} (must lie in [0, 1])")))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_range_must_be_non_negative_finite_and_not_decreasing() {
+        assert!(ensure_range("r", [0.0, 0.0]).is_ok());
+        assert!(ensure_range("r", [0.5, 2.0]).is_ok());
+        let msg = ensure_range("street.wall_gap", [2.0, 1.0])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            msg.contains("street.wall_gap") && msg.contains("decreasing"),
+            "{msg}"
+        );
+        assert!(ensure_range("r", [-0.1, 1.0]).is_err());
+        assert!(ensure_range("r", [0.0, f64::NAN]).is_err());
+        assert!(ensure_range("r", [0.0, f64::INFINITY]).is_err());
     }
 }

@@ -10,7 +10,7 @@ use super::clutter::ClutterConfig;
 use super::ego::LegSpec;
 use super::ground::GroundConfig;
 use super::lidar::LidarConfig;
-use crate::error::{ensure_non_negative, ensure_positive, Error, Result};
+use crate::error::{ensure_non_negative, ensure_positive, ensure_range, Error, Result};
 use crate::kitti::Timestamp;
 use serde::{Deserialize, Serialize};
 
@@ -223,19 +223,6 @@ impl Default for StreetConfig {
             recording: Recording::default(),
         }
     }
-}
-
-/// Checks that a `[low, high]` range has no negative end and does not decrease.
-pub(super) fn ensure_range(what: &str, r: [f64; 2]) -> Result<()> {
-    ensure_non_negative(what, r[0])?;
-    ensure_non_negative(what, r[1])?;
-    if r[1] < r[0] {
-        return Err(Error::invalid(
-            what,
-            format!("[{}, {}] is decreasing", r[0], r[1]),
-        ));
-    }
-    Ok(())
 }
 
 impl StreetConfig {

@@ -21,7 +21,7 @@
 //!
 //! Not for: ray casting (see [`super::lidar`]) or the ego motion (see [`super::ego`]).
 
-use super::clutter::{place_clutter, Clutter};
+use super::clutter::{Clutter, ClutterKind};
 use super::lidar::{Geometry, Shape, Surface};
 use super::StreetConfig;
 use crate::error::{Error, Result};
@@ -358,6 +358,106 @@ pub fn build_street(
         clutter,
         hedge_scatter: config.clutter.hedge_scatter,
     })
+}
+
+/// Places the configured clutter along `segments` near the ego's positions `ego`. Every piece
+/// stands in one of two rows on each side of the street, clear of the road users' rows
+/// (parked cars at the kerb, pedestrians on the sidewalk): poles and trunks
+/// [`ClutterConfig::kerb_setback`](super::clutter::ClutterConfig::kerb_setback) behind the
+/// kerb, hedges and low walls against the building line. A piece is drawn at random along a
+/// segment (away from its corners by the traffic's `corner_clearance`, within `spawn_radius`
+/// of the ego's path) and redrawn when it would come within 1 m of another piece of its row;
+/// one that finds no free place in 2000 draws is left out.
+fn place_clutter(
+    config: &StreetConfig,
+    segments: &[Segment],
+    ego: &[[f64; 2]],
+    rng: &mut FilterRng,
+) -> Vec<Clutter> {
+    let c = &config.clutter;
+    let layout = &config.street;
+    let traffic = &config.traffic;
+    let kerb_row = layout.road_half_width + c.kerb_setback;
+    let building_row = layout.road_half_width + layout.sidewalk_width;
+    let kinds = std::iter::repeat_n(ClutterKind::Pole, c.poles)
+        .chain(std::iter::repeat_n(ClutterKind::Trunk, c.trunks))
+        .chain(std::iter::repeat_n(ClutterKind::Hedge, c.hedges))
+        .chain(std::iter::repeat_n(ClutterKind::LowWall, c.low_walls));
+    // Each piece placed with its segment, along- and signed lateral coordinates.
+    let mut out: Vec<(usize, f64, f64, Clutter)> = Vec::new();
+    for kind in kinds {
+        let size = match kind {
+            ClutterKind::Pole => {
+                let d = 2.0 * uniform(rng, c.pole_radius);
+                [d, d, uniform(rng, c.pole_height)]
+            }
+            ClutterKind::Trunk => {
+                let d = 2.0 * uniform(rng, c.trunk_radius);
+                [d, d, uniform(rng, c.trunk_height)]
+            }
+            ClutterKind::Hedge => [
+                uniform(rng, c.hedge_length),
+                uniform(rng, c.hedge_width),
+                uniform(rng, c.hedge_height),
+            ],
+            ClutterKind::LowWall => [
+                uniform(rng, c.low_wall_length),
+                uniform(rng, c.low_wall_width),
+                uniform(rng, c.low_wall_height),
+            ],
+        };
+        let (lateral_abs, reflectance) = match kind {
+            ClutterKind::Pole => (kerb_row, rng.random_range(0.3f32..0.6)),
+            ClutterKind::Trunk => (kerb_row, rng.random_range(0.2f32..0.4)),
+            // Against the building line, 5 cm in front of it.
+            ClutterKind::Hedge | ClutterKind::LowWall => (
+                building_row - 0.5 * size[1] - 0.05,
+                rng.random_range(0.15f32..0.5),
+            ),
+        };
+        for _attempt in 0..2000 {
+            let j = rng.random_range(0..segments.len());
+            let seg = &segments[j];
+            let side = if rng.random_range(0..2) == 0 {
+                1.0
+            } else {
+                -1.0
+            };
+            let clear = traffic.corner_clearance;
+            let (lo, hi) = (seg.s_start + clear, seg.s_end - clear);
+            if hi <= lo {
+                continue;
+            }
+            let s = rng.random_range(lo..hi);
+            let lateral = side * lateral_abs;
+            let centre = seg.at(s, lateral);
+            let near_path = ego
+                .iter()
+                .any(|e| (e[0] - centre[0]).hypot(e[1] - centre[1]) <= traffic.spawn_radius);
+            if !near_path {
+                continue;
+            }
+            let crowded = out.iter().any(|(k, other_s, other_lateral, o)| {
+                *k == j
+                    && (other_lateral - lateral).abs() < 1.0
+                    && (other_s - s).abs() < 0.5 * (o.size[0] + size[0]) + 1.0
+            });
+            if crowded {
+                continue;
+            }
+            let piece = Clutter {
+                id: out.len() as u32,
+                kind,
+                centre,
+                yaw: seg.dir[1].atan2(seg.dir[0]),
+                size,
+                reflectance,
+            };
+            out.push((j, s, lateral, piece));
+            break;
+        }
+    }
+    out.into_iter().map(|(_, _, _, p)| p).collect()
 }
 
 /// One row of objects: where on the street and how it moves.
