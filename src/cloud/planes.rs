@@ -67,6 +67,7 @@
 mod band;
 mod config;
 mod pieces;
+mod plane_f32;
 mod ransac;
 
 pub use config::{PlaneConfig, WallQuality};
@@ -77,7 +78,8 @@ use crate::geometry::{Plane, PlanePatch};
 use crate::rng::FilterRng;
 use band::BandGrid;
 use pieces::{connected_pieces, hull_candidates, point64, rms};
-use ransac::{fit_chunked, one_round, PlaneF32};
+use plane_f32::PlaneF32;
+use ransac::{fit_chunked, one_round};
 
 /// Removes from `pool` the values of `taken`, a subsequence of it (both ascending), in place:
 /// the runs of `pool` between them move down whole.

@@ -11,7 +11,7 @@
 //! Not for: the ground's round (its pool is the whole scan and its plane crosses every cell),
 //! or neighbour queries (see [`crate::cloud::cluster`]).
 
-use super::ransac::PlaneF32;
+use super::plane_f32::PlaneF32;
 use crate::cloud::voxel_groups::VoxelGroups;
 
 /// Edge of a grid cell (m).

@@ -5,6 +5,7 @@
 //! Not for: the sequence of rounds or the classification of planes (see the parent module).
 
 use super::band::BandGrid;
+use super::plane_f32::PlaneF32;
 use super::PlaneConfig;
 use crate::cloud::voxel_groups::VoxelGroups;
 use crate::geometry::Plane;
@@ -16,38 +17,6 @@ use rayon::prelude::*;
 /// Number of points per chunk for parallel passes over points. Fixed, so that sums are
 /// combined in the same order for every thread count.
 const CHUNK: usize = 4096;
-
-/// Plane with f32 coefficients for fast residuals.
-#[derive(Copy, Clone)]
-pub(super) struct PlaneF32 {
-    n: [f32; 3],
-    d: f32,
-}
-
-impl PlaneF32 {
-    pub(super) fn new(p: &Plane) -> Self {
-        PlaneF32 {
-            n: [p.normal.x as f32, p.normal.y as f32, p.normal.z as f32],
-            d: p.offset as f32,
-        }
-    }
-    #[inline]
-    pub(super) fn residual_signed(&self, p: &[f32; 3]) -> f32 {
-        self.n[0] * p[0] + self.n[1] * p[1] + self.n[2] * p[2] + self.d
-    }
-    #[inline]
-    pub(super) fn residual(&self, p: &[f32; 3]) -> f32 {
-        (self.n[0] * p[0] + self.n[1] * p[1] + self.n[2] * p[2] + self.d).abs()
-    }
-    /// The normal's coefficients, widened.
-    pub(super) fn normal_f64(&self) -> [f64; 3] {
-        self.n.map(f64::from)
-    }
-    /// The offset, widened.
-    pub(super) fn offset_f64(&self) -> f64 {
-        self.d as f64
-    }
-}
 
 /// One RANSAC round on the pool `active` (ascending local indices): the refined plane and its
 /// inliers (ascending), or `None` when no plane with `min_points` inliers is found. With
