@@ -200,6 +200,133 @@ fn check_frames(path: &Path, frames: &[DetectionFrame]) -> Result<()> {
     Ok(())
 }
 
+/// The columns of a detections CSV file, found by name in its header line.
+struct CsvColumns<'a> {
+    names: Vec<&'a str>,
+    frame: usize,
+    time: usize,
+    z: Vec<usize>,
+    pose: Option<[usize; 3]>,
+    id: Option<usize>,
+}
+
+impl<'a> CsvColumns<'a> {
+    fn parse(path: &Path, header: &'a str) -> Result<Self> {
+        let names: Vec<&str> = header.split(',').map(str::trim).collect();
+        let col = |name: &str| names.iter().position(|n| *n == name);
+        let frame =
+            col("frame").ok_or_else(|| Error::parse(path, 1, "header", "no `frame` column"))?;
+        let time =
+            col("time").ok_or_else(|| Error::parse(path, 1, "header", "no `time` column"))?;
+        let z: Vec<usize> = (0..).map_while(|i| col(&format!("z{i}"))).collect();
+        if z.is_empty() {
+            return Err(Error::parse(
+                path,
+                1,
+                "header",
+                "no measurement columns `z0`, `z1`, ...",
+            ));
+        }
+        let pose = match (col("sensor_x"), col("sensor_y"), col("sensor_heading")) {
+            (Some(a), Some(b), Some(c)) => Some([a, b, c]),
+            (None, None, None) => None,
+            _ => {
+                return Err(Error::parse(
+                    path,
+                    1,
+                    "header",
+                    "sensor pose needs all of sensor_x, sensor_y, sensor_heading",
+                ))
+            }
+        };
+        let id = col("id");
+        Ok(CsvColumns {
+            names,
+            frame,
+            time,
+            z,
+            pose,
+            id,
+        })
+    }
+}
+
+/// One data line's cells, with what an error about one of them names: the file, the line
+/// and the column.
+struct CsvRow<'a> {
+    path: &'a Path,
+    line: usize,
+    names: &'a [&'a str],
+    cells: Vec<&'a str>,
+}
+
+impl<'a> CsvRow<'a> {
+    fn split(path: &'a Path, line: usize, names: &'a [&'a str], text: &'a str) -> Result<Self> {
+        let cells: Vec<&str> = text.split(',').map(str::trim).collect();
+        if cells.len() != names.len() {
+            return Err(Error::parse(
+                path,
+                line,
+                "line",
+                format!("{} fields, the header has {}", cells.len(), names.len()),
+            ));
+        }
+        Ok(CsvRow {
+            path,
+            line,
+            names,
+            cells,
+        })
+    }
+
+    fn is_empty(&self, c: usize) -> bool {
+        self.cells[c].is_empty()
+    }
+
+    /// The number in column `c`, whatever its value.
+    fn raw(&self, c: usize) -> Result<f64> {
+        self.cells[c].parse().map_err(|_| {
+            Error::parse(
+                self.path,
+                self.line,
+                self.names[c],
+                format!("`{}` is not a number", self.cells[c]),
+            )
+        })
+    }
+
+    /// The finite number in column `c`.
+    fn num(&self, c: usize) -> Result<f64> {
+        let v = self.raw(c)?;
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(Error::parse(
+                self.path,
+                self.line,
+                self.names[c],
+                format!("{v} is not finite"),
+            ))
+        }
+    }
+
+    /// The non-negative integer in column `c`, called `what` (a frame number, an id).
+    fn integer<T: std::str::FromStr>(&self, c: usize, field: &str, what: &str) -> Result<T> {
+        self.cells[c].parse().map_err(|_| {
+            Error::parse(
+                self.path,
+                self.line,
+                field,
+                format!("`{}` is not {what}", self.cells[c]),
+            )
+        })
+    }
+
+    fn error(&self, field: &str, message: String) -> Error {
+        Error::parse(self.path, self.line, field, message)
+    }
+}
+
 fn parse_csv(
     path: &Path,
     text: &str,
@@ -213,83 +340,15 @@ fn parse_csv(
     let Some((_, header)) = lines.next() else {
         return Err(Error::parse(path, 1, "header", "the file is empty"));
     };
-    let names: Vec<&str> = header.split(',').map(str::trim).collect();
-    let col = |name: &str| names.iter().position(|n| *n == name);
-    let frame_col =
-        col("frame").ok_or_else(|| Error::parse(path, 1, "header", "no `frame` column"))?;
-    let time_col =
-        col("time").ok_or_else(|| Error::parse(path, 1, "header", "no `time` column"))?;
-    let z_cols: Vec<usize> = (0..).map_while(|i| col(&format!("z{i}"))).collect();
-    if z_cols.is_empty() {
-        return Err(Error::parse(
-            path,
-            1,
-            "header",
-            "no measurement columns `z0`, `z1`, ...",
-        ));
-    }
-    let pose_cols = match (col("sensor_x"), col("sensor_y"), col("sensor_heading")) {
-        (Some(a), Some(b), Some(c)) => Some([a, b, c]),
-        (None, None, None) => None,
-        _ => {
-            return Err(Error::parse(
-                path,
-                1,
-                "header",
-                "sensor pose needs all of sensor_x, sensor_y, sensor_heading",
-            ))
-        }
-    };
-    let id_col = col("id");
+    let columns = CsvColumns::parse(path, header)?;
     let mut frames: Vec<DetectionFrame> = Vec::new();
     let mut unlisted = 0usize;
     for (i, line) in lines {
-        let line_no = i + 1;
-        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
-        if cells.len() != names.len() {
-            return Err(Error::parse(
-                path,
-                line_no,
-                "line",
-                format!("{} fields, the header has {}", cells.len(), names.len()),
-            ));
-        }
-        let raw = |c: usize| -> Result<f64> {
-            cells[c].parse().map_err(|_| {
-                Error::parse(
-                    path,
-                    line_no,
-                    names[c],
-                    format!("`{}` is not a number", cells[c]),
-                )
-            })
-        };
-        let num = |c: usize| -> Result<f64> {
-            let v = raw(c)?;
-            if v.is_finite() {
-                Ok(v)
-            } else {
-                Err(Error::parse(
-                    path,
-                    line_no,
-                    names[c],
-                    format!("{v} is not finite"),
-                ))
-            }
-        };
-        let frame: usize = cells[frame_col].parse().map_err(|_| {
-            Error::parse(
-                path,
-                line_no,
-                "frame",
-                format!("`{}` is not a frame number", cells[frame_col]),
-            )
-        })?;
-        let time = num(time_col)?;
+        let row = CsvRow::split(path, i + 1, &columns.names, line)?;
+        let frame: usize = row.integer(columns.frame, "frame", "a frame number")?;
+        let time = row.num(columns.time)?;
         if frame < frames.len().saturating_sub(1) {
-            return Err(Error::parse(
-                path,
-                line_no,
+            return Err(row.error(
                 "frame",
                 format!("frame {frame} after frame {}", frames.len() - 1),
             ));
@@ -297,9 +356,7 @@ fn parse_csv(
         let gap = frame.saturating_sub(frames.len());
         unlisted = unlisted.saturating_add(gap);
         if unlisted > MAX_FRAME_GAP {
-            return Err(Error::parse(
-                path,
-                line_no,
+            return Err(row.error(
                 "frame",
                 format!(
                     "frame {frame} would leave {gap} empty frames before it, {unlisted} in the \
@@ -310,30 +367,30 @@ fn parse_csv(
         push_gap_frames(&mut frames, frame, time);
         let f = frames.last_mut().expect("just pushed");
         if f.time != time {
-            return Err(Error::parse(
-                path,
-                line_no,
+            return Err(row.error(
                 "time",
                 format!("{time} differs from {} earlier in frame {frame}", f.time),
             ));
         }
-        if let Some(pc) = pose_cols {
-            if pc.iter().all(|&c| !cells[c].is_empty()) {
-                f.sensor_pose = Some([num(pc[0])?, num(pc[1])?, num(pc[2])?]);
+        if let Some(pc) = columns.pose {
+            if pc.iter().all(|&c| !row.is_empty(c)) {
+                f.sensor_pose = Some([row.num(pc[0])?, row.num(pc[1])?, row.num(pc[2])?]);
             }
         }
-        if z_cols.iter().all(|&c| cells[c].is_empty()) {
+        if columns.z.iter().all(|&c| row.is_empty(c)) {
             continue;
         }
         let z = match policy {
-            NonFinite::Error => z_cols
+            NonFinite::Error => columns
+                .z
                 .iter()
-                .map(|&c| num(c))
+                .map(|&c| row.num(c))
                 .collect::<Result<Vec<f64>>>()?,
             NonFinite::Skip => {
-                let z = z_cols
+                let z = columns
+                    .z
                     .iter()
-                    .map(|&c| raw(c))
+                    .map(|&c| row.raw(c))
                     .collect::<Result<Vec<f64>>>()?;
                 if z.iter().any(|v| !v.is_finite()) {
                     *skipped += 1;
@@ -343,10 +400,8 @@ fn parse_csv(
             }
         };
         f.measurements.push(z);
-        if let Some(c) = id_col {
-            let id: u64 = cells[c].parse().map_err(|_| {
-                Error::parse(path, line_no, "id", format!("`{}` is not an id", cells[c]))
-            })?;
+        if let Some(c) = columns.id {
+            let id: u64 = row.integer(c, "id", "an id")?;
             f.ids.get_or_insert_with(Vec::new).push(id);
         }
     }
@@ -482,6 +537,36 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("frame 0 after frame 1"));
+        for (name, text, expected) in [
+            (
+                "e.csv",
+                "frame,time,z0\nx,0.0,1\n",
+                ["e.csv:2", "frame", "`x` is not a frame number"],
+            ),
+            (
+                "f.csv",
+                "frame,time,z0,id\n0,0.0,1,-3\n",
+                ["f.csv:2", "id", "`-3` is not an id"],
+            ),
+            (
+                "g.csv",
+                "frame,z0\n0,1\n",
+                ["g.csv:1", "header", "no `time` column"],
+            ),
+            (
+                "h.csv",
+                "frame,time,z0,sensor_x\n0,0.0,1,2\n",
+                ["h.csv:1", "header", "sensor_heading"],
+            ),
+            (
+                "i.csv",
+                "frame,time,z0\n0,0.0,1\n0,0.5,2\n",
+                ["i.csv:3", "time", "differs from 0"],
+            ),
+        ] {
+            let e = read_frames(&tmp(name, text)).unwrap_err().to_string();
+            assert!(expected.iter().all(|x| e.contains(x)), "{e}");
+        }
     }
 
     #[test]
