@@ -354,13 +354,15 @@ impl DriveTracker {
         self.road_users.retain(|l, _| live.contains(l));
     }
 
+    /// The frame's report: the filter's estimates split into walls and clusters, each matched
+    /// to this frame's detections and reported ([`Self::report_walls`],
+    /// [`Self::report_clusters`]).
     fn report(
         &mut self,
         estimates: &[Estimate],
         pose: &Isometry3<f64>,
         det: &FrameDetections,
     ) -> Result<(Vec<TrackedPlane>, Vec<TrackedCluster>)> {
-        let inv = pose.inverse();
         let mut planes: Vec<(&Estimate, [f64; 4])> = Vec::new();
         let mut clusters: Vec<(&Estimate, Point3<f64>)> = Vec::new();
         for e in estimates {
@@ -376,7 +378,22 @@ impl DriveTracker {
                 None => {}
             }
         }
-        // Greedy matching, cheapest pair first.
+        let out_planes = self.report_walls(&planes, pose, det);
+        let out_clusters = self.report_clusters(&clusters, pose, det)?;
+        Ok((out_planes, out_clusters))
+    }
+
+    /// The wall estimates (`(estimate, canonical β)`), each matched to at most one of the
+    /// frame's walls (greedy, cheapest pair first) and reported with the rectangle it
+    /// remembers: a matched wall's rectangle replaces it when it lies on the same stretch of
+    /// facade.
+    fn report_walls(
+        &mut self,
+        planes: &[(&Estimate, [f64; 4])],
+        pose: &Isometry3<f64>,
+        det: &FrameDetections,
+    ) -> Vec<TrackedPlane> {
+        let inv = pose.inverse();
         let mut plane_pairs: Vec<(f64, usize, usize)> = Vec::new();
         for (i, (_, beta)) in planes.iter().enumerate() {
             // The remembered rectangle in the sensor frame: of several segments of one plane,
@@ -395,18 +412,6 @@ impl DriveTracker {
             }
         }
         let plane_match = greedy(plane_pairs, planes.len(), det.walls.len());
-        let mut cluster_pairs: Vec<(f64, usize, usize)> = Vec::new();
-        for (i, (_, w)) in clusters.iter().enumerate() {
-            let s = inv * w;
-            for (j, c) in det.clusters.iter().enumerate() {
-                let d = (s - Point3::from(c.position())).norm();
-                if d <= MATCH_DISTANCE {
-                    cluster_pairs.push((d, i, j));
-                }
-            }
-        }
-        let cluster_match = greedy(cluster_pairs, clusters.len(), det.clusters.len());
-
         let mut out_planes = Vec::with_capacity(planes.len());
         for ((e, beta), m) in planes.iter().zip(plane_match) {
             let plane = Plane::new(Vector3::new(beta[0], beta[1], beta[2]), beta[3]).ok();
@@ -443,6 +448,32 @@ impl DriveTracker {
                 detection: m,
             });
         }
+        out_planes
+    }
+
+    /// The cluster estimates (`(estimate, world position)`), each matched to at most one of
+    /// the frame's clusters (nearest first): a matched one's road-user state takes in the
+    /// detection's shape, and the road users are reported (every confirmed cluster with
+    /// `all_clusters`). Static clutter that is not reported gets the particle cap of
+    /// `ClusterTuning::clutter_particles`.
+    fn report_clusters(
+        &mut self,
+        clusters: &[(&Estimate, Point3<f64>)],
+        pose: &Isometry3<f64>,
+        det: &FrameDetections,
+    ) -> Result<Vec<TrackedCluster>> {
+        let inv = pose.inverse();
+        let mut cluster_pairs: Vec<(f64, usize, usize)> = Vec::new();
+        for (i, (_, w)) in clusters.iter().enumerate() {
+            let s = inv * w;
+            for (j, c) in det.clusters.iter().enumerate() {
+                let d = (s - Point3::from(c.position())).norm();
+                if d <= MATCH_DISTANCE {
+                    cluster_pairs.push((d, i, j));
+                }
+            }
+        }
+        let cluster_match = greedy(cluster_pairs, clusters.len(), det.clusters.len());
         let ego_yaw = yaw_of(pose);
         let mut out_clusters = Vec::with_capacity(clusters.len());
         // Static clutter that is not reported is carried with fewer particles (see
@@ -534,7 +565,22 @@ impl DriveTracker {
                 road_user,
             });
         }
-        // A road user inside a more certain one's footprint is a fragment of it.
+        self.drop_fragments(&mut out_clusters);
+        self.reported = out_clusters
+            .iter()
+            .filter(|c| c.road_user)
+            .map(|c| c.label)
+            .collect();
+        if !self.all_clusters {
+            out_clusters.retain(|c| c.road_user);
+        }
+        self.filter.set_particle_caps(caps);
+        Ok(out_clusters)
+    }
+
+    /// A road user inside a more certain one's footprint is a fragment of it: it is no road
+    /// user ([`contained_in_others`]).
+    fn drop_fragments(&self, out_clusters: &mut [TrackedCluster]) {
         let users: Vec<usize> = (0..out_clusters.len())
             .filter(|&i| out_clusters[i].road_user && out_clusters[i].box_world.is_some())
             .collect();
@@ -554,16 +600,6 @@ impl DriveTracker {
                 out_clusters[i].road_user = false;
             }
         }
-        self.reported = out_clusters
-            .iter()
-            .filter(|c| c.road_user)
-            .map(|c| c.label)
-            .collect();
-        if !self.all_clusters {
-            out_clusters.retain(|c| c.road_user);
-        }
-        self.filter.set_particle_caps(caps);
-        Ok((out_planes, out_clusters))
     }
 }
 
