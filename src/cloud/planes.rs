@@ -223,20 +223,28 @@ pub fn extract_planes(
     }
     let (xs, ys, zs) = (cloud.xs(), cloud.ys(), cloud.zs());
     let (pts, orig) = finite_points(xs, ys, zs);
-    let mut out = PlaneSegmentation {
-        skipped: cloud.len() - pts.len(),
-        ..Default::default()
-    };
+    let extracted = sequential_rounds(&pts, config, rng);
+    let mut out = classify_planes(&pts, &orig, &extracted, config)?;
+    out.skipped = cloud.len() - pts.len();
+    Ok(out)
+}
 
+/// Whether `p` may be the ground: near-horizontal, its normal up and the sensor above it.
+fn ground_like(p: &Plane, config: &PlaneConfig) -> bool {
+    p.tilt() <= config.max_ground_tilt && p.normal.z > 0.0 && p.offset >= config.min_ground_depth
+}
+
+/// The sequential RANSAC rounds over the finite points `pts`: each round's plane and its
+/// local inlier indices, in extraction order. The first ground-like plane cuts the pool down
+/// to the points clearly above it; from then on the rounds look for walls only.
+fn sequential_rounds(
+    pts: &[[f32; 3]],
+    config: &PlaneConfig,
+    rng: &mut FilterRng,
+) -> Vec<(Plane, Vec<u32>)> {
     // Local indices (into `pts`) of the points still in the pool.
     let mut active: Vec<u32> = (0..pts.len() as u32).collect();
-    // Extracted planes: (final plane, local inlier indices).
     let mut extracted: Vec<(Plane, Vec<u32>)> = Vec::new();
-    let ground_like = |p: &Plane| {
-        p.tilt() <= config.max_ground_tilt
-            && p.normal.z > 0.0
-            && p.offset >= config.min_ground_depth
-    };
     let mut first_ground: Option<PlaneF32> = None;
     let mut grid: Option<BandGrid> = None;
     for _ in 0..config.max_planes {
@@ -253,11 +261,11 @@ pub fn extract_planes(
         } else {
             0.0
         };
-        let Some((plane, inliers)) = one_round(&pts, &active, min_tilt, config, rng, grid.as_ref())
+        let Some((plane, inliers)) = one_round(pts, &active, min_tilt, config, rng, grid.as_ref())
         else {
             break;
         };
-        if first_ground.is_none() && ground_like(&plane) {
+        if first_ground.is_none() && ground_like(&plane, config) {
             // The pool keeps what is clearly above the ground and not its inlier, in one pass
             // (the ground's inliers are most of the pool: one look-up each beats finding
             // them in it).
@@ -271,7 +279,7 @@ pub fn extract_planes(
                 .retain(|&i| !taken[i as usize] && g.residual_signed(&pts[i as usize]) > clearance);
             first_ground = Some(g);
             // The wall rounds' passes look for their points on a grid of this pool.
-            grid = Some(BandGrid::new(&pts, &active));
+            grid = Some(BandGrid::new(pts, &active));
         } else {
             remove_sorted(&mut active, &inliers);
             if let Some(g) = grid.as_mut() {
@@ -280,28 +288,32 @@ pub fn extract_planes(
         }
         extracted.push((plane, inliers));
     }
+    extracted
+}
 
-    // Ground: most inliers among near-horizontal planes below the sensor.
+/// What the extracted planes are: the ground (most inliers among the ground-like planes), the
+/// walls (the connected pieces of near-vertical planes that pass the size limits and the
+/// facade test) and the rejected rest with its reasons. `orig` maps the local indices of
+/// `pts` to the cloud's.
+fn classify_planes(
+    pts: &[[f32; 3]],
+    orig: &[u32],
+    extracted: &[(Plane, Vec<u32>)],
+    config: &PlaneConfig,
+) -> Result<PlaneSegmentation> {
+    let mut out = PlaneSegmentation::default();
     let ground_idx = extracted
         .iter()
         .enumerate()
-        .filter(|(_, (p, _))| ground_like(p))
+        .filter(|(_, (p, _))| ground_like(p, config))
         .max_by(|a, b| a.1 .1.len().cmp(&b.1 .1.len()).then(b.0.cmp(&a.0)))
         .map(|(i, _)| i);
-
     // The local vertical: the ground's normal when there is a ground, else the sensor's z.
     let up = ground_idx
         .map(|g| extracted[g].0.normal)
         .unwrap_or_else(nalgebra::Vector3::z);
     let ground_plane = ground_idx.map(|g| extracted[g].0);
     let mut assigned = vec![false; pts.len()];
-    let patch_of = |plane: &Plane, idx: &[u32]| -> Result<PlanePatch> {
-        PlanePatch::from_points(*plane, &hull_candidates(plane, idx, &pts))
-    };
-    let upright_patch_of = |plane: &Plane, idx: &[u32]| -> Result<PlanePatch> {
-        let points: Vec<_> = idx.iter().map(|&i| point64(pts[i as usize])).collect();
-        PlanePatch::upright_from_points(*plane, &points)
-    };
     let to_orig = |idx: &[u32]| -> Vec<u32> {
         let mut v: Vec<u32> = idx.iter().map(|&i| orig[i as usize]).collect();
         v.sort_unstable();
@@ -311,7 +323,7 @@ pub fn extract_planes(
     for (k, (plane, inliers)) in extracted.iter().enumerate() {
         if Some(k) == ground_idx {
             let patch = if config.ground_outline {
-                patch_of(plane, inliers)?
+                PlanePatch::from_points(*plane, &hull_candidates(plane, inliers, pts))?
             } else {
                 PlanePatch::from_points(*plane, &[point64(pts[inliers[0] as usize])])?
             };
@@ -321,12 +333,12 @@ pub fn extract_planes(
             out.ground = Some(PlaneDetection {
                 patch,
                 inliers: to_orig(inliers),
-                rms: rms(plane, inliers, &pts),
+                rms: rms(plane, inliers, pts),
             });
             continue;
         }
         if plane.tilt() <= config.max_ground_tilt {
-            let reason = if ground_like(plane) {
+            let reason = if ground_like(plane, config) {
                 RejectReason::SecondaryGround
             } else {
                 RejectReason::HorizontalNotGround
@@ -351,78 +363,26 @@ pub fn extract_planes(
         for piece in connected_pieces(
             plane,
             inliers,
-            &pts,
+            pts,
             config.grid_cell,
             config.min_cell_points,
         ) {
-            if piece.len() < config.min_points {
-                out.rejected.push(RejectedPlane {
-                    plane: *plane,
-                    patch: None,
-                    points: piece.len(),
-                    reason: RejectReason::TooFewPoints {
-                        points: piece.len(),
-                    },
-                });
-                continue;
-            }
-            let piece_plane = fit_chunked(&pts, &piece).unwrap_or(*plane);
-            let patch = upright_patch_of(&piece_plane, &piece)?;
-            let tilt = piece_plane.tilt();
-            let (length, height) = patch.extent;
-            if tilt < std::f64::consts::FRAC_PI_2 - config.max_wall_tilt {
-                out.rejected.push(RejectedPlane {
-                    plane: piece_plane,
-                    points: piece.len(),
-                    patch: Some(patch),
-                    reason: RejectReason::Oblique { tilt },
-                });
-            } else if patch.area < config.min_wall_area
-                || length < config.min_wall_length
-                || height < config.min_wall_height
-            {
-                out.rejected.push(RejectedPlane {
-                    plane: piece_plane,
-                    points: piece.len(),
-                    reason: RejectReason::TooSmall {
-                        area: patch.area,
-                        length,
-                        height,
-                    },
-                    patch: Some(patch),
-                });
-            } else {
-                let rms = rms(&piece_plane, &piece, &pts);
-                let top = patch
-                    .vertices
-                    .iter()
-                    .map(|v| v.z)
-                    .fold(f64::NEG_INFINITY, f64::max);
-                let lean = piece_plane.normal.dot(&up).abs().min(1.0).asin();
-                let fails = |q: &WallQuality| {
-                    top < q.min_top_above_sensor || rms > q.max_rms || lean > q.max_lean
-                };
-                if config.wall_quality.as_ref().is_some_and(fails) {
-                    out.rejected.push(RejectedPlane {
-                        plane: piece_plane,
-                        points: piece.len(),
-                        reason: RejectReason::NotBuildingScale { top, rms, lean },
-                        patch: Some(patch),
+            match judge_piece(plane, &piece, pts, config, &up)? {
+                Err(rejected) => out.rejected.push(rejected),
+                Ok((patch, rms)) => {
+                    for &i in &piece {
+                        assigned[i as usize] = true;
+                    }
+                    let patch = match ground_plane {
+                        Some(g) if config.walls_to_ground => patch.lowered_to(&g),
+                        _ => patch,
+                    };
+                    out.walls.push(PlaneDetection {
+                        rms,
+                        patch,
+                        inliers: to_orig(&piece),
                     });
-                    continue;
                 }
-                for &i in &piece {
-                    assigned[i as usize] = true;
-                }
-                let patch = match ground_plane {
-                    Some(g) if config.walls_to_ground => patch.lowered_to(&g),
-                    _ => patch,
-                };
-                out.walls.push(PlaneDetection {
-                    rms,
-                    patch,
-                    inliers: to_orig(&piece),
-                });
             }
         }
     }
@@ -431,6 +391,74 @@ pub fn extract_planes(
         .map(|i| orig[i])
         .collect();
     Ok(out)
+}
+
+/// One connected piece (local indices) of the near-vertical `plane`: a wall, as its upright
+/// rectangle and RMS, or why not (too few points, oblique once refitted, too small, or
+/// failing the facade test relative to the local vertical `up`).
+fn judge_piece(
+    plane: &Plane,
+    piece: &[u32],
+    pts: &[[f32; 3]],
+    config: &PlaneConfig,
+    up: &nalgebra::Vector3<f64>,
+) -> Result<std::result::Result<(PlanePatch, f64), RejectedPlane>> {
+    if piece.len() < config.min_points {
+        return Ok(Err(RejectedPlane {
+            plane: *plane,
+            patch: None,
+            points: piece.len(),
+            reason: RejectReason::TooFewPoints {
+                points: piece.len(),
+            },
+        }));
+    }
+    let piece_plane = fit_chunked(pts, piece).unwrap_or(*plane);
+    let points: Vec<_> = piece.iter().map(|&i| point64(pts[i as usize])).collect();
+    let patch = PlanePatch::upright_from_points(piece_plane, &points)?;
+    let tilt = piece_plane.tilt();
+    let (length, height) = patch.extent;
+    if tilt < std::f64::consts::FRAC_PI_2 - config.max_wall_tilt {
+        return Ok(Err(RejectedPlane {
+            plane: piece_plane,
+            points: piece.len(),
+            patch: Some(patch),
+            reason: RejectReason::Oblique { tilt },
+        }));
+    }
+    if patch.area < config.min_wall_area
+        || length < config.min_wall_length
+        || height < config.min_wall_height
+    {
+        return Ok(Err(RejectedPlane {
+            plane: piece_plane,
+            points: piece.len(),
+            reason: RejectReason::TooSmall {
+                area: patch.area,
+                length,
+                height,
+            },
+            patch: Some(patch),
+        }));
+    }
+    let rms = rms(&piece_plane, piece, pts);
+    let top = patch
+        .vertices
+        .iter()
+        .map(|v| v.z)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let lean = piece_plane.normal.dot(up).abs().min(1.0).asin();
+    let fails =
+        |q: &WallQuality| top < q.min_top_above_sensor || rms > q.max_rms || lean > q.max_lean;
+    if config.wall_quality.as_ref().is_some_and(fails) {
+        return Ok(Err(RejectedPlane {
+            plane: piece_plane,
+            points: piece.len(),
+            reason: RejectReason::NotBuildingScale { top, rms, lean },
+            patch: Some(patch),
+        }));
+    }
+    Ok(Ok((patch, rms)))
 }
 
 #[cfg(test)]
