@@ -65,6 +65,11 @@ pub struct Args {
     /// the drawn triple (overrides the settings; default 2, at most 100).
     #[arg(long, value_name = "N")]
     wall_refits: Option<usize>,
+    /// Keep every building-scale vertical piece as a wall: the facade test (top above the
+    /// sensor, RMS, plumb) is off, whatever the settings say. Shows what the test rejects:
+    /// vegetation, hedges, car sides.
+    #[arg(long)]
+    any_vertical: bool,
 }
 
 /// Source of the ego motion.
@@ -119,6 +124,9 @@ pub fn run(args: Args) -> Result<()> {
     };
     if let Some(n) = args.wall_refits {
         planes.wall_refits = n;
+    }
+    if args.any_vertical {
+        planes.wall_quality = None;
     }
     let config = PlanePredictionConfig {
         planes,

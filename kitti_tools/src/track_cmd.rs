@@ -75,6 +75,11 @@ pub struct Args {
     /// the drawn triple (overrides the config's `planes.wall_refits`; default 2, at most 100).
     #[arg(long, value_name = "N")]
     wall_refits: Option<usize>,
+    /// Keep every building-scale vertical piece as a wall: the facade test (top above the
+    /// sensor, RMS, plumb) is off, whatever the settings say. Shows what the test rejects:
+    /// vegetation, hedges, car sides.
+    #[arg(long)]
+    any_vertical: bool,
     /// Move walls by a per-particle draw of the vehicle model instead of the measured poses.
     #[arg(long)]
     ect: bool,
@@ -155,6 +160,9 @@ pub fn run(args: Args) -> Result<()> {
     config.all_clusters = args.all_clusters;
     if let Some(n) = args.wall_refits {
         config.planes.wall_refits = n;
+    }
+    if args.any_vertical {
+        config.planes.wall_quality = None;
     }
     let baseline = std::cell::RefCell::new(BaselineBoxes::new());
     let frames = args.frames.as_deref().map(parse_range).transpose()?;

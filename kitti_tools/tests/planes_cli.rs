@@ -229,3 +229,22 @@ fn segmentation_settings_come_from_a_file_and_a_flag() {
     assert!(!refused.status.success());
     assert!(String::from_utf8_lossy(&refused.stderr).contains("wall_refits"));
 }
+
+/// The four shared scans hold no facade: the default keeps no wall there, `--any-vertical`
+/// keeps their vertical pieces (vegetation) and pairs them from scan to scan.
+#[test]
+fn any_vertical_keeps_what_the_facade_test_rejects() {
+    let Some(drive) = shared_data("kitti_raw/2011_09_26/2011_09_26_drive_UNKNOWN_sync") else {
+        return;
+    };
+    let d = drive.to_str().unwrap();
+    let pairs = |extra: &[&str]| -> u64 {
+        let mut args = vec!["planes", "--drive", d, "--all", "--runs", "1", "--json"];
+        args.extend_from_slice(extra);
+        let text = ok(&run(&args));
+        let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+        json["summary"]["pairs"].as_u64().unwrap()
+    };
+    assert_eq!(pairs(&[]), 0);
+    assert!(pairs(&["--any-vertical"]) >= 3);
+}
