@@ -285,14 +285,7 @@ impl<'a> CsvRow<'a> {
 
     /// The number in column `c`, whatever its value.
     fn raw(&self, c: usize) -> Result<f64> {
-        self.cells[c].parse().map_err(|_| {
-            Error::parse(
-                self.path,
-                self.line,
-                self.names[c],
-                format!("`{}` is not a number", self.cells[c]),
-            )
-        })
+        self.parsed(c, "a number")
     }
 
     /// The finite number in column `c`.
@@ -301,25 +294,16 @@ impl<'a> CsvRow<'a> {
         if v.is_finite() {
             Ok(v)
         } else {
-            Err(Error::parse(
-                self.path,
-                self.line,
-                self.names[c],
-                format!("{v} is not finite"),
-            ))
+            Err(self.error(self.names[c], format!("{v} is not finite")))
         }
     }
 
-    /// The non-negative integer in column `c`, called `what` (a frame number, an id).
-    fn integer<T: std::str::FromStr>(&self, c: usize, field: &str, what: &str) -> Result<T> {
-        self.cells[c].parse().map_err(|_| {
-            Error::parse(
-                self.path,
-                self.line,
-                field,
-                format!("`{}` is not {what}", self.cells[c]),
-            )
-        })
+    /// Column `c` parsed as a `T`; an error says the cell is not `what` (a number, a frame
+    /// number, an id) and names the column.
+    fn parsed<T: std::str::FromStr>(&self, c: usize, what: &str) -> Result<T> {
+        self.cells[c]
+            .parse()
+            .map_err(|_| self.error(self.names[c], format!("`{}` is not {what}", self.cells[c])))
     }
 
     fn error(&self, field: &str, message: String) -> Error {
@@ -345,7 +329,7 @@ fn parse_csv(
     let mut unlisted = 0usize;
     for (i, line) in lines {
         let row = CsvRow::split(path, i + 1, &columns.names, line)?;
-        let frame: usize = row.integer(columns.frame, "frame", "a frame number")?;
+        let frame: usize = row.parsed(columns.frame, "a frame number")?;
         let time = row.num(columns.time)?;
         if frame < frames.len().saturating_sub(1) {
             return Err(row.error(
@@ -401,7 +385,7 @@ fn parse_csv(
         };
         f.measurements.push(z);
         if let Some(c) = columns.id {
-            let id: u64 = row.integer(c, "id", "an id")?;
+            let id: u64 = row.parsed(c, "an id")?;
             f.ids.get_or_insert_with(Vec::new).push(id);
         }
     }
