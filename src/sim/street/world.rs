@@ -242,7 +242,7 @@ fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
 }
 
 /// A draw uniform in `[range[0], range[1])`, or `range[0]` for an empty range.
-pub(super) fn uniform(rng: &mut FilterRng, range: [f64; 2]) -> f64 {
+fn uniform(rng: &mut FilterRng, range: [f64; 2]) -> f64 {
     if range[1] > range[0] {
         rng.random_range(range[0]..range[1])
     } else {
@@ -431,10 +431,7 @@ fn place_clutter(
             let s = rng.random_range(lo..hi);
             let lateral = side * lateral_abs;
             let centre = seg.at(s, lateral);
-            let near_path = ego
-                .iter()
-                .any(|e| (e[0] - centre[0]).hypot(e[1] - centre[1]) <= traffic.spawn_radius);
-            if !near_path {
+            if !ego.iter().any(|e| dist(*e, centre) <= traffic.spawn_radius) {
                 continue;
             }
             let crowded = out.iter().any(|(k, other_s, other_lateral, o)| {
