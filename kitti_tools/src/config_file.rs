@@ -37,14 +37,15 @@ pub fn read_checked<T: DeserializeOwned>(
 }
 
 /// Reads `path` over `base`: the fields the file sets replace `base`'s (tables field by field),
-/// the others keep `base`'s values. The file is first read as a `T` of its own, so that a
-/// misspelt field or a bad value is reported with its file and line.
+/// the others keep `base`'s values. The file's text is first parsed as a `T` of its own, so that
+/// a misspelt field or a bad value is reported with its file and line.
 pub fn read_config_over<T: DeserializeOwned + serde::Serialize>(
     path: &Path,
     base: &T,
 ) -> Result<T> {
-    read_config::<T>(path)?;
-    let file: serde_json::Value = read_config(path)?;
+    let text = read_text(path)?;
+    parse_config::<T>(path, &text)?;
+    let file: serde_json::Value = parse_config(path, &text)?;
     let mut merged = serde_json::to_value(base).context("configuration as a table")?;
     overlay(&mut merged, file);
     serde_json::from_value(merged).with_context(|| format!("{}", path.display()))
@@ -69,19 +70,27 @@ fn overlay(base: &mut serde_json::Value, top: serde_json::Value) {
 
 /// Reads `path` as TOML (`.toml`) or JSON (`.json`) into `T`.
 pub fn read_config<T: DeserializeOwned>(path: &Path) -> Result<T> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    parse_config(path, &read_text(path)?)
+}
+
+fn read_text(path: &Path) -> Result<String> {
+    std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))
+}
+
+/// Parses `text`, the contents of `path`, as TOML or JSON by `path`'s extension; errors name
+/// the file and line.
+fn parse_config<T: DeserializeOwned>(path: &Path, text: &str) -> Result<T> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
     match ext.as_str() {
-        "toml" => toml::from_str(&text).map_err(|e| {
-            let line = e.span().map(|s| line_of(&text, s.start)).unwrap_or(0);
+        "toml" => toml::from_str(text).map_err(|e| {
+            let line = e.span().map(|s| line_of(text, s.start)).unwrap_or(0);
             anyhow::anyhow!("{}:{line}: {}", path.display(), e.message())
         }),
-        "json" => serde_json::from_str(&text)
+        "json" => serde_json::from_str(text)
             .map_err(|e| anyhow::anyhow!("{}:{}: {e}", path.display(), e.line())),
         other => bail!(
             "{}: unknown config extension `{other}` (expected .toml or .json)",
