@@ -236,6 +236,7 @@ fn walls_again(
     poses: &[nalgebra::Isometry3<f64>],
     min_area: f64,
 ) -> Vec<(f64, Option<(f64, f64)>)> {
+    use smc_lmb::models::plane::plane_residual;
     let segs: Vec<PlaneSegmentation> = clouds
         .iter()
         .map(|c| extract_planes(c, &PlaneConfig::default(), &mut seeded(1)).expect("segment"))
@@ -250,16 +251,10 @@ fn walls_again(
                 .walls
                 .iter()
                 .map(|v| {
-                    let p = &v.patch.plane;
-                    // The same plane may come out with the opposite normal.
-                    let same = moved.normal.dot(&p.normal) >= 0.0;
-                    let (n, d) = if same {
-                        (p.normal, p.offset)
-                    } else {
-                        (-p.normal, -p.offset)
-                    };
-                    let angle = moved.normal.dot(&n).clamp(-1.0, 1.0).acos().to_degrees();
-                    (angle, (moved.offset - d).abs())
+                    // Normals aligned first: the same plane may come out with the other sign.
+                    let (angle, dd) =
+                        plane_residual(&moved.as_vector(), &v.patch.plane.as_vector());
+                    (angle.to_degrees(), dd.abs())
                 })
                 .min_by(|a, b| (a.0 + 5.0 * a.1).total_cmp(&(b.0 + 5.0 * b.1)));
             out.push((w.patch.area, best));
