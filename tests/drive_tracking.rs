@@ -291,6 +291,109 @@ fn overlapped_frames_track_as_a_plain_loop_does() {
     assert!(run.frames.iter().any(|f| !f.clusters.is_empty()));
 }
 
+/// A drive whose scans 4 and 5 were dropped (KITTI keeps their OXTS packets and leaves their
+/// time stamp lines blank, as in drive 0009): the run leaves those frames out and tracks as a
+/// plain loop that steps the tracker on the other frames, over the longer step.
+#[test]
+fn dropped_scans_are_left_out_and_predicted_over() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = synthetic_drive(tmp.path());
+    let full_times = RawDrive::open(&dir).unwrap().timestamps().unwrap().seconds;
+    for k in [4, 5] {
+        std::fs::remove_file(dir.join(format!("velodyne_points/data/{k:010}.bin"))).unwrap();
+    }
+    let stamps = dir.join("velodyne_points/timestamps.txt");
+    let text = std::fs::read_to_string(&stamps).unwrap();
+    let blanked: String = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i == 4 || i == 5 {
+                "\n".to_string()
+            } else {
+                format!("{l}\n")
+            }
+        })
+        .collect();
+    std::fs::write(&stamps, &blanked).unwrap();
+    let drive = RawDrive::open(&dir).unwrap();
+    assert_eq!(
+        (drive.frame_count(), drive.velodyne_count()),
+        (FRAMES, FRAMES - 2)
+    );
+    assert_eq!(drive.dropped_scans(), vec![(4, 5)]);
+    assert_eq!(
+        drive.check(),
+        vec![smc_lmb::kitti::Issue::DroppedScans {
+            folder: drive.velodyne_dir(),
+            first: 4,
+            last: 5
+        }]
+    );
+    let times = drive.timestamps().unwrap().seconds;
+    assert_eq!(times[6], full_times[6]);
+    // The blank lines' stamps lie evenly between their neighbours' (here the drive's own).
+    assert!(
+        (times[4] - full_times[4]).abs() < 1e-6,
+        "{} {}",
+        times[4],
+        full_times[4]
+    );
+
+    let c = config();
+    let seed = 4;
+    let run = track_drive(&drive, None, &c, seed, |_| Ok(())).unwrap();
+    let kept: Vec<usize> = (0..FRAMES).filter(|k| ![4, 5].contains(k)).collect();
+    let numbers: Vec<usize> = run.frames.iter().map(|f| f.frame).collect();
+    assert_eq!(numbers, kept);
+    let poses = drive.poses().unwrap();
+    let mut tracker = DriveTracker::new(&c, seed).unwrap();
+    for (got, &k) in run.frames.iter().zip(&kept) {
+        let cloud = drive.velodyne(k).unwrap();
+        let det = detect_objects(&cloud, &c, &mut segment_rng(seed, k)).unwrap();
+        let mut want = tracker.step(k, times[k], poses[k], None, &det).unwrap();
+        let mut got = got.clone();
+        want.times = Default::default();
+        got.times = Default::default();
+        assert_eq!(got, want, "frame {k}");
+    }
+    // The moving box keeps its label over the 0.3 s from frame 3 to frame 6.
+    let box_label = |f: &smc_lmb::pipeline::drive_tracking::TrackedFrame, k: usize| {
+        let c = box_centre(k);
+        f.clusters
+            .iter()
+            .find(|t| {
+                let p = t.position_world;
+                (p[0] - c[0]).hypot(p[1] - c[1]) < 1.0
+            })
+            .map(|t| t.label)
+    };
+    let (before, after) = (box_label(&run.frames[3], 3), box_label(&run.frames[4], 6));
+    assert!(before.is_some() && before == after, "{before:?} {after:?}");
+
+    // A blank stamp where there is a scan: the file and line.
+    let wrong: String = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i == 2 || i == 4 || i == 5 {
+                "\n".to_string()
+            } else {
+                format!("{l}\n")
+            }
+        })
+        .collect();
+    std::fs::write(&stamps, wrong).unwrap();
+    let drive = RawDrive::open(&dir).unwrap();
+    let err = track_drive(&drive, None, &c, seed, |_| Ok(()))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("timestamps.txt:3: timestamp: blank, but frame 2 has a scan"),
+        "{err}"
+    );
+}
+
 #[test]
 fn bad_drives_give_clear_errors() {
     let tmp = tempfile::tempdir().unwrap();

@@ -206,7 +206,7 @@ fn broken_sequences_fail_naming_file_and_line() {
     std::fs::write(&oxts, two).unwrap();
     assert_error(
         seq.imu_poses().unwrap_err(),
-        &["oxts/0000.txt:3: packet: missing: 2 packets for the 3 scans"],
+        &["oxts/0000.txt:3: packet: missing: 2 packets for the 3 frames the scans in"],
     );
     assert_eq!(seq.oxts_count(), 2);
     assert!(seq.check().iter().any(
@@ -216,7 +216,7 @@ fn broken_sequences_fail_naming_file_and_line() {
     std::fs::write(&oxts, &full).unwrap();
     assert_error(
         seq.poses().unwrap_err(),
-        &["oxts/0000.txt:4: packet: 50 packets for the 3 scans"],
+        &["oxts/0000.txt:4: packet: 50 packets for the 3 frames the scans in"],
     );
 
     // Calibration without Tr_imu_velo.
@@ -250,7 +250,7 @@ fn broken_sequences_fail_naming_file_and_line() {
         &[
             "label_02/0000.txt:",
             "frame: label of frame 3 but",
-            "holds 3 scans",
+            "span 3 frames",
         ],
     );
     let first_beyond = std::fs::read_to_string(seq.labels_path())

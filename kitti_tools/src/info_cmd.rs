@@ -3,8 +3,10 @@
 //! issues.
 //!
 //! Severity of issues: a missing sensor folder or missing file only limits what can be done
-//! with the drive and is a warning; everything else (numbering gaps, counts that disagree, time
-//! that does not increase, unreadable files) is an error and makes the command exit non-zero.
+//! with the drive and is a warning, and so are scans dropped inside the numbering (KITTI's
+//! drive 0009 = tracking sequence 0001 lacks four); everything else (other numbering gaps,
+//! counts that disagree, time that does not increase, unreadable files) is an error and makes
+//! the command exit non-zero.
 
 use anyhow::{bail, Result};
 use nalgebra::Isometry3;
@@ -80,7 +82,7 @@ struct Report {
 fn is_error(issue: &Issue) -> bool {
     !matches!(
         issue,
-        Issue::MissingFolder { .. } | Issue::MissingFile { .. }
+        Issue::MissingFolder { .. } | Issue::MissingFile { .. } | Issue::DroppedScans { .. }
     )
 }
 

@@ -337,3 +337,153 @@ fn track_writes_kitti_results_of_the_lmb_and_the_baseline_which_eval_scores() {
     ]);
     assert!(!out.status.success());
 }
+
+/// KITTI drops a scan now and then (tracking sequence 0001 has none for frames 177–180, its
+/// raw drive 0009 keeps their OXTS packets and a blank time stamp line): such frames are left
+/// out, the filter predicts over them, and their labels count as missed.
+#[test]
+fn dropped_scans_are_predicted_over_and_their_labels_missed() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path().join("training");
+    synth(&root, 12, 1);
+    for k in [5, 6] {
+        std::fs::remove_file(root.join(format!("velodyne/0001/{k:06}.bin"))).unwrap();
+    }
+    let r = root.to_str().unwrap();
+    let info = ok(&common::output(&[
+        "info",
+        "--tracking",
+        r,
+        "--sequence",
+        "1",
+        "--json",
+    ]));
+    let report: serde_json::Value = serde_json::from_str(&info).unwrap();
+    assert_eq!(report["velodyne_frames"], 10, "{info}");
+    assert_eq!(report["oxts_packets"], 12, "{info}");
+    assert_eq!(report["errors"], 0, "{info}");
+    let issues = report["issues"].as_array().unwrap();
+    assert_eq!(issues.len(), 1, "{info}");
+    assert_eq!(issues[0]["severity"], "warning", "{info}");
+    assert!(
+        issues[0]["message"]
+            .as_str()
+            .unwrap()
+            .contains("frames 5..=6 have no scan"),
+        "{info}"
+    );
+
+    let (json, results) = (dir.path().join("t.json"), dir.path().join("lmb"));
+    let text = ok(&common::output(&[
+        "track",
+        "--tracking",
+        r,
+        "--sequence",
+        "1",
+        "--particles",
+        "200",
+        "--out",
+        json.to_str().unwrap(),
+        "--kitti-out",
+        results.to_str().unwrap(),
+        "--quiet",
+    ]));
+    assert!(text.contains("tracking_0001: 10 frames"), "{text}");
+    let tracks: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let frames = tracks["frames"].as_array().unwrap();
+    let numbers: Vec<u64> = frames
+        .iter()
+        .map(|f| f["frame"].as_u64().unwrap())
+        .collect();
+    assert_eq!(numbers, [0, 1, 2, 3, 4, 7, 8, 9, 10, 11]);
+    // The clusters confirmed before the gap are still there after it, under their labels:
+    // the filter predicted over the 0.3 s from frame 4 to frame 7.
+    let labels = |f: &serde_json::Value| -> std::collections::BTreeSet<String> {
+        f["clusters"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c["label"].to_string())
+            .collect()
+    };
+    let (before, after) = (labels(&frames[4]), labels(&frames[5]));
+    let kept = before.intersection(&after).count();
+    assert!(
+        !before.is_empty() && kept * 4 >= before.len() * 3,
+        "{kept} of {} labels of frame 4 in frame 7",
+        before.len()
+    );
+    let lines = std::fs::read_to_string(results.join("0001.txt")).unwrap();
+    let result_frames: std::collections::BTreeSet<u64> = lines
+        .lines()
+        .map(|l| l.split_whitespace().next().unwrap().parse().unwrap())
+        .collect();
+    assert!(!result_frames.contains(&5) && !result_frames.contains(&6));
+    assert!(result_frames.contains(&4) && result_frames.contains(&7));
+    let scores = ok(&common::output(&[
+        "eval",
+        "--tracking",
+        r,
+        "--sequence",
+        "1",
+        "--results",
+        results.to_str().unwrap(),
+    ]));
+    assert!(scores.contains("HOTA"), "{scores}");
+
+    // Wall pairs need both scans: 11 consecutive pairs, 3 of them touch the gap.
+    let planes = ok(&common::output(&[
+        "planes",
+        "--tracking",
+        r,
+        "--sequence",
+        "1",
+        "--all",
+        "--runs",
+        "1",
+        "--json",
+    ]));
+    let planes: serde_json::Value = serde_json::from_str(&planes).unwrap();
+    let pair_frames: std::collections::BTreeSet<u64> = planes["pairs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["frame"].as_u64().unwrap())
+        .collect();
+    assert!(
+        !pair_frames.is_empty() && pair_frames.iter().all(|f| ![5, 6, 7].contains(f)),
+        "{pair_frames:?}"
+    );
+    let lone = common::output(&[
+        "planes",
+        "--tracking",
+        r,
+        "--sequence",
+        "1",
+        "--frame",
+        "5",
+        "--runs",
+        "1",
+    ]);
+    assert!(!lone.status.success());
+    let err = String::from_utf8_lossy(&lone.stderr);
+    assert!(err.contains("dropped scans"), "{err}");
+
+    // Scans that end before the OXTS packets do are no dropped scans: an error naming the
+    // OXTS file's line.
+    std::fs::remove_file(root.join("velodyne/0001/000011.bin")).unwrap();
+    let out = common::output(&[
+        "track",
+        "--tracking",
+        r,
+        "--sequence",
+        "1",
+        "--out",
+        json.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("oxts/0001.txt:12"), "{err}");
+}

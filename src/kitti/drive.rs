@@ -156,14 +156,27 @@ impl RawDrive {
         self.oxts.as_ref().map_or(0, Vec::len)
     }
 
-    /// Number of frames: the Velodyne frames when `velodyne_points/data` exists, otherwise the
-    /// OXTS packets.
+    /// Number of frames: the frames the Velodyne scans span when `velodyne_points/data` exists
+    /// (the last scan's number + 1, dropped scans inside the numbering included; see
+    /// [`has_scan`](Self::has_scan)), otherwise the OXTS packets.
     pub fn frame_count(&self) -> usize {
         if self.has_velodyne() {
-            self.velodyne_count()
+            self.velodyne.extent()
         } else {
             self.oxts_count()
         }
+    }
+
+    /// Whether frame `k` has a Velodyne scan. KITTI drops a scan now and then (drive 0009 has
+    /// none for frames 177–180) and keeps the other files' numbers, its OXTS packet and a
+    /// blank line in `velodyne_points/timestamps.txt`.
+    pub fn has_scan(&self, k: usize) -> bool {
+        self.velodyne.has_scan(k)
+    }
+
+    /// The frames below [`frame_count`](Self::frame_count) without a scan, as inclusive ranges.
+    pub fn dropped_scans(&self) -> Vec<(u64, u64)> {
+        self.velodyne.dropped()
     }
 
     /// Path of Velodyne frame `k`: the listed `.bin` or `.pcd` file, else (whether or not it
@@ -224,14 +237,15 @@ impl RawDrive {
         read_cam_to_cam(self.date_dir.join(CALIB_CAM_TO_CAM))
     }
 
-    /// Fails when the drive has Velodyne frames and their number differs from the OXTS count.
+    /// Fails when the drive has Velodyne frames and the frames they span differ from the OXTS
+    /// count (a dropped scan inside the numbering still has its packet).
     fn ensure_counts_agree(&self, n_oxts: usize) -> Result<()> {
-        if self.has_velodyne() && self.velodyne_count() != n_oxts {
+        if self.has_velodyne() && self.frame_count() != n_oxts {
             return Err(Issue::CountMismatch {
                 a: self.oxts_dir(),
                 a_count: n_oxts,
                 b: self.velodyne_dir(),
-                b_count: self.velodyne_count(),
+                b_count: self.frame_count(),
             }
             .to_error());
         }
@@ -274,21 +288,21 @@ impl RawDrive {
         let sensors = [
             (
                 "no point clouds",
-                self.velodyne.files(),
+                self.velodyne.files().map(|f| (f, self.velodyne.extent())),
                 self.velodyne_dir(),
                 self.velodyne_timestamps_path(),
                 "Velodyne frames have no time stamps",
             ),
             (
                 "no OXTS packets, so no poses (point clouds only)",
-                self.oxts.as_deref(),
+                self.oxts.as_deref().map(|f| (f, f.len())),
                 self.oxts_dir(),
                 self.oxts_timestamps_path(),
                 "OXTS packets have no time stamps",
             ),
         ];
         for (missing_consequence, files, dir, stamps_path, stamps_consequence) in sensors {
-            let Some(files) = files else {
+            let Some((files, frames)) = files else {
                 issues.push(Issue::MissingFolder {
                     path: dir,
                     consequence: missing_consequence.to_string(),
@@ -296,10 +310,18 @@ impl RawDrive {
                 continue;
             };
             for (first, last) in numbering_gaps(files.iter().map(|f| f.0)) {
-                issues.push(Issue::NumberingGap {
-                    folder: dir.clone(),
-                    first_missing: first,
-                    last_missing: last,
+                issues.push(if dir == self.velodyne_dir() {
+                    Issue::DroppedScans {
+                        folder: dir.clone(),
+                        first,
+                        last,
+                    }
+                } else {
+                    Issue::NumberingGap {
+                        folder: dir.clone(),
+                        first_missing: first,
+                        last_missing: last,
+                    }
                 });
             }
             if !stamps_path.exists() {
@@ -315,12 +337,22 @@ impl RawDrive {
                     error: e.to_string(),
                 }),
                 Ok(stamps) => {
-                    if stamps.len() != files.len() {
+                    if stamps.len() != frames {
                         issues.push(Issue::CountMismatch {
                             a: dir.clone(),
-                            a_count: files.len(),
+                            a_count: frames,
                             b: stamps_path.clone(),
                             b_count: stamps.len(),
+                        });
+                    }
+                    if let Some(&i) = stamps
+                        .blank
+                        .iter()
+                        .find(|&&i| files.binary_search_by_key(&(i as u64), |f| f.0).is_ok())
+                    {
+                        issues.push(Issue::Unreadable {
+                            path: stamps_path.clone(),
+                            error: format!("line {} is blank, but frame {i} has a file", i + 1),
                         });
                     }
                     if let Some(i) = stamps.first_non_increasing() {
@@ -332,11 +364,11 @@ impl RawDrive {
                 }
             }
         }
-        if let (Some(v), Some(o)) = (self.velodyne.files(), &self.oxts) {
-            if v.len() != o.len() {
+        if let (true, Some(o)) = (self.has_velodyne(), &self.oxts) {
+            if self.frame_count() != o.len() {
                 issues.push(Issue::CountMismatch {
                     a: self.velodyne_dir(),
-                    a_count: v.len(),
+                    a_count: self.frame_count(),
                     b: self.oxts_dir(),
                     b_count: o.len(),
                 });

@@ -109,6 +109,28 @@ impl ScanFolder {
         self.files.as_ref().map_or(0, Vec::len)
     }
 
+    /// Number of frames the scans span: the last scan's number + 1 (0 without scans). It
+    /// exceeds [`count`](Self::count) when scans were dropped inside the numbering.
+    pub(crate) fn extent(&self) -> usize {
+        self.files
+            .as_deref()
+            .and_then(<[_]>::last)
+            .map_or(0, |(n, _)| *n as usize + 1)
+    }
+
+    /// Whether frame `k` has a listed scan.
+    pub(crate) fn has_scan(&self, k: usize) -> bool {
+        self.files
+            .as_deref()
+            .is_some_and(|f| listed_path(f, k as u64).is_some())
+    }
+
+    /// The frames below [`extent`](Self::extent) without a scan (dropped scans), as inclusive
+    /// ranges.
+    pub(crate) fn dropped(&self) -> Vec<(u64, u64)> {
+        numbering_gaps(self.files.iter().flatten().map(|f| f.0))
+    }
+
     /// Path of scan `k`.
     pub(crate) fn path(&self, k: usize) -> PathBuf {
         self.files

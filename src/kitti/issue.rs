@@ -37,6 +37,18 @@ pub enum Issue {
         /// Last missing frame number of this gap.
         last_missing: u64,
     },
+    /// Frames inside a scan folder's numbering without a scan: KITTI drops a scan now and then
+    /// and keeps the other files' numbers. Tracking leaves such frames out and predicts over
+    /// them; frame pairs with one of them are not compared. Not an inconsistency of the
+    /// recording, but what it lacks.
+    DroppedScans {
+        /// The scan folder.
+        folder: PathBuf,
+        /// First frame without a scan.
+        first: u64,
+        /// Last frame without a scan of this run.
+        last: u64,
+    },
     /// Two sources that should have one entry per frame disagree.
     CountMismatch {
         /// First source (folder or file).
@@ -72,7 +84,7 @@ impl Issue {
             | Issue::MissingFile { path, .. }
             | Issue::NonIncreasingTime { path, .. }
             | Issue::Unreadable { path, .. } => path,
-            Issue::NumberingGap { folder, .. } => folder,
+            Issue::NumberingGap { folder, .. } | Issue::DroppedScans { folder, .. } => folder,
             Issue::CountMismatch { a, .. } => a,
         }
     }
@@ -87,6 +99,7 @@ impl Issue {
             Issue::MissingFolder { .. } => "folder",
             Issue::MissingFile { .. } => "file",
             Issue::NumberingGap { .. } => "frame numbering",
+            Issue::DroppedScans { .. } => "scans",
             Issue::CountMismatch { .. } => "frame count",
             Issue::NonIncreasingTime { .. } => "timestamp",
             Issue::Unreadable { .. } => "content",
@@ -108,6 +121,14 @@ impl Issue {
                 last_missing,
                 ..
             } => format!("frames {first_missing}..={last_missing} are missing"),
+            Issue::DroppedScans { first, last, .. } if first == last => {
+                format!("frame {first} has no scan (dropped); tracking predicts over it")
+            }
+            Issue::DroppedScans { first, last, .. } => {
+                format!(
+                    "frames {first}..={last} have no scan (dropped); tracking predicts over them"
+                )
+            }
             Issue::CountMismatch {
                 a_count,
                 b,

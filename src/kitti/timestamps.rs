@@ -6,7 +6,7 @@
 //! The clock is taken as UTC without leap seconds (as the KITTI files are plain wall-clock
 //! stamps). Not for: time zones or time-of-week GPS time.
 
-use super::text::{numbered_lines, read_text};
+use super::text::read_text;
 use crate::atomic::write_atomically;
 use crate::error::{Error, Result};
 use std::fmt;
@@ -220,10 +220,14 @@ impl fmt::Display for Timestamp {
 /// The content of one timestamp file.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Timestamps {
-    /// The stamps as written, one per frame.
+    /// The stamps, one per frame: as written, or interpolated for a blank line (see `blank`).
     pub absolute: Vec<Timestamp>,
     /// Seconds since the first stamp (so `seconds[0] == 0`), one per frame.
     pub seconds: Vec<f64>,
+    /// Frames whose line is blank, ascending. KITTI leaves the line of a dropped frame empty
+    /// (drive 2011_09_26_drive_0009's Velodyne scans 177–180); its stamp is interpolated
+    /// between the nearest written ones before and after it.
+    pub blank: Vec<usize>,
 }
 
 impl Timestamps {
@@ -233,7 +237,11 @@ impl Timestamps {
             None => Vec::new(),
             Some(first) => absolute.iter().map(|t| t.seconds_since(first)).collect(),
         };
-        Timestamps { absolute, seconds }
+        Timestamps {
+            absolute,
+            seconds,
+            blank: Vec::new(),
+        }
     }
 
     /// Number of stamps.
@@ -260,17 +268,73 @@ impl Timestamps {
     }
 }
 
-/// Reads a timestamp file. Blank lines are skipped; a malformed line is an [`Error::Parse`]
-/// naming the file, its line and what was wrong.
+/// Fills each blank entry (`None`) by linear interpolation, in integer nanoseconds, between
+/// the written stamps before and after it. `stamps` starts and ends with a written stamp.
+fn interpolate_blanks(stamps: &[Option<Timestamp>]) -> Vec<Timestamp> {
+    let mut out: Vec<Timestamp> = Vec::with_capacity(stamps.len());
+    let mut i = 0;
+    while i < stamps.len() {
+        match stamps[i] {
+            Some(t) => {
+                out.push(t);
+                i += 1;
+            }
+            None => {
+                let before = out.last().copied().expect("the first line has a stamp");
+                let after_at = i + stamps[i..]
+                    .iter()
+                    .position(Option::is_some)
+                    .expect("so has the last");
+                let after = stamps[after_at].expect("found written");
+                let (a, b) = (before.unix_nanos(), after.unix_nanos());
+                let span = (after_at - i + 1) as i128;
+                for j in 1..=(after_at - i) as i128 {
+                    // Between two valid stamps, so in range.
+                    out.push(Timestamp::from_unix_nanos(a + (b - a) * j / span).unwrap_or(before));
+                }
+                i = after_at;
+            }
+        }
+    }
+    out
+}
+
+/// Reads a timestamp file: one stamp a line; trailing blank lines are ignored. A blank line
+/// between two stamps is a dropped frame ([`Timestamps::blank`]).
+///
+/// Errors (naming file and line): a line that is not a stamp, or a blank line before the
+/// first stamp (its frame's time could not be placed).
 pub fn read_timestamps(path: impl AsRef<Path>) -> Result<Timestamps> {
     let path = path.as_ref();
     let text = read_text(path)?;
-    let mut absolute = Vec::new();
-    for (line_no, line) in numbered_lines(&text) {
-        let t = Timestamp::parse(line).map_err(|e| Error::parse(path, line_no, "timestamp", e))?;
-        absolute.push(t);
+    let lines: Vec<&str> = text.lines().map(str::trim).collect();
+    let end = lines
+        .iter()
+        .rposition(|l| !l.is_empty())
+        .map_or(0, |i| i + 1);
+    let mut stamps = Vec::with_capacity(end);
+    let mut blank = Vec::new();
+    for (i, line) in lines[..end].iter().enumerate() {
+        if line.is_empty() {
+            if i == 0 {
+                return Err(Error::parse(
+                    path,
+                    1,
+                    "timestamp",
+                    "blank before the first stamp: the frame's time cannot be placed",
+                ));
+            }
+            blank.push(i);
+            stamps.push(None);
+        } else {
+            let t =
+                Timestamp::parse(line).map_err(|e| Error::parse(path, i + 1, "timestamp", e))?;
+            stamps.push(Some(t));
+        }
     }
-    Ok(Timestamps::from_absolute(absolute))
+    let mut out = Timestamps::from_absolute(interpolate_blanks(&stamps));
+    out.blank = blank;
+    Ok(out)
 }
 
 /// Writes a timestamp file (one stamp a line, nine fraction digits), atomically.
@@ -359,6 +423,27 @@ mod tests {
         .unwrap();
         let msg = read_timestamps(&p).unwrap_err().to_string();
         assert!(msg.contains("timestamps.txt:3: timestamp"), "{msg}");
+    }
+
+    #[test]
+    fn a_blank_line_between_stamps_is_a_dropped_frame() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("timestamps.txt");
+        // Frames 1 and 2 dropped; 0.3 s from frame 0 to frame 3, so 0.1 s steps.
+        std::fs::write(
+            &p,
+            "2011-09-26 13:02:25.900000000\n\n  \n2011-09-26 13:02:26.200000000\n\n\n",
+        )
+        .unwrap();
+        let t = read_timestamps(&p).unwrap();
+        assert_eq!(t.blank, vec![1, 2]);
+        assert_eq!(t.len(), 4);
+        assert_eq!(t.absolute[1].to_string(), "2011-09-26 13:02:26.000000000");
+        assert_eq!(t.absolute[2].to_string(), "2011-09-26 13:02:26.100000000");
+        assert!((t.seconds[3] - 0.3).abs() < 1e-12);
+        std::fs::write(&p, "\n2011-09-26 13:02:26.200000000\n").unwrap();
+        let msg = read_timestamps(&p).unwrap_err().to_string();
+        assert!(msg.contains("timestamps.txt:1: timestamp: blank"), "{msg}");
     }
 
     #[test]

@@ -304,14 +304,26 @@ impl TrackingSequence {
         self.read_packets().map_or(0, |p| p.len())
     }
 
-    /// Number of frames: the scans when `velodyne/NNNN` exists, otherwise the OXTS packets
-    /// (0 when neither can be read).
+    /// Number of frames: the frames the scans span when `velodyne/NNNN` exists (the last
+    /// scan's number + 1, dropped scans inside the numbering included; see
+    /// [`has_scan`](Self::has_scan)), otherwise the OXTS packets (0 when neither can be read).
     pub fn frame_count(&self) -> usize {
         if self.has_velodyne() {
-            self.velodyne_count()
+            self.velodyne.extent()
         } else {
             self.oxts_count()
         }
+    }
+
+    /// Whether frame `k` has a scan. KITTI's sequence 0001 has none for frames 177–180 (its
+    /// raw drive dropped them); their OXTS lines and labels are there.
+    pub fn has_scan(&self, k: usize) -> bool {
+        self.velodyne.has_scan(k)
+    }
+
+    /// The frames below [`frame_count`](Self::frame_count) without a scan, as inclusive ranges.
+    pub fn dropped_scans(&self) -> Vec<(u64, u64)> {
+        self.velodyne.dropped()
     }
 
     /// Path of scan `k`: the listed `.bin` or `.pcd` file, else (whether or not it exists)
@@ -347,7 +359,7 @@ impl TrackingSequence {
     pub fn oxts(&self) -> Result<Vec<OxtsPacket>> {
         let packets = self.read_packets()?;
         if self.has_velodyne() {
-            let n = self.velodyne_count();
+            let n = self.frame_count();
             let path = self.oxts_path();
             if packets.len() < n {
                 return Err(Error::parse(
@@ -355,7 +367,7 @@ impl TrackingSequence {
                     packets.len() + 1,
                     "packet",
                     format!(
-                        "missing: {} packets for the {n} scans of {}",
+                        "missing: {} packets for the {n} frames the scans in {} span",
                         packets.len(),
                         self.velodyne_dir().display()
                     ),
@@ -369,7 +381,7 @@ impl TrackingSequence {
                     line,
                     "packet",
                     format!(
-                        "{} packets for the {n} scans of {}",
+                        "{} packets for the {n} frames the scans in {} span",
                         packets.len(),
                         self.velodyne_dir().display()
                     ),
@@ -419,7 +431,7 @@ impl TrackingSequence {
         let path = self.labels_path();
         let labels = read_tracking_labels(&path)?;
         if self.has_velodyne() {
-            let n = self.velodyne_count();
+            let n = self.frame_count();
             if let Some(l) = labels.iter().find(|l| l.frame >= n) {
                 let text = read_text(&path)?;
                 let line = numbered_lines(&text)
@@ -435,7 +447,7 @@ impl TrackingSequence {
                     line,
                     "frame",
                     format!(
-                        "label of frame {} but {} holds {n} scans",
+                        "label of frame {} but the scans in {} span {n} frames",
                         l.frame,
                         self.velodyne_dir().display()
                     ),
@@ -459,10 +471,10 @@ impl TrackingSequence {
             }),
             Some(files) => {
                 for (first, last) in numbering_gaps(files.iter().map(|f| f.0)) {
-                    issues.push(Issue::NumberingGap {
+                    issues.push(Issue::DroppedScans {
                         folder: self.velodyne_dir(),
-                        first_missing: first,
-                        last_missing: last,
+                        first,
+                        last,
                     });
                 }
                 for (_, path) in files {
@@ -491,10 +503,10 @@ impl TrackingSequence {
                     path: self.oxts_path(),
                     error: e.to_string(),
                 }),
-                Ok(p) if self.has_velodyne() && p.len() != self.velodyne_count() => {
+                Ok(p) if self.has_velodyne() && p.len() != self.frame_count() => {
                     issues.push(Issue::CountMismatch {
                         a: self.velodyne_dir(),
-                        a_count: self.velodyne_count(),
+                        a_count: self.frame_count(),
                         b: self.oxts_path(),
                         b_count: p.len(),
                     })
@@ -521,12 +533,12 @@ impl TrackingSequence {
                 }),
                 Ok(labels) => {
                     let frames = super::labels::label_frame_count(&labels);
-                    if self.has_velodyne() && frames > self.velodyne_count() {
+                    if self.has_velodyne() && frames > self.frame_count() {
                         issues.push(Issue::CountMismatch {
                             a: self.labels_path(),
                             a_count: frames,
                             b: self.velodyne_dir(),
-                            b_count: self.velodyne_count(),
+                            b_count: self.frame_count(),
                         });
                     }
                 }

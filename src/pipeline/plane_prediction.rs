@@ -265,10 +265,12 @@ fn ego_for(
 
 /// Runs the prediction over consecutive frame pairs `(k, k + 1)` for `k` in `frames`, given a
 /// frame loader, sensor poses, optional vehicle states and step lengths. Each frame is
-/// segmented once.
+/// segmented once. A pair one of whose frames has no scan (`has_scan`: KITTI drops a scan
+/// now and then) is left out.
 #[allow(clippy::too_many_arguments)]
 fn predict_sequence(
     frames: std::ops::Range<usize>,
+    has_scan: &dyn Fn(usize) -> bool,
     load: &dyn Fn(usize) -> Result<PointCloud>,
     poses: &[Isometry3<f64>],
     states: Option<&[[f64; 6]]>,
@@ -280,7 +282,17 @@ fn predict_sequence(
     config.validate()?;
     let mut out = Vec::new();
     let mut previous: Option<(usize, Vec<PlanePatch>)> = None;
-    for k in frames {
+    let pairs: Vec<usize> = frames
+        .clone()
+        .filter(|&k| has_scan(k) && has_scan(k + 1))
+        .collect();
+    if pairs.is_empty() && !frames.is_empty() {
+        return Err(Error::invalid(
+            format!("frame pairs {}..{}", frames.start, frames.end),
+            "none has a scan in both frames (dropped scans)",
+        ));
+    }
+    for k in pairs {
         let walls_k = match previous.take() {
             Some((f, w)) if f == k => w,
             _ => segment_walls(&load(k)?, &config.planes, rng)?,
@@ -349,6 +361,7 @@ pub fn predict_drive_pairs(
     };
     predict_sequence(
         frames,
+        &|k| drive.has_scan(k),
         &|k| drive.velodyne(k),
         &poses,
         states.as_deref(),
@@ -399,6 +412,7 @@ pub fn predict_tracking_pairs(
     };
     predict_sequence(
         frames,
+        &|k| sequence.has_scan(k),
         &|k| sequence.velodyne(k),
         &poses,
         states.as_deref(),
@@ -423,7 +437,7 @@ pub fn predict_pairs_with_poses(
     rng: &mut FilterRng,
 ) -> Result<Vec<PairPrediction>> {
     check_range(&frames, poses.len(), source)?;
-    predict_sequence(frames, load, poses, None, &[], config, runs, rng)
+    predict_sequence(frames, &|_| true, load, poses, None, &[], config, runs, rng)
 }
 
 /// Plane prediction over the consecutive frame pairs of a KITTI odometry sequence (ground-truth
@@ -445,6 +459,7 @@ pub fn predict_odometry_pairs(
     )?;
     predict_sequence(
         frames,
+        &|_| true,
         &|k| sequence.velodyne(k),
         &poses,
         None,

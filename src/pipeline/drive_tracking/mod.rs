@@ -482,17 +482,21 @@ pub fn segment_rng(seed: u64, frame: usize) -> crate::rng::FilterRng {
 struct Recording<'a> {
     /// Name in errors and in the output.
     name: String,
-    /// Number of scans.
+    /// Number of frames, a dropped scan's included.
     frames: usize,
+    /// Whether frame k has a scan (KITTI drops one now and then: see
+    /// [`RawDrive::has_scan`]); a frame without one is left out of the run and the next
+    /// frame is predicted to over the longer step.
+    has_scan: &'a dyn Fn(usize) -> bool,
     /// Reads scan k.
     read: &'a (dyn Fn(usize) -> Result<PointCloud> + Sync),
-    /// Velodyne poses (frame k → frame 0), one per scan; `None`: lidar odometry on the scans.
+    /// Velodyne poses (frame k → frame 0), one per frame; `None`: lidar odometry on the scans.
     poses: Option<Vec<Isometry3<f64>>>,
     /// Where the poses come from, e.g. `oxts` (`none` when every pose is the identity).
     ego: String,
-    /// Vehicle states [X, Ẋ, Y, Ẏ, φ, φ̇] for the ECT ego model, one per scan.
+    /// Vehicle states [X, Ẋ, Y, Ẏ, φ, φ̇] for the ECT ego model, one per frame.
     vehicle: Option<Vec<[f64; 6]>>,
-    /// Frame times, s, one per scan.
+    /// Frame times, s, one per frame.
     times: Vec<f64>,
 }
 
@@ -556,7 +560,7 @@ pub fn track_drive(
             "has no velodyne_points/data folder",
         ));
     }
-    let n = drive.velodyne_count();
+    let n = drive.frame_count();
     check_frame_range(frames.as_ref(), n, &format!("drive {name}"))?;
     if !drive.has_oxts() {
         if let EgoModel::Ect { .. } = config.ego {
@@ -578,11 +582,20 @@ pub fn track_drive(
     )?;
     let vehicle = ect_states(config, || drive.vehicle_states())?;
     let times: Vec<f64> = if drive.velodyne_timestamps_path().is_file() {
+        let path = drive.velodyne_timestamps_path();
         let t = drive.timestamps()?;
         if t.len() != n {
             return Err(Error::invalid(
-                format!("{}", drive.velodyne_timestamps_path().display()),
+                format!("{}", path.display()),
                 format!("has {} stamps for {n} Velodyne frames", t.len()),
+            ));
+        }
+        if let Some(&k) = t.blank.iter().find(|&&k| drive.has_scan(k)) {
+            return Err(Error::parse(
+                path,
+                k + 1,
+                "timestamp",
+                format!("blank, but frame {k} has a scan"),
             ));
         }
         t.seconds
@@ -590,9 +603,11 @@ pub fn track_drive(
         (0..n).map(|k| k as f64 * config.dt).collect()
     };
     let read = |k: usize| drive.velodyne(k);
+    let has_scan = |k: usize| drive.has_scan(k);
     let recording = Recording {
         name: drive.name(),
         frames: n,
+        has_scan: &has_scan,
         read: &read,
         poses,
         ego,
@@ -626,7 +641,7 @@ pub fn track_tracking_sequence(
             format!("has no scan folder {}", sequence.velodyne_dir().display()),
         ));
     }
-    let n = sequence.velodyne_count();
+    let n = sequence.frame_count();
     check_frame_range(frames.as_ref(), n, &name)?;
     let oxts_poses = || sequence.poses();
     let (poses, ego) = choose_poses(
@@ -639,9 +654,11 @@ pub fn track_tracking_sequence(
         "oxts",
     )?;
     let read = |k: usize| sequence.velodyne(k);
+    let has_scan = |k: usize| sequence.has_scan(k);
     let recording = Recording {
         name: format!("tracking_{}", sequence.name()),
         frames: n,
+        has_scan: &has_scan,
         read: &read,
         poses,
         ego,
@@ -715,6 +732,7 @@ pub fn track_odometry_sequence(
     let recording = Recording {
         name: format!("odometry_{}", sequence.name()),
         frames: n,
+        has_scan: &|_| true,
         read: &read,
         poses,
         ego,
@@ -800,14 +818,22 @@ fn track_recording(
     mut on_frame: impl FnMut(&FrameView<'_>) -> Result<()>,
 ) -> Result<DriveTracks> {
     let range = frames.unwrap_or(0..rec.frames);
+    // The frames of the range that have a scan.
+    let scans: Vec<usize> = range.clone().filter(|&k| (rec.has_scan)(k)).collect();
+    if scans.is_empty() {
+        return Err(Error::invalid(
+            format!("frames {}..{} of {}", range.start, range.end, rec.name),
+            "hold no scan",
+        ));
+    }
     let (poses, times, vehicle) = (&rec.poses, &rec.times, &rec.vehicle);
     let mut tracker = DriveTracker::new(config, seed)?;
     let mut odometry = match rec.poses {
         Some(_) => None,
         None => Some(LidarOdometry::new(OdometryConfig::default())?),
     };
-    let mut out = Vec::with_capacity(range.len());
-    let total = range.len();
+    let mut out = Vec::with_capacity(scans.len());
+    let total = scans.len();
     // Frames overlap: the scan of frame k is segmented while the filter updates frame k − 1
     // with its detections and predicts to frame k, on the pool's other thread; that side
     // also gives frame k − 1's clusters their boxes and classes, just before its update, so
@@ -820,12 +846,11 @@ fn track_recording(
         let cloud = (rec.read)(k)?;
         Ok((cloud, start.elapsed().as_secs_f64() * 1e3))
     };
-    let mut next = Some(read(range.start)?);
-    for k in range.clone() {
+    let mut next = Some(read(scans[0])?);
+    for (i, &k) in scans.iter().enumerate() {
         let (cloud, read_ms) = next.take().expect("each scan is read before its round");
-        let previous_state = vehicle
-            .as_ref()
-            .map(|v| v[if k > range.start { k - 1 } else { k }]);
+        let previous_state = vehicle.as_ref().map(|v| v[scans[i.saturating_sub(1)]]);
+        let following = scans.get(i + 1).copied();
         let start = Instant::now();
         let (pose, ego_ms) = match (poses, odometry.as_mut()) {
             (Some(p), _) => (p[k], 0.0),
@@ -863,10 +888,9 @@ fn track_recording(
                 let start = Instant::now();
                 tracker.predict_to(times[k], pose, previous_state)?;
                 let predict_ms = start.elapsed().as_secs_f64() * 1e3;
-                let next = if k + 1 < range.end {
-                    Some(read(k + 1)?)
-                } else {
-                    None
+                let next = match following {
+                    Some(f) => Some(read(f)?),
+                    None => None,
                 };
                 Ok((earlier, predict_ms, next))
             },
