@@ -101,10 +101,14 @@ impl PyRawDrive {
     fn name(&self) -> String {
         self.0.name()
     }
-    /// Number of frames.
+    /// Number of frames, dropped scans inside the numbering included (see `has_scan`).
     #[getter]
     fn frame_count(&self) -> usize {
         self.0.frame_count()
+    }
+    /// Whether frame `k` has a scan (KITTI drops one now and then, e.g. drive 0009's 177–180).
+    fn has_scan(&self, k: usize) -> bool {
+        self.0.has_scan(k)
     }
     /// Velodyne scan `k` as an `N × 4` float32 array.
     fn velodyne<'py>(&self, py: Python<'py>, k: usize) -> PyResult<Bound<'py, PyArray2<f32>>> {
@@ -192,10 +196,14 @@ impl PyTrackingSequence {
     fn name(&self) -> String {
         self.0.name().to_string()
     }
-    /// Number of frames.
+    /// Number of frames, dropped scans inside the numbering included (see `has_scan`).
     #[getter]
     fn frame_count(&self) -> usize {
         self.0.frame_count()
+    }
+    /// Whether frame `k` has a scan (sequence 0001 has none for frames 177–180).
+    fn has_scan(&self, k: usize) -> bool {
+        self.0.has_scan(k)
     }
     /// Velodyne scan `k` as an `N × 4` float32 array.
     fn velodyne<'py>(&self, py: Python<'py>, k: usize) -> PyResult<Bound<'py, PyArray2<f32>>> {

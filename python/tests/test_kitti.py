@@ -69,6 +69,7 @@ def test_real_raw_drive_scans_poses_and_times():
     root = shared_data(DRIVE)
     drive = smc_lmb.RawDrive(root)
     assert drive.frame_count == 50
+    assert all(drive.has_scan(k) for k in range(50)) and not drive.has_scan(50)
     scan = drive.velodyne(11)
     raw = np.fromfile(root / "velodyne_points/data/0000000011.bin", dtype=np.float32).reshape(-1, 4)
     np.testing.assert_array_equal(scan, raw)
@@ -155,6 +156,8 @@ def test_real_tracking_sequence_poses_and_labels():
     root = shared_data("kitti_tracking/training")
     seq = smc_lmb.TrackingSequence(root, 0)
     assert seq.name == "0000" and seq.frame_count == 50
+    # The shared copy keeps no scans (they are raw drive 0005's): frames come from OXTS.
+    assert not seq.has_scan(0)
     poses = seq.poses()
     assert poses.shape == (50, 4, 4)
     np.testing.assert_allclose(poses[0], np.eye(4), atol=1e-12)
