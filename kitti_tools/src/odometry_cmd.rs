@@ -5,7 +5,7 @@
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use nalgebra::Isometry3;
-use smc_lmb::cloud::odometry::{odometry_of_files, Fallback, OdometryConfig};
+use smc_lmb::cloud::odometry::{odometry_of_files_at, Fallback, OdometryConfig};
 use smc_lmb::kitti::odometry::{read_odometry_poses, write_odometry_poses};
 use smc_lmb::kitti::{OdometrySequence, RawDrive};
 use smc_lmb::metrics::{
@@ -60,9 +60,12 @@ pub struct Args {
     quiet: bool,
 }
 
-/// The scans to register and where the reference trajectory comes from.
+/// The scans to register, their frame numbers and where the reference trajectory comes from.
 struct Input {
     scans: Vec<PathBuf>,
+    /// Frame number of each scan: `0, 1, 2, …` but where a drive dropped scans (the
+    /// reference has a pose per frame).
+    frames: Vec<usize>,
     reference: Option<Reference>,
 }
 
@@ -76,6 +79,7 @@ pub fn run(args: Args) -> Result<()> {
     let mut input = input(&args)?;
     if let Some(n) = args.frames {
         input.scans.truncate(n);
+        input.frames.truncate(n);
     }
     if input.scans.is_empty() {
         bail!("no scans to register");
@@ -83,21 +87,28 @@ pub fn run(args: Args) -> Result<()> {
     let estimate = match &args.evaluate {
         Some(file) => read_odometry_poses(file)
             .with_context(|| format!("reading the poses to score, {}", file.display()))?,
-        None => estimate(&args, &input.scans)?,
+        None => estimate(&args, &input.scans, &input.frames)?,
     };
     if let Some(file) = &args.reference {
         input.reference = Some(Reference::PoseFile(file.clone(), None));
     }
     if let Some(reference) = &input.reference {
         let (name, poses) = reference_poses(reference)?;
-        if poses.len() < estimate.len() {
+        let last = input.frames.get(estimate.len().saturating_sub(1)).copied();
+        if estimate.len() > input.frames.len() || last.is_none_or(|k| poses.len() <= k) {
             bail!(
                 "{name}: the reference has {} poses for {} scans",
                 poses.len(),
                 estimate.len()
             );
         }
-        report(&estimate, &poses[..estimate.len()], &name)?;
+        // The reference at the scans' frames, from the first scan's frame on.
+        let first = poses[input.frames[0]].inverse();
+        let at_scans: Vec<Isometry3<f64>> = input.frames[..estimate.len()]
+            .iter()
+            .map(|&k| first * poses[k])
+            .collect();
+        report(&estimate, &at_scans, &name)?;
     }
     Ok(())
 }
@@ -107,11 +118,17 @@ fn input(args: &Args) -> Result<Input> {
         (Some(dir), _, _) => {
             let drive =
                 RawDrive::open(dir).with_context(|| format!("opening drive {}", dir.display()))?;
-            let scans = (0..drive.velodyne_count())
-                .map(|k| drive.velodyne_path(k))
+            // Dropped scans are left out; the others keep their frame numbers.
+            let frames: Vec<usize> = (0..drive.frame_count())
+                .filter(|&k| drive.has_scan(k))
                 .collect();
+            let scans = frames.iter().map(|&k| drive.velodyne_path(k)).collect();
             let reference = drive.has_oxts().then_some(Reference::Drive(drive));
-            Ok(Input { scans, reference })
+            Ok(Input {
+                scans,
+                frames,
+                reference,
+            })
         }
         (None, Some(root), _) => {
             let Some(number) = args.sequence else {
@@ -123,19 +140,27 @@ fn input(args: &Args) -> Result<Input> {
                     root.display()
                 )
             })?;
-            let scans = (0..seq.frame_count())
+            let scans: Vec<PathBuf> = (0..seq.frame_count())
                 .map(|k| seq.velodyne_path(k))
                 .collect();
             let poses = seq.poses_path();
             let reference = poses
                 .is_file()
                 .then_some(Reference::PoseFile(poses, Some(seq)));
-            Ok(Input { scans, reference })
+            Ok(Input {
+                frames: (0..scans.len()).collect(),
+                scans,
+                reference,
+            })
         }
-        (None, None, Some(dir)) => Ok(Input {
-            scans: scan_files(dir)?,
-            reference: None,
-        }),
+        (None, None, Some(dir)) => {
+            let scans = scan_files(dir)?;
+            Ok(Input {
+                frames: (0..scans.len()).collect(),
+                scans,
+                reference: None,
+            })
+        }
         (None, None, None) => {
             bail!("give --drive DIR, --odometry ROOT --sequence NN or --scans DIR")
         }
@@ -177,7 +202,7 @@ fn scan_files(dir: &Path) -> Result<Vec<PathBuf>> {
     Ok(files)
 }
 
-fn estimate(args: &Args, scans: &[PathBuf]) -> Result<Vec<Isometry3<f64>>> {
+fn estimate(args: &Args, scans: &[PathBuf], frames: &[usize]) -> Result<Vec<Isometry3<f64>>> {
     let config = OdometryConfig {
         max_range: args.max_range,
         voxel_size: args.voxel_size.unwrap_or(args.max_range / 100.0),
@@ -200,7 +225,7 @@ fn estimate(args: &Args, scans: &[PathBuf]) -> Result<Vec<Isometry3<f64>>> {
     let start = Instant::now();
     let mut fallbacks: BTreeMap<Fallback, Vec<usize>> = BTreeMap::new();
     let mut least_information = f64::INFINITY;
-    let poses = odometry_of_files(scans, &config, |k, r| {
+    let poses = odometry_of_files_at(scans, frames, &config, |k, r| {
         bar.inc(1);
         if let Some(f) = r.fallback {
             fallbacks.entry(f).or_default().push(k);

@@ -189,3 +189,60 @@ fn a_short_reference_is_refused_naming_the_file() {
         "{stderr}"
     );
 }
+
+/// A raw drive whose scans 3 and 4 were dropped (KITTI keeps their OXTS packets and leaves
+/// their time stamp lines blank): the scan after the gap is registered after three frame
+/// steps, not one, and scored against the reference at its own frame.
+#[test]
+fn dropped_scans_are_registered_over_the_longer_step() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = common::output(&[
+        "synth",
+        "--out",
+        dir.path().to_str().unwrap(),
+        "--frames",
+        "8",
+        "--seed",
+        "2",
+        "--quiet",
+    ]);
+    assert!(out.status.success());
+    let drive = dir.path().join("2020_01_01/2020_01_01_drive_0001_sync");
+    for k in [3, 4] {
+        std::fs::remove_file(drive.join(format!("velodyne_points/data/{k:010}.bin"))).unwrap();
+    }
+    let stamps = drive.join("velodyne_points/timestamps.txt");
+    let blanked: String = std::fs::read_to_string(&stamps)
+        .unwrap()
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i == 3 || i == 4 {
+                "\n".into()
+            } else {
+                format!("{l}\n")
+            }
+        })
+        .collect();
+    std::fs::write(&stamps, blanked).unwrap();
+    let poses = dir.path().join("poses.txt");
+    let (good, stdout, stderr) = run(&[
+        "odometry",
+        "--drive",
+        drive.to_str().unwrap(),
+        "--out",
+        poses.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(good, "{stdout}\n{stderr}");
+    assert!(stdout.contains("6 scans, 7.0 m path"), "{stdout}");
+    assert!(!stderr.contains("constant-velocity"), "{stderr}");
+    let drift: f64 = stdout
+        .split("end-point drift ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(drift < 0.05, "{stdout}");
+}

@@ -105,12 +105,21 @@ impl LidarOdometry {
     ///
     /// Errors: the scan has no finite point between `min_range` and `max_range`.
     pub fn register(&mut self, cloud: &PointCloud) -> Result<Registered> {
-        // On one of rayon's threads: each ICP iteration's parallel pass then starts without
-        // handing its work to the pool and waiting for it.
-        rayon::scope(|_| self.register_here(cloud))
+        self.register_after(cloud, 1)
     }
 
-    fn register_here(&mut self, cloud: &PointCloud) -> Result<Registered> {
+    /// Registers a scan taken `steps` frame periods after the last one: more than one when
+    /// the scans between them were dropped (KITTI's drive 0009 lacks four). The
+    /// constant-velocity prediction repeats the last frame's motion `steps` times, and the
+    /// motion kept for the next scan is the registered one spread evenly over the steps
+    /// (its translation and rotation angle divided by `steps`). `steps` 0 counts as 1.
+    pub fn register_after(&mut self, cloud: &PointCloud, steps: usize) -> Result<Registered> {
+        // On one of rayon's threads: each ICP iteration's parallel pass then starts without
+        // handing its work to the pool and waiting for it.
+        rayon::scope(|_| self.register_here(cloud, steps.max(1)))
+    }
+
+    fn register_here(&mut self, cloud: &PointCloud, steps: usize) -> Result<Registered> {
         let c = &self.config;
         // Preprocess: range crop (Sec. III-A; no deskewing, see the type's docs).
         let frame = crop_range(cloud, c.min_range, c.max_range);
@@ -133,7 +142,8 @@ impl LidarOdometry {
             .fixed_threshold
             .unwrap_or_else(|| self.threshold.threshold());
         // Constant-velocity prediction (Sec. III-A) and alignment (Sec. III-D).
-        let initial = renormalized(&(self.last_pose * self.last_delta));
+        let motion = (1..steps).fold(self.last_delta, |m, _| m * self.last_delta);
+        let initial = renormalized(&(self.last_pose * motion));
         let refine = c.refine_iterations > 0 && c.refine_passes > 0;
         let params = IcpParams {
             max_correspondence: 3.0 * sigma,
@@ -181,7 +191,12 @@ impl LidarOdometry {
         // Update: threshold from the model deviation, map, velocity, pose.
         self.threshold.update(&(initial.inverse() * pose));
         self.map.update(&frame_down, &pose);
-        self.last_delta = renormalized(&(self.last_pose.inverse() * pose));
+        let moved = self.last_pose.inverse() * pose;
+        self.last_delta = renormalized(&if steps == 1 {
+            moved
+        } else {
+            one_step_of(&moved, steps)
+        });
         self.last_pose = pose;
         self.poses.push(pose);
         if let Some(f) = fallback {
@@ -244,6 +259,23 @@ impl LidarOdometry {
     }
 }
 
+/// The motion of one of `steps` equal steps that together make `motion`: the rotation of
+/// angle / `steps` about the same axis, and the translation t_s that the steps add up to the
+/// whole one, Σ_{i<n} R_sⁱ t_s = t (t / `steps` if that sum cannot be inverted).
+fn one_step_of(motion: &Isometry3<f64>, steps: usize) -> Isometry3<f64> {
+    let n = steps as f64;
+    let rotation = nalgebra::UnitQuaternion::from_scaled_axis(motion.rotation.scaled_axis() / n);
+    let r = rotation.to_rotation_matrix().into_inner();
+    let (mut sum, mut power) = (Matrix3::zeros(), Matrix3::identity());
+    for _ in 0..steps {
+        sum += power;
+        power *= r;
+    }
+    let t = motion.translation.vector;
+    let step = sum.try_inverse().map_or(t / n, |inv| inv * t);
+    Isometry3::from_parts(step.into(), rotation)
+}
+
 /// Runs the odometry over the scans `paths` in order and returns one pose per scan;
 /// `on_scan(k)` is called after scan k. Files ending in `.pcd` (any case) are read as PCD,
 /// leaving out points with NaN or infinite values (the invalid points of an organised cloud);
@@ -254,15 +286,42 @@ impl LidarOdometry {
 pub fn odometry_of_files(
     paths: &[PathBuf],
     config: &OdometryConfig,
+    on_scan: impl FnMut(usize, &Registered),
+) -> Result<Vec<Isometry3<f64>>> {
+    let frames: Vec<usize> = (0..paths.len()).collect();
+    odometry_of_files_at(paths, &frames, config, on_scan)
+}
+
+/// [`odometry_of_files`] for scans taken at the frame numbers `frames` (ascending, one per
+/// path): where scans were dropped between two of them, the second is registered after the
+/// longer step ([`LidarOdometry::register_after`]). Errors as [`odometry_of_files`], and
+/// `frames` that do not match `paths` or do not increase.
+pub fn odometry_of_files_at(
+    paths: &[PathBuf],
+    frames: &[usize],
+    config: &OdometryConfig,
     mut on_scan: impl FnMut(usize, &Registered),
 ) -> Result<Vec<Isometry3<f64>>> {
     if paths.is_empty() {
         return Err(Error::invalid("odometry scans", "no scans given"));
     }
+    if frames.len() != paths.len() || frames.windows(2).any(|w| w[1] <= w[0]) {
+        return Err(Error::invalid(
+            "odometry frame numbers",
+            format!(
+                "{} increasing numbers needed, one per scan, got {}",
+                paths.len(),
+                frames.len()
+            ),
+        ));
+    }
     let mut odometry = LidarOdometry::new(config.clone())?;
     for (k, path) in paths.iter().enumerate() {
         let cloud = read_scan(path)?;
-        let registered = odometry.register(&cloud).map_err(|e| named(path, e))?;
+        let steps = if k == 0 { 1 } else { frames[k] - frames[k - 1] };
+        let registered = odometry
+            .register_after(&cloud, steps)
+            .map_err(|e| named(path, e))?;
         on_scan(k, &registered);
     }
     Ok(odometry.poses.clone())
@@ -323,6 +382,33 @@ fn eigen_ratio(m: &Matrix3<f64>) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn one_step_of_a_screw_motion_repeats_into_it() {
+        // A turn of 0.3 rad about z with a translation along z: exact.
+        let screw = Isometry3::new(
+            nalgebra::Vector3::new(0.0, 0.0, 3.0),
+            nalgebra::Vector3::new(0.0, 0.0, 0.3),
+        );
+        let step = one_step_of(&screw, 3);
+        let back = step * step * step;
+        assert!((back.to_homogeneous() - screw.to_homogeneous()).abs().max() < 1e-12);
+        // A vehicle's 3 m with a 0.03 rad turn (translation across the axis): exact too.
+        let drive = Isometry3::new(
+            nalgebra::Vector3::new(3.0, 0.05, 0.0),
+            nalgebra::Vector3::new(0.0, 0.0, 0.03),
+        );
+        let step = one_step_of(&drive, 3);
+        let back = step * step * step;
+        assert!((back.to_homogeneous() - drive.to_homogeneous()).abs().max() < 1e-12);
+        // No motion stays none.
+        let still = one_step_of(&Isometry3::identity(), 4);
+        assert_eq!(
+            still.to_homogeneous(),
+            Isometry3::identity().to_homogeneous()
+        );
+    }
+
     use crate::cloud::odometry::test_scene::yard;
     use nalgebra::{Point3, Vector3};
 

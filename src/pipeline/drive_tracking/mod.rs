@@ -855,8 +855,9 @@ fn track_recording(
         let (pose, ego_ms) = match (poses, odometry.as_mut()) {
             (Some(p), _) => (p[k], 0.0),
             (None, Some(o)) => {
+                let steps = if i == 0 { 1 } else { k - scans[i - 1] };
                 let pose = o
-                    .register(&cloud)
+                    .register_after(&cloud, steps)
                     .map_err(|e| {
                         Error::invalid(
                             format!("lidar odometry on frame {k} of {}", rec.name),
