@@ -211,6 +211,7 @@ fn seed_drive_walls_repeat_with_lidar_odometry() {
     let config = PlanePredictionConfig::default();
     let results = predict_pairs_with_poses(
         0..count - 1,
+        &|_| true,
         &load,
         &poses,
         "drive 0005",

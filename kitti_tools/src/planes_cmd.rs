@@ -99,11 +99,21 @@ impl Input {
         }
     }
 
-    fn scan_count(&self) -> usize {
+    /// Frames, dropped scans included.
+    fn frame_count(&self) -> usize {
         match self {
-            Input::Drive(d) => d.velodyne_count(),
+            Input::Drive(d) => d.frame_count(),
             Input::Odometry(s) => s.frame_count(),
-            Input::Tracking(s) => s.velodyne_count(),
+            Input::Tracking(s) => s.frame_count(),
+        }
+    }
+
+    /// Whether frame `k` has a scan.
+    fn has_scan(&self, k: usize) -> bool {
+        match self {
+            Input::Drive(d) => d.has_scan(k),
+            Input::Odometry(_) => true,
+            Input::Tracking(s) => s.has_scan(k),
         }
     }
 
@@ -198,12 +208,13 @@ pub fn run(args: Args) -> Result<()> {
         )
     };
     let results: Vec<PairPrediction> = if lidar {
-        let count = input.scan_count();
+        let count = input.frame_count();
         let end = frames
             .as_ref()
             .map_or(count, |r| r.end.saturating_add(1).min(count));
-        let poses = smc_lmb::cloud::odometry::odometry_of_frames(
+        let poses = smc_lmb::cloud::odometry::odometry_of_frames_with(
             end,
+            &|k| input.has_scan(k),
             &|k| input.load(k),
             &smc_lmb::cloud::odometry::OdometryConfig::default(),
         )
@@ -211,6 +222,7 @@ pub fn run(args: Args) -> Result<()> {
         let frames = frames.unwrap_or(0..end.saturating_sub(1));
         smc_lmb::pipeline::plane_prediction::predict_pairs_with_poses(
             frames,
+            &|k| input.has_scan(k),
             &|k| input.load(k),
             &poses,
             &source,

@@ -245,4 +245,30 @@ fn dropped_scans_are_registered_over_the_longer_step() {
         .parse()
         .unwrap();
     assert!(drift < 0.05, "{stdout}");
+
+    // The walls of the pairs with both scans, on the same odometry.
+    let planes = ok(&common::output(&[
+        "planes",
+        "--drive",
+        drive.to_str().unwrap(),
+        "--all",
+        "--runs",
+        "1",
+        "--ego",
+        "lidar",
+        "--json",
+    ]));
+    let planes: serde_json::Value = serde_json::from_str(&planes).unwrap();
+    let frames: Vec<u64> = planes["pairs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["frame"].as_u64().unwrap())
+        .collect();
+    assert!(!frames.is_empty(), "{planes}");
+    assert!(frames.iter().all(|f| ![3, 4, 5].contains(f)), "{frames:?}");
+    let angle = planes["summary"]["median_normal_angle_deg"]
+        .as_f64()
+        .unwrap();
+    assert!(angle < 1.0, "{planes}");
 }

@@ -426,9 +426,12 @@ pub fn predict_tracking_pairs(
 /// Plane prediction over the consecutive frame pairs `(k, k + 1)`, `k ∈ frames`, of any
 /// recording, with the measured motion between the given sensor `poses` (sensor → world, one
 /// per frame; e.g. from [`crate::cloud::odometry`] when the recording has no poses of its
-/// own). `source` names the recording in errors.
+/// own). Pairs with a frame for which `has_scan` is false (a dropped scan) are left out.
+/// `source` names the recording in errors.
+#[allow(clippy::too_many_arguments)]
 pub fn predict_pairs_with_poses(
     frames: std::ops::Range<usize>,
+    has_scan: &dyn Fn(usize) -> bool,
     load: &dyn Fn(usize) -> Result<PointCloud>,
     poses: &[Isometry3<f64>],
     source: &str,
@@ -437,7 +440,7 @@ pub fn predict_pairs_with_poses(
     rng: &mut FilterRng,
 ) -> Result<Vec<PairPrediction>> {
     check_range(&frames, poses.len(), source)?;
-    predict_sequence(frames, &|_| true, load, poses, None, &[], config, runs, rng)
+    predict_sequence(frames, has_scan, load, poses, None, &[], config, runs, rng)
 }
 
 /// Plane prediction over the consecutive frame pairs of a KITTI odometry sequence (ground-truth

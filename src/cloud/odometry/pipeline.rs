@@ -335,14 +335,48 @@ pub fn odometry_of_frames(
     load: &dyn Fn(usize) -> Result<PointCloud>,
     config: &OdometryConfig,
 ) -> Result<Vec<Isometry3<f64>>> {
-    if count == 0 {
+    odometry_of_frames_with(count, &|_| true, load, config)
+}
+
+/// [`odometry_of_frames`] for a recording whose frames without a scan (`has_scan` false:
+/// KITTI drops one now and then) are not loaded: the scan after them is registered over the
+/// longer step ([`LidarOdometry::register_after`]), and each of them gets the pose of equal
+/// steps between the scans around it. Frames after the last scan keep its pose. Errors as
+/// [`odometry_of_frames`], and no scan among the frames.
+pub fn odometry_of_frames_with(
+    count: usize,
+    has_scan: &dyn Fn(usize) -> bool,
+    load: &dyn Fn(usize) -> Result<PointCloud>,
+    config: &OdometryConfig,
+) -> Result<Vec<Isometry3<f64>>> {
+    let scans: Vec<usize> = (0..count).filter(|&k| has_scan(k)).collect();
+    if scans.is_empty() {
         return Err(Error::invalid("odometry scans", "no scans given"));
     }
     let mut odometry = LidarOdometry::new(config.clone())?;
-    for k in 0..count {
-        odometry.register(&load(k)?)?;
+    // Frames before the first scan take its pose (the identity).
+    let mut poses = vec![Isometry3::identity(); count];
+    let mut last: Option<(usize, Isometry3<f64>)> = None;
+    for &k in &scans {
+        let steps = last.map_or(1, |(l, _)| k - l);
+        let pose = odometry.register_after(&load(k)?, steps)?.pose;
+        if let Some((l, before)) = last {
+            let step = one_step_of(&(before.inverse() * pose), steps);
+            let mut p = before;
+            for between in poses.iter_mut().take(k).skip(l + 1) {
+                p *= step;
+                *between = p;
+            }
+        }
+        poses[k] = pose;
+        last = Some((k, pose));
     }
-    Ok(odometry.poses.clone())
+    if let Some((l, pose)) = last {
+        for after in poses.iter_mut().skip(l + 1) {
+            *after = pose;
+        }
+    }
+    Ok(poses)
 }
 
 /// Reads one scan by its extension: `.pcd` without its non-finite points (an organised
@@ -461,6 +495,45 @@ mod tests {
                 "frame {k}: {err:?}"
             );
             previous = pose;
+        }
+    }
+
+    #[test]
+    fn frames_without_a_scan_get_poses_between_their_neighbours() {
+        // The yard's slow bend at 0.6 m a frame; frames 2 to 4 have no scan.
+        let step = Isometry3::new(Vector3::new(0.6, 0.03, 0.0), Vector3::new(0.0, 0.0, 0.0105));
+        let mut truth = vec![Isometry3::identity()];
+        for _ in 0..6 {
+            truth.push(truth.last().unwrap() * step);
+        }
+        let config = OdometryConfig {
+            voxel_size: 0.5,
+            max_correction: 1.0,
+            ..OdometryConfig::default()
+        };
+        let dropped = |k: usize| (2..=4).contains(&k);
+        let load = |k: usize| -> Result<PointCloud> {
+            assert!(!dropped(k), "frame {k} has no scan");
+            Ok(seen_from(&yard(0.1, k as u64), &truth[k]))
+        };
+        let poses = odometry_of_frames_with(7, &|k| !dropped(k), &load, &config).unwrap();
+        assert_eq!(poses.len(), 7);
+        for (k, (p, t)) in poses.iter().zip(&truth).enumerate() {
+            let err = t.inverse() * p;
+            assert!(err.translation.vector.norm() < 0.05, "frame {k}: {err:?}");
+            assert!(
+                err.rotation.angle().to_degrees() < 0.2,
+                "frame {k}: {err:?}"
+            );
+        }
+        // Registered as the next frame, the scan after the gap starts from a guess 1.8 m
+        // short: beyond the correction bound, a jump, and its pose stays the guess.
+        let mut odo = LidarOdometry::new(config).unwrap();
+        for k in [0, 1, 5] {
+            let r = odo.register(&load(k).unwrap()).unwrap();
+            if k == 5 {
+                assert_eq!(r.fallback, Some(Fallback::Jump), "{r:?}");
+            }
         }
     }
 
