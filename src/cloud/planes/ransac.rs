@@ -31,8 +31,31 @@ pub(super) fn one_round(
     grid: Option<&BandGrid>,
 ) -> Option<(Plane, Vec<u32>)> {
     // 1. Subsample (with replacement when the pool is small) and voxel grid.
-    let m = config.score_sample.min(active.len());
-    let sample: Vec<[f32; 3]> = if m == active.len() {
+    let sample = subsample(pts, active, config.score_sample, rng);
+    let cells = VoxelGroups::new(&sample, config.sample_cell as f32);
+    // 2. Hypotheses, drawn sequentially.
+    let hyps = draw_hypotheses(&sample, &cells, min_tilt, config, rng);
+    // 3. The best of them on the subsample.
+    let (best, best_score) = best_hypothesis(&sample, &hyps, config)?;
+    // Expected support in the whole pool far below min_points: stop early.
+    let expected = best_score as f64 * active.len() as f64 / sample.len() as f64;
+    if expected < 0.5 * config.min_points as f64 {
+        return None;
+    }
+    // 4. MSSE threshold, inliers, refits.
+    refine(pts, active, &best, min_tilt, config, grid)
+}
+
+/// `score_sample` points of `active` drawn with replacement, or all of them when the pool is
+/// not larger.
+fn subsample(
+    pts: &[[f32; 3]],
+    active: &[u32],
+    score_sample: usize,
+    rng: &mut FilterRng,
+) -> Vec<[f32; 3]> {
+    let m = score_sample.min(active.len());
+    if m == active.len() {
         active.iter().map(|&i| pts[i as usize]).collect()
     } else {
         // The draws first, then the two look-ups, each in a loop of its own: the loads of one
@@ -42,10 +65,20 @@ pub(super) fn one_round(
             .collect();
         let ids: Vec<u32> = draws.iter().map(|&k| active[k as usize]).collect();
         ids.iter().map(|&i| pts[i as usize]).collect()
-    };
-    let cells = VoxelGroups::new(&sample, config.sample_cell as f32);
+    }
+}
 
-    // 2. Hypotheses, drawn sequentially.
+/// Up to `hypotheses` planes through point triples of `sample` (the second and third point
+/// from the first one's voxel of `cells`), at least `min_tilt` from horizontal; at most 20
+/// attempts a hypothesis.
+fn draw_hypotheses(
+    sample: &[[f32; 3]],
+    cells: &VoxelGroups,
+    min_tilt: f64,
+    config: &PlaneConfig,
+    rng: &mut FilterRng,
+) -> Vec<PlaneF32> {
+    let m = sample.len();
     let tan_min = min_tilt.tan();
     let mut hyps: Vec<PlaneF32> = Vec::with_capacity(config.hypotheses);
     let mut attempts = 0usize;
@@ -73,14 +106,24 @@ pub(super) fn one_round(
             }
         }
     }
+    hyps
+}
+
+/// The hypothesis with most support in `sample` and that support (ties: the earliest drawn),
+/// scored in parallel into an ordered vector; preemptively, when there are more than
+/// `preemptive_keep`, only the best `preemptive_keep` on an evenly strided part are scored on
+/// the whole sample. `None` without hypotheses.
+fn best_hypothesis(
+    sample: &[[f32; 3]],
+    hyps: &[PlaneF32],
+    config: &PlaneConfig,
+) -> Option<(PlaneF32, usize)> {
     if hyps.is_empty() {
         return None;
     }
-
-    // 3. Score in parallel into an ordered vector; best = most support, earliest on ties.
     let thr = config.score_threshold as f32;
-    let stride = m.div_ceil(config.preemptive_sample);
-    if hyps.len() > config.preemptive_keep && stride > 1 {
+    let stride = sample.len().div_ceil(config.preemptive_sample);
+    let kept: Vec<PlaneF32> = if hyps.len() > config.preemptive_keep && stride > 1 {
         let part: Vec<[f32; 3]> = sample.iter().step_by(stride).copied().collect();
         let part = Columns::of(&part);
         let pre: Vec<usize> = hyps
@@ -92,30 +135,37 @@ pub(super) fn one_round(
         rank.sort_by(|&a, &b| pre[b].cmp(&pre[a]).then(a.cmp(&b)));
         rank.truncate(config.preemptive_keep);
         rank.sort_unstable();
-        hyps = rank.into_iter().map(|k| hyps[k]).collect();
-    }
-    let soa = Columns::of(&sample);
-    let scores: Vec<usize> = hyps
+        rank.into_iter().map(|k| hyps[k]).collect()
+    } else {
+        hyps.to_vec()
+    };
+    let soa = Columns::of(sample);
+    let scores: Vec<usize> = kept
         .par_iter()
         .with_min_len(4)
         .map(|h| soa.support(h, thr))
         .collect();
-    let (best, best_score) = scores
+    scores
         .iter()
         .enumerate()
         .max_by(|a, b| a.1.cmp(b.1).then(b.0.cmp(&a.0)))
-        .map(|(i, s)| (i, *s))?;
-    // Expected support in the whole pool far below min_points: stop early.
-    let expected = best_score as f64 * active.len() as f64 / m as f64;
-    if expected < 0.5 * config.min_points as f64 {
-        return None;
-    }
+        .map(|(i, s)| (kept[i], *s))
+}
 
-    // 4. MSSE threshold, inliers, refit; twice. The first refit only turns the drawn plane
-    // into a fitted one: a pool of more than twice `REFINE_POINTS` points makes it on an
-    // evenly strided part of the pool; the second is made on the whole pool. A wall round
-    // then makes up to `wall_refits` more passes over the whole pool, until its inliers stay
-    // the same.
+/// The drawn plane `drawn` refined on the pool: an MSSE threshold, its inliers and a
+/// least-squares refit, twice. The first refit only turns the drawn plane into a fitted one:
+/// a pool of more than twice `REFINE_POINTS` points makes it on an evenly strided part of the
+/// pool; the second is made on the whole pool. A wall round (`min_tilt` > 0) then makes up to
+/// `wall_refits` more passes over the whole pool, until its inliers stay the same. `None`
+/// when one of the first two passes keeps fewer than `min_points` inliers.
+fn refine(
+    pts: &[[f32; 3]],
+    active: &[u32],
+    drawn: &PlaneF32,
+    min_tilt: f64,
+    config: &PlaneConfig,
+    grid: Option<&BandGrid>,
+) -> Option<(Plane, Vec<u32>)> {
     let stride = (active.len() / REFINE_POINTS).max(1);
     let part: Vec<u32> = if stride > 1 {
         active.iter().step_by(stride).copied().collect()
@@ -139,9 +189,7 @@ pub(super) fn one_round(
         } else {
             (active, config.min_points, true)
         };
-        let plane = fitted
-            .as_ref()
-            .map_or(hyps[best], |(p, _)| PlaneF32::new(p));
+        let plane = fitted.as_ref().map_or(*drawn, |(p, _)| PlaneF32::new(p));
         let inliers = band_inliers(pts, pool, grid.filter(|_| whole), &plane, config);
         // A fixed point (the inliers the fit before had, so at least `min_points` of them).
         if pass >= 2
