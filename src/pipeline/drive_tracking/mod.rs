@@ -742,6 +742,40 @@ pub fn track_odometry_sequence(
     track_recording(&recording, frames, config, seed, on_frame)
 }
 
+/// Where the tracking loop takes each frame's sensor pose from.
+enum Ego<'a> {
+    /// The recording's poses, one per frame.
+    Recorded(&'a [Isometry3<f64>]),
+    /// Lidar odometry on the scans as they are read.
+    Lidar(LidarOdometry),
+}
+
+impl Ego<'_> {
+    /// The pose of frame `k`, whose scan is `cloud`, `steps` frames after the scan before it
+    /// (more than one after dropped scans), and the milliseconds the odometry took.
+    fn pose(
+        &mut self,
+        k: usize,
+        steps: usize,
+        cloud: &PointCloud,
+        name: &str,
+    ) -> Result<(Isometry3<f64>, f64)> {
+        match self {
+            Ego::Recorded(poses) => Ok((poses[k], 0.0)),
+            Ego::Lidar(odometry) => {
+                let start = Instant::now();
+                let registered = odometry.register_after(cloud, steps).map_err(|e| {
+                    Error::invalid(
+                        format!("lidar odometry on frame {k} of {name}"),
+                        e.to_string(),
+                    )
+                })?;
+                Ok((registered.pose, start.elapsed().as_secs_f64() * 1e3))
+            }
+        }
+    }
+}
+
 /// A frame segmented and predicted, waiting for its update in the next round of the loop.
 struct Held {
     frame: usize,
@@ -826,11 +860,11 @@ fn track_recording(
             "hold no scan",
         ));
     }
-    let (poses, times, vehicle) = (&rec.poses, &rec.times, &rec.vehicle);
+    let (times, vehicle) = (&rec.times, &rec.vehicle);
     let mut tracker = DriveTracker::new(config, seed)?;
-    let mut odometry = match rec.poses {
-        Some(_) => None,
-        None => Some(LidarOdometry::new(OdometryConfig::default())?),
+    let mut ego = match &rec.poses {
+        Some(p) => Ego::Recorded(p),
+        None => Ego::Lidar(LidarOdometry::new(OdometryConfig::default())?),
     };
     let mut out = Vec::with_capacity(scans.len());
     let total = scans.len();
@@ -851,24 +885,8 @@ fn track_recording(
         let (cloud, read_ms) = next.take().expect("each scan is read before its round");
         let previous_state = vehicle.as_ref().map(|v| v[scans[i.saturating_sub(1)]]);
         let following = scans.get(i + 1).copied();
-        let start = Instant::now();
-        let (pose, ego_ms) = match (poses, odometry.as_mut()) {
-            (Some(p), _) => (p[k], 0.0),
-            (None, Some(o)) => {
-                let steps = if i == 0 { 1 } else { k - scans[i - 1] };
-                let pose = o
-                    .register_after(&cloud, steps)
-                    .map_err(|e| {
-                        Error::invalid(
-                            format!("lidar odometry on frame {k} of {}", rec.name),
-                            e.to_string(),
-                        )
-                    })?
-                    .pose;
-                (pose, start.elapsed().as_secs_f64() * 1e3)
-            }
-            (None, None) => unreachable!("odometry is set up when there are no poses"),
-        };
+        let steps = if i == 0 { 1 } else { k - scans[i - 1] };
+        let (pose, ego_ms) = ego.pose(k, steps, &cloud, &rec.name)?;
         let start = Instant::now();
         let earlier = held.take();
         type Earlier = Option<(Held, FrameDetections, TrackedFrame, f64)>;
@@ -925,9 +943,10 @@ fn track_recording(
         emit(h, &detections, tracked, &mut out, total, &mut on_frame)?;
     }
     let mut summary = TrackingSummary::of(&out);
-    summary.ego_fallbacks = odometry
-        .as_ref()
-        .map_or(0, |o| o.fallbacks().values().sum());
+    summary.ego_fallbacks = match &ego {
+        Ego::Recorded(_) => 0,
+        Ego::Lidar(o) => o.fallbacks().values().sum(),
+    };
     Ok(DriveTracks {
         drive: rec.name.clone(),
         seed,
