@@ -746,8 +746,8 @@ pub fn track_odometry_sequence(
 enum Ego<'a> {
     /// The recording's poses, one per frame.
     Recorded(&'a [Isometry3<f64>]),
-    /// Lidar odometry on the scans as they are read.
-    Lidar(LidarOdometry),
+    /// Lidar odometry on the scans as they are read (boxed: its map is large).
+    Lidar(Box<LidarOdometry>),
 }
 
 impl Ego<'_> {
@@ -864,7 +864,7 @@ fn track_recording(
     let mut tracker = DriveTracker::new(config, seed)?;
     let mut ego = match &rec.poses {
         Some(p) => Ego::Recorded(p),
-        None => Ego::Lidar(LidarOdometry::new(OdometryConfig::default())?),
+        None => Ego::Lidar(Box::new(LidarOdometry::new(OdometryConfig::default())?)),
     };
     let mut out = Vec::with_capacity(scans.len());
     let total = scans.len();
