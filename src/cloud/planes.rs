@@ -70,7 +70,7 @@ mod pieces;
 mod plane_f32;
 mod ransac;
 
-pub use config::{PlaneConfig, WallQuality};
+pub use config::{PlaneConfig, WallQuality, MAX_WALL_REFITS};
 
 use crate::cloud::PointCloud;
 use crate::error::{Error, Result};

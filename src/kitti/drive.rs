@@ -13,7 +13,9 @@
 //! Opening lists the frame files only; clouds, packets, stamps and calibration are read when
 //! asked for. Either sensor folder may be absent: a drive without OXTS still gives point clouds,
 //! and asking it for poses is an error naming the missing folder. [`RawDrive::check`] reports
-//! every inconsistency at once.
+//! every inconsistency at once. A scan missing inside the numbering is a dropped scan (drive
+//! 0009 lacks 177–180; their OXTS packets are there and their stamp lines blank): the drive's
+//! frames are those the scans span, and [`RawDrive::has_scan`] tells which have one.
 //!
 //! Not for: camera images, the odometry benchmark layout (see [`super::odometry`]) or the
 //! tracking benchmark layout (see [`super::tracking`]).
@@ -279,9 +281,10 @@ impl RawDrive {
     }
 
     /// Every inconsistency of the drive on disk: missing sensor folders, timestamp files or
-    /// calibration files; gaps in frame numbering; frame counts that disagree between the data
-    /// folders and their timestamp files; OXTS files or timestamp files that do not parse; stamps
-    /// that do not increase; `.bin` files whose size is not a multiple of 16 bytes.
+    /// calibration files; gaps in the OXTS numbering and dropped scans
+    /// ([`Issue::DroppedScans`]); frame counts that disagree between the data folders and their
+    /// timestamp files; OXTS files or timestamp files that do not parse; stamps that do not
+    /// increase; `.bin` files whose size is not a multiple of 16 bytes.
     /// An empty list means the drive is consistent.
     pub fn check(&self) -> Vec<Issue> {
         let mut issues = Vec::new();

@@ -12,7 +12,9 @@
 //! frame for frame), and poses, Velodyne poses and vehicle states are computed exactly as
 //! [`super::drive::RawDrive`] computes them, from the OXTS packets and `Tr_imu_velo` with
 //! [`super::poses`]. The layout keeps no time stamps: frame k is taken at k·[`FRAME_PERIOD`]
-//! (the recordings' 10 Hz).
+//! (the recordings' 10 Hz). A scan missing inside the numbering is a dropped scan (sequence
+//! 0001 has none for frames 177–180, whose OXTS lines and labels are there): the sequence's
+//! frames are those the scans span, and [`TrackingSequence::has_scan`] tells which have one.
 //!
 //! Opening lists the scans only; everything else is read when asked for. [`TrackingSequence::check`]
 //! reports every inconsistency at once.
@@ -458,7 +460,7 @@ impl TrackingSequence {
     }
 
     /// Every inconsistency of the sequence on disk: missing scan folder, OXTS or calibration
-    /// file; gaps in the scan numbering; an OXTS file, calibration or label file that does not
+    /// file; dropped scans inside the numbering ([`Issue::DroppedScans`]); an OXTS file, calibration or label file that does not
     /// parse; OXTS packets or label frames that disagree with the scans; `.bin` files whose
     /// size is not a multiple of 16 bytes. A missing label file is not an issue (the testing
     /// split has none). An empty list means the sequence is consistent.
