@@ -94,20 +94,25 @@ pub fn run(args: Args) -> Result<()> {
     }
     if let Some(reference) = &input.reference {
         let (name, poses) = reference_poses(reference)?;
-        let last = input.frames.get(estimate.len().saturating_sub(1)).copied();
-        if estimate.len() > input.frames.len() || last.is_none_or(|k| poses.len() <= k) {
+        // The frame of each estimated pose: the scans' own numbers, and consecutive ones after
+        // the last (a scored file may hold more poses than there are scans).
+        let gap = input
+            .frames
+            .last()
+            .map_or(0, |&l| l + 1 - input.frames.len());
+        let frame = |i: usize| input.frames.get(i).copied().unwrap_or(i + gap);
+        if estimate
+            .len()
+            .checked_sub(1)
+            .is_some_and(|l| poses.len() <= frame(l))
+        {
             bail!(
                 "{name}: the reference has {} poses for {} scans",
                 poses.len(),
                 estimate.len()
             );
         }
-        // The reference at the scans' frames, from the first scan's frame on.
-        let first = poses[input.frames[0]].inverse();
-        let at_scans: Vec<Isometry3<f64>> = input.frames[..estimate.len()]
-            .iter()
-            .map(|&k| first * poses[k])
-            .collect();
+        let at_scans: Vec<Isometry3<f64>> = (0..estimate.len()).map(|i| poses[frame(i)]).collect();
         report(&estimate, &at_scans, &name)?;
     }
     Ok(())
