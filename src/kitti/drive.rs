@@ -21,7 +21,9 @@
 //! tracking benchmark layout (see [`super::tracking`]).
 
 use super::calib::{read_cam_to_cam, read_rigid_calib, CamToCamCalib, RigidCalib};
-use super::frames::{list_frame_files, numbering_gaps, require_contiguous, ScanFolder};
+use super::frames::{
+    list_frame_files, listed_path, numbering_gaps, require_contiguous, ScanFolder,
+};
 use super::issue::Issue;
 use super::oxts::{read_oxts_file, OxtsPacket};
 use super::poses::{self, VehicleState};
@@ -219,6 +221,32 @@ impl RawDrive {
         read_timestamps(self.velodyne_timestamps_path())
     }
 
+    /// The Velodyne frames' times, seconds since the first stamp, one per frame (a dropped
+    /// scan's interpolated from its blank line).
+    ///
+    /// Errors (naming the file): it cannot be read, its stamps are not one per frame, or a
+    /// frame with a scan has a blank line (naming that line).
+    pub fn scan_times(&self) -> Result<Vec<f64>> {
+        let path = self.velodyne_timestamps_path();
+        let t = self.timestamps()?;
+        let n = self.frame_count();
+        if t.len() != n {
+            return Err(Error::invalid(
+                format!("{}", path.display()),
+                format!("has {} stamps for {n} Velodyne frames", t.len()),
+            ));
+        }
+        if let Some(&k) = t.blank.iter().find(|&&k| self.has_scan(k)) {
+            return Err(Error::parse(
+                path,
+                k + 1,
+                "timestamp",
+                format!("blank, but frame {k} has a scan"),
+            ));
+        }
+        Ok(t.seconds)
+    }
+
     /// OXTS time stamps (`oxts/timestamps.txt`).
     pub fn oxts_timestamps(&self) -> Result<Timestamps> {
         read_timestamps(self.oxts_timestamps_path())
@@ -351,7 +379,7 @@ impl RawDrive {
                     if let Some(&i) = stamps
                         .blank
                         .iter()
-                        .find(|&&i| files.binary_search_by_key(&(i as u64), |f| f.0).is_ok())
+                        .find(|&&i| listed_path(files, i as u64).is_some())
                     {
                         issues.push(Issue::Unreadable {
                             path: stamps_path.clone(),

@@ -111,8 +111,9 @@ impl LidarOdometry {
     /// Registers a scan taken `steps` frame periods after the last one: more than one when
     /// the scans between them were dropped (KITTI's drive 0009 lacks four). The
     /// constant-velocity prediction repeats the last frame's motion `steps` times, and the
-    /// motion kept for the next scan is the registered one spread evenly over the steps
-    /// (its translation and rotation angle divided by `steps`). `steps` 0 counts as 1.
+    /// motion kept for the next scan is one of `steps` equal steps that make the registered
+    /// one (its `steps`-th root: the rotation angle divided by `steps` about the same axis,
+    /// the translation that the steps add up to). `steps` 0 counts as 1.
     pub fn register_after(&mut self, cloud: &PointCloud, steps: usize) -> Result<Registered> {
         // On one of rayon's threads: each ICP iteration's parallel pass then starts without
         // handing its work to the pool and waiting for it.

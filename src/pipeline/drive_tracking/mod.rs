@@ -582,23 +582,7 @@ pub fn track_drive(
     )?;
     let vehicle = ect_states(config, || drive.vehicle_states())?;
     let times: Vec<f64> = if drive.velodyne_timestamps_path().is_file() {
-        let path = drive.velodyne_timestamps_path();
-        let t = drive.timestamps()?;
-        if t.len() != n {
-            return Err(Error::invalid(
-                format!("{}", path.display()),
-                format!("has {} stamps for {n} Velodyne frames", t.len()),
-            ));
-        }
-        if let Some(&k) = t.blank.iter().find(|&&k| drive.has_scan(k)) {
-            return Err(Error::parse(
-                path,
-                k + 1,
-                "timestamp",
-                format!("blank, but frame {k} has a scan"),
-            ));
-        }
-        t.seconds
+        drive.scan_times()?
     } else {
         (0..n).map(|k| k as f64 * config.dt).collect()
     };
