@@ -190,6 +190,36 @@ fn a_short_reference_is_refused_naming_the_file() {
     );
 }
 
+/// A scored pose file may hold more poses than the folder has scans: they are compared with
+/// the reference's frames in order; one more than the reference holds is refused.
+#[test]
+fn a_scored_file_longer_than_the_scans_is_compared_frame_by_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let scans = standing_scans(dir.path());
+    let (scored, reference) = (dir.path().join("scored.txt"), dir.path().join("ref.txt"));
+    std::fs::write(&scored, identity_lines(3)).unwrap();
+    std::fs::write(&reference, identity_lines(3)).unwrap();
+    let score = |extra: &[&str]| {
+        let mut args = vec![
+            "odometry",
+            "--scans",
+            scans.to_str().unwrap(),
+            "--evaluate",
+            scored.to_str().unwrap(),
+            "--reference",
+            reference.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        run(&args)
+    };
+    let (good, stdout, stderr) = score(&[]);
+    assert!(good, "{stdout}\n{stderr}");
+    assert!(stdout.contains("over 2 pairs"), "{stdout}");
+    std::fs::write(&scored, identity_lines(4)).unwrap();
+    let (good, _, stderr) = score(&[]);
+    assert!(!good && stderr.contains("3 poses for 4 scans"), "{stderr}");
+}
+
 /// A raw drive whose scans 3 and 4 were dropped (KITTI keeps their OXTS packets and leaves
 /// their time stamp lines blank): the scan after the gap is registered after three frame
 /// steps, not one, and scored against the reference at its own frame.
