@@ -13,10 +13,10 @@
 
 use rand::RngExt;
 use rand_distr::{Distribution, StandardNormal};
+use smc_lmb::filter::{check_state_dim, StepContext, TransitionModel};
 use smc_lmb::filter::{
     AdaptiveBirth, Frame, LmbConfig, LmbFilter, Measurements, ParticleSet, PositionBirthSampler,
 };
-use smc_lmb::filter::{StepContext, TransitionModel};
 use smc_lmb::metrics::ospa;
 use smc_lmb::models::{ConstantDetection, PositionMeasurement, UniformClutter};
 use smc_lmb::rng::seeded;
@@ -33,7 +33,14 @@ impl TransitionModel for OrnsteinUhlenbeck {
         4
     }
 
-    fn predict(&self, particles: &mut ParticleSet, ctx: &StepContext, rng: &mut FilterRng) {
+    fn predict(
+        &self,
+        particles: &mut ParticleSet,
+        ctx: &StepContext,
+        rng: &mut FilterRng,
+    ) -> Result<(), smc_lmb::Error> {
+        // A state too short for [x, ẋ, y, ẏ] is an error, never a silent no-op.
+        check_state_dim("OrnsteinUhlenbeck", 4, particles)?;
         let decay = (-ctx.dt / self.tau).exp();
         let kick = self.sigma * (1.0 - decay * decay).sqrt();
         let mut c = particles.components_mut(); // [x, ẋ, y, ẏ] as contiguous columns
@@ -45,6 +52,7 @@ impl TransitionModel for OrnsteinUhlenbeck {
                 *x += ctx.dt * *v;
             }
         }
+        Ok(())
     }
 }
 
@@ -97,7 +105,7 @@ fn main() -> Result<(), smc_lmb::Error> {
     for k in 0..steps {
         let ctx = StepContext::new(k, k as f64, 1.0);
         if k > 0 {
-            model.predict(&mut truth, &ctx, &mut sim_rng);
+            model.predict(&mut truth, &ctx, &mut sim_rng).unwrap();
         }
         let objects: Vec<Vec<f64>> = (0..3)
             .map(|i| vec![truth.component(0)[i], truth.component(2)[i]])

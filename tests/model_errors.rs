@@ -38,13 +38,19 @@ impl TransitionModel for BlowsUp {
     fn state_dim(&self) -> usize {
         4
     }
-    fn predict(&self, p: &mut ParticleSet, ctx: &StepContext, rng: &mut FilterRng) {
-        self.inner.predict(p, ctx, rng);
+    fn predict(
+        &self,
+        p: &mut ParticleSet,
+        ctx: &StepContext,
+        rng: &mut FilterRng,
+    ) -> smc_lmb::Result<()> {
+        self.inner.predict(p, ctx, rng)?;
         for x in p.component_mut(0) {
             if *x > self.x_max {
                 *x = f64::INFINITY;
             }
         }
+        Ok(())
     }
 }
 

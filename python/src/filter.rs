@@ -137,7 +137,7 @@ fn frame(time: f64, z: &Table, pose: Option<Isometry3<f64>>) -> smc_lmb::Result<
 
 impl PyLmbFilter {
     /// Runs frames with the GIL released; a Python model's exception replaces the library's
-    /// error about the NaN state it left behind.
+    /// error (which names the track and step, kept as a note on the exception).
     fn run_frames(&mut self, py: Python<'_>, frames: Vec<Frame>) -> PyResult<Vec<Vec<Estimate>>> {
         let (filter, rng, ms) = (&mut self.filter, &mut self.rng, &mut self.step_ms);
         let result = py.detach(|| {
@@ -320,7 +320,7 @@ impl smc_lmb::filter::TransitionModel for SharedModel {
         particles: &mut smc_lmb::filter::ParticleSet,
         ctx: &smc_lmb::filter::StepContext,
         rng: &mut FilterRng,
-    ) {
+    ) -> smc_lmb::Result<()> {
         self.0.predict(particles, ctx, rng)
     }
 }

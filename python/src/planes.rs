@@ -21,7 +21,7 @@ use smc_lmb::cloud::PointCloud;
 use smc_lmb::geometry::PlanePatch;
 use smc_lmb::kitti::{OdometrySequence, RawDrive, TrackingSequence};
 use smc_lmb::metrics::{PlanePairError, PlanePredictionSummary};
-use smc_lmb::models::ExtendedConstantTurn;
+use smc_lmb::models::{ExtendedConstantTurn, SharedVehicleModel};
 use smc_lmb::pipeline::plane_prediction::{self as pp, PairPrediction, PlanePredictionConfig};
 use smc_lmb::rng::seeded;
 use std::path::PathBuf;
@@ -187,10 +187,10 @@ fn prediction_config(options: Option<&Bound<'_, PyDict>>) -> PyResult<PlanePredi
         }
     }
     if sa.is_some() || st.is_some() {
-        c.ect = lib(ExtendedConstantTurn::new(
+        c.vehicle = SharedVehicleModel::new(lib(ExtendedConstantTurn::new(
             sa.unwrap_or(0.5),
             st.unwrap_or(0.1),
-        ))?;
+        ))?);
     }
     lib(c.validate())?;
     Ok(c)

@@ -16,13 +16,13 @@ use numpy::IntoPyArray;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use rand::Rng;
-use smc_lmb::filter::{ParticleSet, StepContext, TransitionModel};
+use smc_lmb::filter::{check_state_dim, ParticleSet, StepContext, TransitionModel};
 use smc_lmb::FilterRng;
 use std::sync::Mutex;
 
 /// The Python callable as a [`TransitionModel`]. A failing call (an exception, or a result of
-/// the wrong shape) leaves the particle set NaN, which makes the filter step fail naming the
-/// track; the Python exception is kept and raised instead by [`PyTransition::take_error`].
+/// the wrong shape) is an error of the step, which names the track; the Python exception is
+/// kept and raised instead by [`PyTransition::take_error`].
 pub struct PyTransition {
     func: Py<PyAny>,
     dim: usize,
@@ -93,15 +93,23 @@ impl TransitionModel for PyTransition {
         self.dim
     }
 
-    fn predict(&self, particles: &mut ParticleSet, ctx: &StepContext, rng: &mut FilterRng) {
+    fn predict(
+        &self,
+        particles: &mut ParticleSet,
+        ctx: &StepContext,
+        rng: &mut FilterRng,
+    ) -> smc_lmb::Result<()> {
+        check_state_dim("the Python transition", self.dim, particles)?;
         let seed = rng.next_u64();
-        if let Err(e) = Python::attach(|py| self.call(py, particles, ctx.dt, seed)) {
-            let mut slot = self.error.lock().unwrap_or_else(|p| p.into_inner());
-            if slot.is_none() {
-                *slot = Some(e);
-            }
-            for col in particles.components_mut() {
-                col.fill(f64::NAN);
+        match Python::attach(|py| self.call(py, particles, ctx.dt, seed)) {
+            Ok(()) => Ok(()),
+            Err(e) => {
+                let why = e.to_string();
+                let mut slot = self.error.lock().unwrap_or_else(|p| p.into_inner());
+                if slot.is_none() {
+                    *slot = Some(e);
+                }
+                Err(smc_lmb::Error::invalid("the Python transition", why))
             }
         }
     }

@@ -107,7 +107,7 @@ impl crate::filter::BirthSampler for MeasurementBirth {
             mean.push(0.0);
             std.push(self.turn_rate_std);
         }
-        let mut set = ParticleSet::gaussian(&mean, &std, n, rng);
+        let mut set = ParticleSet::sampled(&mean, &std, n, rng);
         if let Some(rb) = &self.range_bearing {
             // Spread along the measurement's own uncertainty as well: perturb each particle's
             // range and bearing and convert again.

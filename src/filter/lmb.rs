@@ -251,12 +251,18 @@ impl LmbFilterBuilder {
         self
     }
 
-    /// Checks that every required model is present and the config is valid.
+    /// Checks that every required model is present, that the models agree on the state
+    /// (the birth model draws states of the transition's length, the measurement model reads
+    /// no more components than the transition moves; see [`TransitionModel::state_dim`],
+    /// [`BirthModel::state_dim`], [`MeasurementModel::state_dim`]) and that the config is
+    /// valid. A disagreement names both models and their dimensions.
     pub fn build(self) -> Result<LmbFilter> {
         self.config.validate()?;
         let missing = |what: &str| Error::invalid("filter", format!("no {what} model given"));
         let transition = self.transition.ok_or_else(|| missing("transition"))?;
         let measurement = self.measurement.ok_or_else(|| missing("measurement"))?;
+        let birth = self.birth.ok_or_else(|| missing("birth"))?;
+        check_dimensions(&*transition, &*measurement, &*birth)?;
         Ok(LmbFilter {
             models: Models {
                 transition,
@@ -266,7 +272,7 @@ impl LmbFilterBuilder {
                 measurement,
                 detection: self.detection.ok_or_else(|| missing("detection"))?,
                 clutter: self.clutter.ok_or_else(|| missing("clutter"))?,
-                birth: self.birth.ok_or_else(|| missing("birth"))?,
+                birth,
                 associator: self
                     .associator
                     .unwrap_or_else(|| Box::new(AssociationMethod::default())),
@@ -286,6 +292,49 @@ impl LmbFilterBuilder {
             pending: None,
         })
     }
+}
+
+/// The builder's comparison of the models' dimensions (see [`LmbFilterBuilder::build`]).
+fn check_dimensions(
+    transition: &dyn TransitionModel,
+    measurement: &dyn MeasurementModel,
+    birth: &dyn BirthModel,
+) -> Result<()> {
+    let d = transition.state_dim();
+    if d == 0 {
+        return Err(Error::invalid(
+            "filter",
+            format!("{} moves states of 0 components", transition.name()),
+        ));
+    }
+    let md = measurement.measurement_dim();
+    if let Some(b) = birth.state_dim(md) {
+        if b != d {
+            return Err(Error::invalid(
+                "filter",
+                format!(
+                    "the birth model {} draws states of {b} components (for measurements of {md}), \
+                     but the transition {} moves states of {d}",
+                    birth.name(),
+                    transition.name()
+                ),
+            ));
+        }
+    }
+    if let Some(m) = measurement.state_dim() {
+        if m > d {
+            return Err(Error::invalid(
+                "filter",
+                format!(
+                    "the measurement model {} reads states of {m} components, but the \
+                     transition {} moves states of {d}",
+                    measurement.name(),
+                    transition.name()
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 struct Models {
@@ -540,7 +589,7 @@ impl LmbFilter {
         else {
             unreachable!("checked above");
         };
-        self.add_births(&ctx, z, seed, &summaries);
+        self.add_births(&ctx, z, seed, &summaries)?;
         let predicted = self.predicted_copies();
         let likelihoods = self.likelihoods(z, &ctx, &summaries)?;
         let marginals = self.associate(z, &ctx, &likelihoods, seed);
@@ -667,7 +716,9 @@ impl LmbFilter {
                 t.existence *= eta_s.clamp(0.0, 1.0);
                 t.particles.keep_history(lag);
                 t.particles.push_history();
-                m.transition.predict(&mut t.particles, ctx, &mut rng);
+                if let Err(e) = m.transition.predict(&mut t.particles, ctx, &mut rng) {
+                    return Some(format!("track {}: {e}", t.label));
+                }
                 t.age += 1;
                 (0..t.particles.dim()).find_map(|c| {
                     let v = t.particles.component(c);
@@ -696,7 +747,7 @@ impl LmbFilter {
         z: &Measurements,
         seed: u64,
         summaries: &[TrackSummary],
-    ) {
+    ) -> Result<()> {
         let evidence = self.previous.as_ref().map(|p| BirthEvidence {
             measurements: &p.measurements,
             assigned: &p.assigned,
@@ -720,24 +771,44 @@ impl LmbFilter {
         );
         let step = self.step;
         let transition = &self.models.transition;
-        let new: Vec<Track> = births
+        let dim = transition.state_dim();
+        let new: Result<Vec<Track>> = births
             .into_par_iter()
             .enumerate()
             .filter(|(_, b)| b.existence > 0.0 && !b.particles.is_empty())
             .map(|(i, b)| {
                 let label = Label::new(step, i as u32);
+                if b.particles.dim() != dim {
+                    return Err(Error::invalid(
+                        format!("birth {label} of step {step}"),
+                        format!(
+                            "{} drew states of {} components, but {} moves states of {dim}",
+                            m.birth.name(),
+                            b.particles.dim(),
+                            transition.name()
+                        ),
+                    ));
+                }
                 let mut particles = b.particles;
                 if b.at_previous_step && ctx.dt > 0.0 {
-                    transition.predict(
-                        &mut particles,
-                        ctx,
-                        &mut stream(seed, KEY_PREDICT ^ label.key()),
-                    );
+                    transition
+                        .predict(
+                            &mut particles,
+                            ctx,
+                            &mut stream(seed, KEY_PREDICT ^ label.key()),
+                        )
+                        .map_err(|e| {
+                            Error::invalid(
+                                format!("prediction of birth {label} of step {step}"),
+                                e.to_string(),
+                            )
+                        })?;
                 }
-                Track::new(label, b.existence.min(1.0), particles)
+                Ok(Track::new(label, b.existence.min(1.0), particles))
             })
             .collect();
-        self.tracks.extend(new);
+        self.tracks.extend(new?);
+        Ok(())
     }
 
     /// Gating and the particle sums η_j(ℓ) and η_miss(ℓ) for every track, in parallel; the

@@ -149,7 +149,7 @@ pub fn merge_into(survivor: &mut Track, absorbed: &mut Track) -> bool {
         .expected_detections
         .max(absorbed.expected_detections);
     absorbed.existence = 0.0;
-    absorbed.particles = ParticleSet::zeros(absorbed.particles.dim(), 0);
+    absorbed.particles = ParticleSet::zeroed(absorbed.particles.dim(), 0);
     true
 }
 

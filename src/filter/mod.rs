@@ -40,8 +40,8 @@ pub use lmb::{
 pub use measurements::Measurements;
 pub use merge::{MergeDistance, ScaledDistance};
 pub use model::{
-    relative_from_logs, ClutterModel, DetectionModel, LikelihoodFault, MeasurementModel,
-    StepContext, SurvivalModel, TrackSummary, TransitionModel,
+    check_state_dim, model_name, relative_from_logs, ClutterModel, DetectionModel, LikelihoodFault,
+    MeasurementModel, StepContext, SurvivalModel, TrackSummary, TransitionModel,
 };
 pub use particles::{Jitter, ParticleSet};
 pub use smoothing::FixedLagSmoother;

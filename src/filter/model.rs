@@ -24,6 +24,7 @@
 //! [`super::lmb`]).
 
 use super::{Measurements, ParticleSet};
+use crate::error::{Error, Result};
 use crate::rng::FilterRng;
 use nalgebra::Isometry3;
 
@@ -89,6 +90,43 @@ impl TrackSummary {
     }
 }
 
+/// The short name of a model type (its path without the modules), for errors that name a
+/// model: `ConstantVelocity`, `Box<dyn TransitionModel>` forwards to the boxed model's.
+pub fn model_name<T: ?Sized>() -> String {
+    let full = std::any::type_name::<T>();
+    // Keep generic arguments readable: strip the module path of every path segment.
+    let mut out = String::with_capacity(full.len());
+    let mut word = String::new();
+    for ch in full.chars() {
+        if ch.is_alphanumeric() || ch == '_' || ch == ':' {
+            word.push(ch);
+        } else {
+            out.push_str(word.rsplit("::").next().unwrap_or(""));
+            word.clear();
+            out.push(ch);
+        }
+    }
+    out.push_str(word.rsplit("::").next().unwrap_or(""));
+    out
+}
+
+/// Checks the contract of [`TransitionModel::predict`]: a non-empty particle set must have at
+/// least `state_dim` components (a model reads and moves the first `state_dim`; a longer
+/// state, such as the drive tracker's kind-tagged one, keeps its extra components). Names
+/// `model` and both dimensions otherwise.
+pub fn check_state_dim(model: &str, state_dim: usize, particles: &ParticleSet) -> Result<()> {
+    if particles.is_empty() || particles.dim() >= state_dim {
+        return Ok(());
+    }
+    Err(Error::invalid(
+        format!("state handed to {model}"),
+        format!(
+            "{} components, but the model moves states of {state_dim}",
+            particles.dim()
+        ),
+    ))
+}
+
 /// Moves a whole particle set one step forward (Markov transition density f(x' | x)).
 ///
 /// Implementations sample the process noise themselves, from `rng`, so that a user's model
@@ -96,8 +134,20 @@ impl TrackSummary {
 pub trait TransitionModel: Send + Sync {
     /// Dimension of the state vector this model moves.
     fn state_dim(&self) -> usize;
-    /// Replaces every particle by a draw from f(· | particle).
-    fn predict(&self, particles: &mut ParticleSet, ctx: &StepContext, rng: &mut FilterRng);
+    /// Replaces every particle by a draw from f(· | particle). A set whose states are shorter
+    /// than [`TransitionModel::state_dim`] is an error (see [`check_state_dim`]), never left
+    /// unchanged; so is anything else the model cannot do with the set. The filter turns the
+    /// error into the step's, naming the track.
+    fn predict(
+        &self,
+        particles: &mut ParticleSet,
+        ctx: &StepContext,
+        rng: &mut FilterRng,
+    ) -> Result<()>;
+    /// The model's name in errors; the type's name by default.
+    fn name(&self) -> String {
+        model_name::<Self>()
+    }
 }
 
 /// Probability p_S(x) that an object survives from the previous step to this one.
@@ -153,6 +203,16 @@ pub fn relative_from_logs(rows: &mut [Vec<f64>], tops: &mut [f64]) -> Result<(),
 pub trait MeasurementModel: Send + Sync {
     /// Dimension of one measurement vector.
     fn measurement_dim(&self) -> usize;
+    /// The length of the states the model reads (its likelihood looks at their first
+    /// `state_dim` components), when it knows it: the filter's builder refuses a transition
+    /// whose states are shorter. `None` (the default) skips that check.
+    fn state_dim(&self) -> Option<usize> {
+        None
+    }
+    /// The model's name in errors; the type's name by default.
+    fn name(&self) -> String {
+        model_name::<Self>()
+    }
     /// Writes log g(z | xᵢ) of every particle into `out`. Must be finite or −∞: NaN or +∞
     /// makes the filter step fail with an error naming the track.
     fn log_likelihood(
@@ -236,8 +296,16 @@ impl<T: TransitionModel + ?Sized> TransitionModel for Box<T> {
     fn state_dim(&self) -> usize {
         (**self).state_dim()
     }
-    fn predict(&self, particles: &mut ParticleSet, ctx: &StepContext, rng: &mut FilterRng) {
+    fn predict(
+        &self,
+        particles: &mut ParticleSet,
+        ctx: &StepContext,
+        rng: &mut FilterRng,
+    ) -> Result<()> {
         (**self).predict(particles, ctx, rng)
+    }
+    fn name(&self) -> String {
+        (**self).name()
     }
 }
 
@@ -250,6 +318,12 @@ impl<T: SurvivalModel + ?Sized> SurvivalModel for Box<T> {
 impl<T: MeasurementModel + ?Sized> MeasurementModel for Box<T> {
     fn measurement_dim(&self) -> usize {
         (**self).measurement_dim()
+    }
+    fn state_dim(&self) -> Option<usize> {
+        (**self).state_dim()
+    }
+    fn name(&self) -> String {
+        (**self).name()
     }
     fn log_likelihood(
         &self,

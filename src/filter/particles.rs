@@ -16,6 +16,7 @@
 
 mod history;
 
+use crate::error::{ensure_finite, Error, Result};
 use crate::rng::FilterRng;
 use rand::RngExt;
 use rand_distr::{Distribution, StandardNormal};
@@ -74,9 +75,56 @@ impl Default for Jitter {
 }
 
 impl ParticleSet {
-    /// `len` particles of dimension `dim`, all at the origin, equally weighted.
-    pub fn zeros(dim: usize, len: usize) -> Self {
-        assert!(dim > 0, "particle dimension must be positive");
+    /// `len` particles of dimension `dim`, all at the origin, equally weighted. Fails on a
+    /// dimension of 0 or a set larger than memory can hold.
+    pub fn zeros(dim: usize, len: usize) -> Result<Self> {
+        if dim == 0 {
+            return Err(Error::invalid(
+                "particle set",
+                "dimension 0 (must be positive)",
+            ));
+        }
+        if dim
+            .checked_mul(len)
+            .is_none_or(|n| n > isize::MAX as usize / 8)
+        {
+            return Err(Error::invalid(
+                "particle set",
+                format!("{len} particles of {dim} components do not fit in memory"),
+            ));
+        }
+        Ok(Self::zeroed(dim, len))
+    }
+
+    /// `len` equally weighted particles drawn from N(mean, diag(std²)). Fails when `mean` and
+    /// `std` differ in length or are empty, or a value is not finite or a deviation negative,
+    /// naming the component.
+    pub fn gaussian(mean: &[f64], std: &[f64], len: usize, rng: &mut FilterRng) -> Result<Self> {
+        if mean.len() != std.len() {
+            return Err(Error::invalid(
+                "Gaussian particle set",
+                format!(
+                    "a mean of {} components and a std of {}",
+                    mean.len(),
+                    std.len()
+                ),
+            ));
+        }
+        ensure_finite("mean of a Gaussian particle set", mean)?;
+        ensure_finite("std of a Gaussian particle set", std)?;
+        if let Some(c) = std.iter().position(|s| *s < 0.0) {
+            return Err(Error::invalid(
+                "std of a Gaussian particle set",
+                format!("component {c} is {} (must be non-negative)", std[c]),
+            ));
+        }
+        Self::zeros(mean.len(), len)?;
+        Ok(Self::sampled(mean, std, len, rng))
+    }
+
+    /// [`ParticleSet::zeros`] for a dimension the caller has checked.
+    pub(crate) fn zeroed(dim: usize, len: usize) -> Self {
+        debug_assert!(dim > 0, "particle dimension must be positive");
         let w = if len > 0 { 1.0 / len as f64 } else { 0.0 };
         ParticleSet {
             dim,
@@ -90,14 +138,10 @@ impl ParticleSet {
         }
     }
 
-    /// `len` equally weighted particles drawn from N(mean, diag(std²)).
-    pub fn gaussian(mean: &[f64], std: &[f64], len: usize, rng: &mut FilterRng) -> Self {
-        assert_eq!(
-            mean.len(),
-            std.len(),
-            "mean and std must have the same dimension"
-        );
-        let mut set = Self::zeros(mean.len(), len);
+    /// [`ParticleSet::gaussian`] for a mean and deviations the caller has checked.
+    pub(crate) fn sampled(mean: &[f64], std: &[f64], len: usize, rng: &mut FilterRng) -> Self {
+        debug_assert_eq!(mean.len(), std.len());
+        let mut set = Self::zeroed(mean.len(), len);
         for (c, (&m, &s)) in mean.iter().zip(std).enumerate() {
             for v in set.component_mut(c) {
                 let e: f64 = StandardNormal.sample(rng);
@@ -115,7 +159,7 @@ impl ParticleSet {
         if dim == 0 || weights.len() != len || rows.iter().any(|r| r.len() != dim) {
             return None;
         }
-        let mut set = Self::zeros(dim, len);
+        let mut set = Self::zeroed(dim, len);
         for (i, row) in rows.iter().enumerate() {
             for (c, &v) in row.iter().enumerate() {
                 set.states[c * len + i] = v;
@@ -394,7 +438,7 @@ impl ParticleSet {
     /// Systematic resampling to `n` equally weighted particles.
     pub fn resample_systematic(&mut self, n: usize, rng: &mut FilterRng) {
         if self.len == 0 || n == 0 {
-            *self = Self::zeros(self.dim, 0);
+            *self = Self::zeroed(self.dim, 0);
             return;
         }
         let step = 1.0 / n as f64;
@@ -486,7 +530,7 @@ mod tests {
     #[test]
     fn reweight_with_no_usable_total_leaves_the_weights() {
         let mut rng = seeded(2);
-        let mut p = ParticleSet::gaussian(&[0.0], &[1.0], 4, &mut rng);
+        let mut p = ParticleSet::sampled(&[0.0], &[1.0], 4, &mut rng);
         p.reweight(&[1.0, 2.0, 3.0, 4.0]);
         let before = p.weights().to_vec();
         assert_eq!(p.reweight(&[0.0; 4]), 0.0);
@@ -505,7 +549,7 @@ mod tests {
     #[test]
     fn reweight_survives_total_underflow() {
         let mut rng = seeded(1);
-        let mut p = ParticleSet::gaussian(&[0.0, 0.0], &[1.0, 1.0], 100, &mut rng);
+        let mut p = ParticleSet::sampled(&[0.0, 0.0], &[1.0, 1.0], 100, &mut rng);
         let logs: Vec<f64> = (0..100).map(|i| -5000.0 - i as f64).collect();
         let lz = p.reweight_log(&logs);
         assert!(lz.is_finite());
@@ -582,7 +626,7 @@ mod tests {
         #[test]
         fn weights_stay_normalised(logs in proptest::collection::vec(-1e4f64..1e4, 1..64), n in 1usize..200, seed in 0u64..1000) {
             let mut rng = seeded(seed);
-            let mut p = ParticleSet::gaussian(&[1.0, -2.0, 0.5], &[1.0, 2.0, 0.1], logs.len(), &mut rng);
+            let mut p = ParticleSet::sampled(&[1.0, -2.0, 0.5], &[1.0, 2.0, 0.1], logs.len(), &mut rng);
             p.reweight_log(&logs);
             let s: f64 = p.weights().iter().sum();
             prop_assert!((s - 1.0).abs() < 1e-9);

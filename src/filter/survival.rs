@@ -54,7 +54,7 @@ mod tests {
 
     #[test]
     fn fills_every_particle() {
-        let p = ParticleSet::zeros(4, 3);
+        let p = ParticleSet::zeroed(4, 3);
         let mut out = vec![0.0; 3];
         ConstantSurvival::new(0.99).unwrap().survival_probability(
             &p,

@@ -8,12 +8,40 @@
 //!
 //! Not for: segmenting planes from point clouds (see [`crate::cloud::planes`]).
 
+use super::FrameChange;
 use crate::error::{Error, Result};
 use nalgebra::{Isometry3, Matrix3, Point2, Point3, SymmetricEigen, Vector2, Vector3};
 
 /// Tolerance on `|d|` below which a plane counts as passing through the origin when choosing
 /// the canonical orientation of its normal (metres).
 const ORIGIN_EPS: f64 = 1e-12;
+
+/// Whether the unit-normal plane (`normal`, `offset`) must be negated to be canonical: the
+/// one sign rule of the crate (see [`Plane`]).
+fn flips(normal: [f64; 3], offset: f64) -> bool {
+    if offset.abs() > ORIGIN_EPS {
+        offset < 0.0
+    } else {
+        let [x, y, z] = normal;
+        [z, y, x].into_iter().find(|c| *c != 0.0).unwrap_or(0.0) < 0.0
+    }
+}
+
+/// The canonical representative of β = [n, d]: the normal scaled to unit length (d with it)
+/// and the sign of [`Plane`] (d ≥ 0, the normal towards the origin; through the origin, the
+/// first non-zero of n_z, n_y, n_x positive). A zero or non-finite normal is returned as it is.
+pub fn canonical(beta: &[f64; 4]) -> [f64; 4] {
+    let [x, y, z, d] = *beta;
+    let norm = (x * x + y * y + z * z).sqrt();
+    if !(norm.is_finite() && norm > 0.0) {
+        return *beta;
+    }
+    let mut s = 1.0 / norm;
+    if flips([x * s, y * s, z * s], d * s) {
+        s = -s;
+    }
+    [x * s, y * s, z * s, d * s]
+}
 
 /// An infinite plane `{p : n·p + d = 0}` with a unit normal `n`.
 ///
@@ -49,16 +77,7 @@ impl Plane {
 
     /// Flips `(n, d)` to the canonical orientation described on [`Plane`].
     fn canonical(normal: Vector3<f64>, offset: f64) -> Self {
-        let flip = if offset.abs() > ORIGIN_EPS {
-            offset < 0.0
-        } else {
-            let key = [normal.z, normal.y, normal.x]
-                .into_iter()
-                .find(|c| *c != 0.0)
-                .unwrap_or(0.0);
-            key < 0.0
-        };
-        if flip {
+        if flips([normal.x, normal.y, normal.z], offset) {
             Plane {
                 normal: -normal,
                 offset: -offset,
@@ -133,12 +152,17 @@ impl Plane {
         p - self.normal * self.signed_distance(p)
     }
 
-    /// The plane expressed in the frame where points map as `p' = T p`: `n' = R n`,
-    /// `d' = d − n'·t`, then put back in canonical orientation.
+    /// The plane expressed in the frame where points map as `p' = T p` (see
+    /// [`Plane::moved_by`]).
     pub fn transform(&self, pose: &Isometry3<f64>) -> Self {
-        let normal = pose.rotation * self.normal;
-        let offset = self.offset - normal.dot(&pose.translation.vector);
-        Self::canonical(normal, offset)
+        self.moved_by(&FrameChange::from_isometry(pose))
+    }
+
+    /// The plane in the new frame of `change` ([`FrameChange::move_plane`]: `n' = R n`,
+    /// `d' = d − n'·t`, renormalised), put back in canonical orientation.
+    pub fn moved_by(&self, change: &FrameChange) -> Self {
+        let [x, y, z, d] = change.move_plane(self.as_vector());
+        Self::canonical(Vector3::new(x, y, z), d)
     }
 
     /// The parameter vector `β = [n_x, n_y, n_z, d]`.
@@ -345,9 +369,15 @@ impl PlanePatch {
     /// The patch in the frame where points map as `p' = T p` (plane and vertices moved; area
     /// and extent unchanged).
     pub fn transform(&self, pose: &Isometry3<f64>) -> Self {
+        self.moved_by(&FrameChange::from_isometry(pose))
+    }
+
+    /// The patch in the new frame of `change` (plane and vertices moved; area and extent
+    /// unchanged).
+    pub fn moved_by(&self, change: &FrameChange) -> Self {
         PlanePatch {
-            plane: self.plane.transform(pose),
-            vertices: self.vertices.map(|p| pose * p),
+            plane: self.plane.moved_by(change),
+            vertices: self.vertices.map(|p| change.move_point(&p)),
             area: self.area,
             extent: self.extent,
         }

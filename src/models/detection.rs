@@ -307,7 +307,7 @@ mod tests {
 
     #[test]
     fn short_states_are_never_detected() {
-        let p = ParticleSet::zeros(2, 3);
+        let p = ParticleSet::zeroed(2, 3);
         let mut out = vec![1.0; 3];
         GaussianRangeDetection::benchmark().detection_probability(
             &p,

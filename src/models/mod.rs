@@ -8,6 +8,8 @@
 //! * [`cloud_bounds`]: a particle cloud's box and polar bounds, for per-track shortcuts that
 //!   equal the per-particle answer (field of view here, occlusion and resolution in people
 //!   tracking).
+//! * [`vehicle`]: the ego vehicle's motion ([`VehicleModel`]): extended constant turn,
+//!   coordinated turn, kinematic bicycle, or a user's own.
 //! * [`plane`]: planar landmarks (walls) as objects: their transition, driven by the ego
 //!   motion, and their measurement. One file because both sides share the plane's state
 //!   convention and its helpers.
@@ -28,6 +30,7 @@ pub mod detection;
 pub mod measurement;
 pub mod motion;
 pub mod plane;
+pub mod vehicle;
 
 pub use cloud_bounds::{CloudBox, PolarBounds};
 pub use clutter::UniformClutter;
@@ -35,3 +38,7 @@ pub use detection::{ConstantDetection, FieldOfViewDetection, GaussianRangeDetect
 pub use measurement::{BearingConvention, PositionMeasurement, RangeBearing};
 pub use motion::{ConstantVelocity, CoordinatedTurn, ExtendedConstantTurn};
 pub use plane::{EgoSource, PlaneMeasurement, PlaneTransition};
+pub use vehicle::{
+    vehicle_model_by_name, CoordinatedTurnVehicle, KinematicBicycle, SharedVehicleModel,
+    VehicleModel, VehicleState,
+};

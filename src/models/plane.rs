@@ -5,30 +5,26 @@
 //! # State
 //!
 //! β = `[n_x, n_y, n_z, d]`: unit normal n and offset d of the plane n·p + d = 0, expressed in
-//! the **vehicle (sensor) frame of the current step**. The landmark itself is static in the
-//! world; it is the vehicle that moves, so the transition is a change of frame. The canonical
-//! sign ([`canonical_plane`]) makes d ≥ 0, i.e. the normal points from the plane towards the
-//! sensor; the transition never flips signs, and the measurement model is sign-free.
+//! the **sensor frame of the current step**. The landmark itself is static in the world; it
+//! is the vehicle that moves, so the transition is a change of frame. The canonical sign
+//! ([`crate::geometry::plane::canonical`]) makes d ≥ 0, i.e. the normal points from the plane
+//! towards the sensor; the transition never flips signs, and the measurement model is
+//! sign-free.
 //!
 //! # Transition (f)
 //!
-//! Let T_k, T_{k+1} be the world poses of the vehicle (vehicle → world) at steps k and k + 1.
-//! A point fixed in the world has vehicle coordinates p_{k+1} = M p_k with
-//! M = T_{k+1}⁻¹ T_k = (R, t), i.e. p_{k+1} = R p_k + t. Substituting p_k = Rᵀ(p_{k+1} − t)
-//! into n·p_k + d = 0 gives (R n)·p_{k+1} + d − (R n)·t = 0, so
+//! Every particle's plane is carried into the new sensor frame by a
+//! [`FrameChange`] M (n' = R n, d' = d − n'·t, renormalised: the plane transition
+//! β_{k+1}ᵀ = β_kᵀ R_k⁻¹ R_{k+1} of Gostar et al. 2019, see [`crate::geometry::frame_change`]).
+//! Optional process noise then tilts the normal by a random small rotation (a tangent-plane
+//! Gaussian with `sigma_angle` rad per tangent axis, followed by renormalisation) and adds
+//! N(0, `sigma_offset`²) to d.
 //!
-//! ```text
-//! n' = R n,    d' = d − n'·t        (homogeneous form: β'ᵀ = βᵀ M⁻¹)
-//! ```
-//!
-//! which is eq. (35) of seed 001, β_{k+1}ᵀ = β_kᵀ R_k⁻¹ R_{k+1}, with R_k = T_k. The result is
-//! renormalised (n' and d' divided by |n'|) so that rounding never lets |n| drift. Optional
-//! process noise then tilts the normal by a random small rotation (a tangent-plane Gaussian
-//! with `sigma_angle` rad per tangent axis, followed by renormalisation) and adds N(0,
-//! `sigma_offset`²) to d.
-//!
-//! Where T_{k+1} comes from is the [`EgoSource`]: the measured poses of the step context, or a
-//! per-particle prediction from an [`ExtendedConstantTurn`] vehicle model (seed 001, Alg. 1).
+//! Where M comes from is the [`EgoSource`]: the measured sensor poses of the step context
+//! (one M for every particle), or per particle a draw of the next vehicle state from a
+//! [`VehicleModel`] (Gostar et al. 2019, Algorithm 1), M = C (P_{k+1}⁻¹ P_k) C⁻¹ with the
+//! vehicle → sensor calibration C ([`FrameChange::of_vehicle`]), so that the ego-motion
+//! uncertainty spreads into the plane density.
 //!
 //! # Measurement (h, g)
 //!
@@ -45,35 +41,56 @@
 //!
 //! Not for: segmenting planes out of point clouds, plane patches (vertices, areas) or metrics.
 
-use super::ExtendedConstantTurn;
+use super::vehicle::{check_vehicle_state, VehicleModel};
 use crate::error::{Error, Result};
 use crate::filter::ParticleSet;
-use crate::filter::{MeasurementModel, StepContext, TrackSummary, TransitionModel};
+use crate::filter::{
+    check_state_dim, MeasurementModel, StepContext, TrackSummary, TransitionModel,
+};
+use crate::geometry::FrameChange;
 use crate::rng::FilterRng;
-use nalgebra::{Isometry3, Matrix3, Vector3};
+use nalgebra::{Isometry3, Vector3};
 use rand_distr::{Distribution, StandardNormal};
+use std::sync::Arc;
 
-/// Where the vehicle pose at the new step comes from.
-#[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
+/// Where the sensor's motion to the new step comes from.
+#[derive(Clone)]
 pub enum EgoSource {
-    /// Use the measured poses of the step context: T_k = `ctx.previous_platform`,
+    /// The measured sensor poses of the step context: T_k = `ctx.previous_platform`,
     /// T_{k+1} = `ctx.platform` (a missing pose counts as the world origin). Every particle is
     /// moved by the same M = T_{k+1}⁻¹ T_k.
     Measured,
-    /// Predict the new vehicle pose (seed 001, Algorithm 1): T_k is the pose of
-    /// `vehicle_state` (see [`ExtendedConstantTurn::pose_of`]); each particle draws its own
-    /// vehicle state at k + 1 from the `ect` model over `ctx.dt` and is moved by its own
-    /// M = T_{k+1}⁻¹ T_k. The ego-motion uncertainty thus spreads into the plane density.
-    /// (The paper draws one vehicle sample for all particles; one per particle is the
-    /// Monte-Carlo marginal over the vehicle motion.) `ctx` poses are ignored; update
-    /// `vehicle_state` every step (e.g. with [`PlaneTransition::set_vehicle_state`]).
+    /// Predicted (Gostar et al. 2019, Algorithm 1): each particle draws its own vehicle state
+    /// at k + 1 from `vehicle` over `ctx.dt`, starting at `vehicle_state` (the state at k),
+    /// and is moved by its own M = C (P_{k+1}⁻¹ P_k) C⁻¹, C = `vehicle_to_sensor`. (The paper
+    /// draws one vehicle sample for all particles; one per particle is the Monte-Carlo
+    /// marginal over the vehicle motion.) `ctx` poses are not used.
     Predicted {
         /// The vehicle motion model.
-        ect: ExtendedConstantTurn,
-        /// Vehicle state `[X, Ẋ, Y, Ẏ, φ, φ̇]` (world frame) at the previous step k.
-        vehicle_state: [f64; 6],
+        vehicle: Arc<dyn VehicleModel>,
+        /// The vehicle state at the previous step k, in the model's layout.
+        vehicle_state: Vec<f64>,
+        /// The vehicle (IMU) → sensor transform C: `p_sensor = C p_vehicle`.
+        vehicle_to_sensor: Isometry3<f64>,
     },
+}
+
+impl std::fmt::Debug for EgoSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            EgoSource::Measured => f.write_str("Measured"),
+            EgoSource::Predicted {
+                vehicle,
+                vehicle_state,
+                vehicle_to_sensor,
+            } => f
+                .debug_struct("Predicted")
+                .field("vehicle", &vehicle.name())
+                .field("vehicle_state", vehicle_state)
+                .field("vehicle_to_sensor", vehicle_to_sensor)
+                .finish(),
+        }
+    }
 }
 
 /// Default standard deviation of the normal-tilt process noise, radians (0.2°).
@@ -82,10 +99,10 @@ pub const DEFAULT_SIGMA_ANGLE: f64 = 0.2 * std::f64::consts::PI / 180.0;
 pub const DEFAULT_SIGMA_OFFSET: f64 = 0.02;
 
 /// Plane transition driven by the vehicle's ego motion; state `[n_x, n_y, n_z, d]` in the
-/// vehicle frame (see the module documentation for the maths).
+/// sensor frame (see the module documentation for the maths).
 ///
-/// Particle sets with fewer than 4 components are left unchanged.
-#[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+/// Particle sets with fewer than 4 components are an error.
+#[derive(Clone, Debug)]
 pub struct PlaneTransition {
     ego: EgoSource,
     sigma_angle: f64,
@@ -94,7 +111,8 @@ pub struct PlaneTransition {
 
 impl PlaneTransition {
     /// A transition with ego source `ego`, normal-tilt noise `sigma_angle` (rad) and offset
-    /// noise `sigma_offset` (m), both finite and ≥ 0.
+    /// noise `sigma_offset` (m), both finite and ≥ 0. A predicted source's vehicle state must
+    /// fit its model ([`check_vehicle_state`]).
     pub fn new(ego: EgoSource, sigma_angle: f64, sigma_offset: f64) -> Result<Self> {
         for (name, v) in [("sigma_angle", sigma_angle), ("sigma_offset", sigma_offset)] {
             if !(v.is_finite() && v >= 0.0) {
@@ -104,13 +122,13 @@ impl PlaneTransition {
                 ));
             }
         }
-        if let EgoSource::Predicted { vehicle_state, .. } = &ego {
-            if vehicle_state.iter().any(|v| !v.is_finite()) {
-                return Err(Error::invalid(
-                    "plane transition vehicle_state",
-                    format!("{vehicle_state:?} (must be finite)"),
-                ));
-            }
+        if let EgoSource::Predicted {
+            vehicle,
+            vehicle_state,
+            ..
+        } = &ego
+        {
+            check_vehicle_state(&**vehicle, vehicle_state)?;
         }
         Ok(PlaneTransition {
             ego,
@@ -144,12 +162,67 @@ impl PlaneTransition {
         self.sigma_offset
     }
 
-    /// Replaces the vehicle state at the previous step (only meaningful for
-    /// [`EgoSource::Predicted`]; a no-op otherwise).
-    pub fn set_vehicle_state(&mut self, state: [f64; 6]) {
-        if let EgoSource::Predicted { vehicle_state, .. } = &mut self.ego {
-            *vehicle_state = state;
+    /// The prediction with the vehicle state at the previous step given here instead of the
+    /// one in [`EgoSource::Predicted`] (the drive tracker hands each step's state this way);
+    /// the same as [`TransitionModel::predict`] for a measured source. A state that does not
+    /// fit the model is an error.
+    pub fn predict_from(
+        &self,
+        vehicle_state: &[f64],
+        particles: &mut ParticleSet,
+        ctx: &StepContext,
+        rng: &mut FilterRng,
+    ) -> Result<()> {
+        check_state_dim("PlaneTransition", 4, particles)?;
+        if particles.is_empty() {
+            return Ok(());
         }
+        match &self.ego {
+            EgoSource::Measured => {
+                let prev = ctx.previous_platform.unwrap_or_else(Isometry3::identity);
+                let cur = ctx.platform.unwrap_or_else(Isometry3::identity);
+                let m = FrameChange::between(&prev, &cur);
+                let mut comps = particles.components_mut();
+                if let [nx, ny, nz, d, ..] = comps.as_mut_slice() {
+                    m.move_planes(nx, ny, nz, d);
+                }
+            }
+            EgoSource::Predicted {
+                vehicle,
+                vehicle_to_sensor,
+                ..
+            } => {
+                check_vehicle_state(&**vehicle, vehicle_state)?;
+                let p0 = vehicle.pose_of(vehicle_state);
+                // One batch of vehicle draws a set: one dispatch, one allocation.
+                let mut next = vec![Isometry3::identity(); particles.len()];
+                vehicle.sample_poses(vehicle_state, ctx.dt, rng, &mut next);
+                let mut comps = particles.components_mut();
+                let [nx, ny, nz, d, ..] = comps.as_mut_slice() else {
+                    return Ok(());
+                };
+                for (i, p1) in next.iter().enumerate() {
+                    let m = FrameChange::of_vehicle(&p0, p1, vehicle_to_sensor);
+                    if !m.is_finite() {
+                        return Err(Error::invalid(
+                            format!("vehicle model {}", vehicle.name()),
+                            format!(
+                                "draw {i} from the state {vehicle_state:?} over {} s gave a \
+                                 non-finite pose",
+                                ctx.dt
+                            ),
+                        ));
+                    }
+                    let b = m.move_plane([nx[i], ny[i], nz[i], d[i]]);
+                    nx[i] = b[0];
+                    ny[i] = b[1];
+                    nz[i] = b[2];
+                    d[i] = b[3];
+                }
+            }
+        }
+        self.add_noise(particles, rng);
+        Ok(())
     }
 
     fn add_noise(&self, particles: &mut ParticleSet, rng: &mut FilterRng) {
@@ -184,122 +257,22 @@ impl PlaneTransition {
     }
 }
 
-/// M = T_{k+1}⁻¹ T_k: maps vehicle-frame coordinates at step k to those at step k + 1.
-pub fn relative_motion(previous: &Isometry3<f64>, current: &Isometry3<f64>) -> Isometry3<f64> {
-    current.inverse() * previous
-}
-
-/// Applies n' = R n, d' = d − n'·t (then divides by |n'|) to one plane.
-#[inline(always)]
-fn move_plane(r: &Matrix3<f64>, t: &Vector3<f64>, b: [f64; 4]) -> [f64; 4] {
-    let [x, y, z, d] = b;
-    let nx = r[(0, 0)] * x + r[(0, 1)] * y + r[(0, 2)] * z;
-    let ny = r[(1, 0)] * x + r[(1, 1)] * y + r[(1, 2)] * z;
-    let nz = r[(2, 0)] * x + r[(2, 1)] * y + r[(2, 2)] * z;
-    let nd = d - (nx * t.x + ny * t.y + nz * t.z);
-    let inv = 1.0 / (nx * nx + ny * ny + nz * nz).sqrt();
-    [nx * inv, ny * inv, nz * inv, nd * inv]
-}
-
-/// Moves one plane β = `[n, d]` by the frame change `m` = T_{k+1}⁻¹ T_k (n' = R n,
-/// d' = d − n'·t, renormalised). A zero normal has no direction to move: it comes out
-/// non-finite, and a particle left so makes the filter step fail with an error naming its
-/// track (see `LmbFilter::step`) rather than be carried on.
-pub fn transform_plane(beta: &[f64; 4], m: &Isometry3<f64>) -> [f64; 4] {
-    let r = m.rotation.to_rotation_matrix().into_inner();
-    move_plane(&r, &m.translation.vector, *beta)
-}
-
-/// Moves every particle's plane (components 0–3) by the same frame change `m` =
-/// T_{k+1}⁻¹ T_k, in place over the structure-of-arrays columns, without allocating per
-/// particle. This is the hot loop of the plane prediction. Sets with fewer than 4 components
-/// are left unchanged.
-pub fn transform_planes(states: &mut ParticleSet, m: &Isometry3<f64>) {
-    if states.dim() < 4 || states.is_empty() {
-        return;
-    }
-    let r = m.rotation.to_rotation_matrix().into_inner();
-    let t = m.translation.vector;
-    let mut comps = states.components_mut();
-    let [nx, ny, nz, d, ..] = comps.as_mut_slice() else {
-        return;
-    };
-    let n = nx.len();
-    let (nx, ny, nz, d) = (&mut nx[..n], &mut ny[..n], &mut nz[..n], &mut d[..n]);
-    for i in 0..n {
-        let b = move_plane(&r, &t, [nx[i], ny[i], nz[i], d[i]]);
-        nx[i] = b[0];
-        ny[i] = b[1];
-        nz[i] = b[2];
-        d[i] = b[3];
-    }
-}
-
-/// The canonical representative of a plane: unit normal and d ≥ 0 (normal towards the
-/// origin of the frame); for a plane through the origin, the first non-zero normal component
-/// is made positive. A zero or non-finite normal is returned unchanged.
-pub fn canonical_plane(beta: &[f64; 4]) -> [f64; 4] {
-    let [x, y, z, d] = *beta;
-    let norm = (x * x + y * y + z * z).sqrt();
-    if !(norm.is_finite() && norm > 0.0) {
-        return *beta;
-    }
-    let mut s = 1.0 / norm;
-    let flip = if d != 0.0 {
-        d < 0.0
-    } else if x != 0.0 {
-        x < 0.0
-    } else if y != 0.0 {
-        y < 0.0
-    } else {
-        z < 0.0
-    };
-    if flip {
-        s = -s;
-    }
-    [x * s, y * s, z * s, d * s]
-}
-
 impl TransitionModel for PlaneTransition {
     fn state_dim(&self) -> usize {
         4
     }
 
-    fn predict(&self, particles: &mut ParticleSet, ctx: &StepContext, rng: &mut FilterRng) {
-        if particles.dim() < 4 || particles.is_empty() {
-            return;
-        }
-        match &self.ego {
-            EgoSource::Measured => {
-                let prev = ctx.previous_platform.unwrap_or_else(Isometry3::identity);
-                let cur = ctx.platform.unwrap_or_else(Isometry3::identity);
-                transform_planes(particles, &relative_motion(&prev, &cur));
-            }
-            EgoSource::Predicted { ect, vehicle_state } => {
-                let dt = ctx.dt;
-                let [x0, _, y0, _, phi0, _] = *vehicle_state;
-                let mut comps = particles.components_mut();
-                let [nx, ny, nz, d, ..] = comps.as_mut_slice() else {
-                    return;
-                };
-                for i in 0..nx.len() {
-                    let v = ect.sample_step(vehicle_state, dt, rng);
-                    // M = T_{k+1}⁻¹ T_k for planar poses: R = Rz(φ_k − φ_{k+1}),
-                    // t = Rz(−φ_{k+1}) (X_k − X_{k+1}, Y_k − Y_{k+1}, 0).
-                    let (s1, c1) = v[4].sin_cos();
-                    let (sr, cr) = (phi0 - v[4]).sin_cos();
-                    let (dx, dy) = (x0 - v[0], y0 - v[2]);
-                    let r = Matrix3::new(cr, -sr, 0.0, sr, cr, 0.0, 0.0, 0.0, 1.0);
-                    let t = Vector3::new(c1 * dx + s1 * dy, -s1 * dx + c1 * dy, 0.0);
-                    let b = move_plane(&r, &t, [nx[i], ny[i], nz[i], d[i]]);
-                    nx[i] = b[0];
-                    ny[i] = b[1];
-                    nz[i] = b[2];
-                    d[i] = b[3];
-                }
-            }
-        }
-        self.add_noise(particles, rng);
+    fn predict(
+        &self,
+        particles: &mut ParticleSet,
+        ctx: &StepContext,
+        rng: &mut FilterRng,
+    ) -> Result<()> {
+        let state: &[f64] = match &self.ego {
+            EgoSource::Measured => &[],
+            EgoSource::Predicted { vehicle_state, .. } => vehicle_state,
+        };
+        self.predict_from(state, particles, ctx, rng)
     }
 }
 
@@ -381,6 +354,10 @@ impl MeasurementModel for PlaneMeasurement {
         4
     }
 
+    fn state_dim(&self) -> Option<usize> {
+        Some(4)
+    }
+
     fn log_likelihood(
         &self,
         z: &[f64],
@@ -431,9 +408,11 @@ impl MeasurementModel for PlaneMeasurement {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::plane::canonical;
+    use crate::models::ExtendedConstantTurn;
     use crate::rng::seeded;
-    use nalgebra::{Point3, Translation3, UnitQuaternion};
-    use proptest::prelude::*;
+    use nalgebra::Translation3;
+    use nalgebra::UnitQuaternion;
 
     fn ctx_with(prev: Isometry3<f64>, cur: Isometry3<f64>, dt: f64) -> StepContext {
         StepContext {
@@ -453,89 +432,41 @@ mod tests {
         Isometry3::new(Vector3::from(t), Vector3::from(axis_angle))
     }
 
-    /// A point on the plane: −d n plus an in-plane offset built from (u, v).
-    fn point_on(beta: &[f64; 4], u: f64, v: f64) -> Point3<f64> {
-        let n = Vector3::new(beta[0], beta[1], beta[2]);
-        let helper = if n.x.abs() < 0.9 {
-            Vector3::x()
-        } else {
-            Vector3::y()
-        };
-        let e1 = n.cross(&helper).normalize();
-        let e2 = n.cross(&e1);
-        Point3::from(-beta[3] * n + u * e1 + v * e2)
-    }
-
     fn unit_plane(v: [f64; 3], d: f64) -> [f64; 4] {
         let n = Vector3::from(v).normalize();
         [n.x, n.y, n.z, d]
     }
 
-    #[test]
-    fn zero_normal_comes_out_non_finite() {
-        let m = Isometry3::from_parts(
-            Translation3::new(1.0, 2.0, 0.0),
-            UnitQuaternion::from_euler_angles(0.0, 0.0, 0.3),
-        );
-        let moved = transform_plane(&[0.0, 0.0, 0.0, 5.0], &m);
-        assert!(moved.iter().all(|v| !v.is_finite()), "{moved:?}");
-        let fine = transform_plane(&[1.0, 0.0, 0.0, 5.0], &m);
-        assert!(fine.iter().all(|v| v.is_finite()), "{fine:?}");
-    }
-
-    proptest! {
-        #[test]
-        fn moved_point_lies_on_moved_plane(
-            t0 in prop::array::uniform3(-50.0f64..50.0), r0 in prop::array::uniform3(-3.0f64..3.0),
-            t1 in prop::array::uniform3(-50.0f64..50.0), r1 in prop::array::uniform3(-3.0f64..3.0),
-            nv in prop::array::uniform3(-1.0f64..1.0), d in -30.0f64..30.0,
-            u in -20.0f64..20.0, v in -20.0f64..20.0,
-        ) {
-            prop_assume!(Vector3::from(nv).norm() > 0.1);
-            let beta = unit_plane(nv, d);
-            let m = relative_motion(&pose(t0, r0), &pose(t1, r1));
-            let p1 = m * point_on(&beta, u, v);
-            let b1 = transform_plane(&beta, &m);
-            let resid = b1[0] * p1.x + b1[1] * p1.y + b1[2] * p1.z + b1[3];
-            prop_assert!(resid.abs() < 1e-9, "residual {resid}");
-            let n1 = (b1[0] * b1[0] + b1[1] * b1[1] + b1[2] * b1[2]).sqrt();
-            prop_assert!((n1 - 1.0).abs() < 1e-12);
-            // the SoA loop agrees with the single-plane function
-            let mut set = one(beta);
-            transform_planes(&mut set, &m);
-            prop_assert_eq!(set.state(0), b1.to_vec());
-        }
-
-        #[test]
-        fn composition_of_steps(
-            t0 in prop::array::uniform3(-20.0f64..20.0), r0 in prop::array::uniform3(-3.0f64..3.0),
-            t1 in prop::array::uniform3(-20.0f64..20.0), r1 in prop::array::uniform3(-3.0f64..3.0),
-            t2 in prop::array::uniform3(-20.0f64..20.0), r2 in prop::array::uniform3(-3.0f64..3.0),
-            nv in prop::array::uniform3(-1.0f64..1.0), d in -30.0f64..30.0,
-        ) {
-            prop_assume!(Vector3::from(nv).norm() > 0.1);
-            let beta = unit_plane(nv, d);
-            let (p0, p1, p2) = (pose(t0, r0), pose(t1, r1), pose(t2, r2));
-            let two = transform_plane(&transform_plane(&beta, &relative_motion(&p0, &p1)),
-                                      &relative_motion(&p1, &p2));
-            let direct = transform_plane(&beta, &relative_motion(&p0, &p2));
-            for (a, b) in two.iter().zip(direct) {
-                prop_assert!((a - b).abs() < 1e-9, "{two:?} vs {direct:?}");
-            }
-        }
+    fn predicted(
+        vehicle: Arc<dyn VehicleModel>,
+        state: Vec<f64>,
+        mounting: Isometry3<f64>,
+    ) -> PlaneTransition {
+        PlaneTransition::new(
+            EgoSource::Predicted {
+                vehicle,
+                vehicle_state: state,
+                vehicle_to_sensor: mounting,
+            },
+            0.0,
+            0.0,
+        )
+        .unwrap()
     }
 
     #[test]
     fn forward_translation_brings_wall_closer() {
         // wall x = 10, canonical form n = (−1, 0, 0), d = 10 (normal towards the sensor)
-        let beta = canonical_plane(&[1.0, 0.0, 0.0, -10.0]);
+        let beta = canonical(&[1.0, 0.0, 0.0, -10.0]);
         assert_eq!(beta, [-1.0, 0.0, 0.0, 10.0]);
         let prev = Isometry3::identity();
         let cur =
             Isometry3::from_parts(Translation3::new(1.0, 0.0, 0.0), UnitQuaternion::identity());
         let model = PlaneTransition::new(EgoSource::Measured, 0.0, 0.0).unwrap();
         let mut set = one(beta);
-        model.predict(&mut set, &ctx_with(prev, cur, 0.1), &mut seeded(1));
+        model
+            .predict(&mut set, &ctx_with(prev, cur, 0.1), &mut seeded(1))
+            .unwrap();
         assert_eq!(set.state(0), vec![-1.0, 0.0, 0.0, 9.0]);
     }
 
@@ -544,29 +475,30 @@ mod tests {
         let model = PlaneTransition::new(EgoSource::Measured, 0.0, 0.0).unwrap();
         let beta = unit_plane([0.3, -0.4, 0.8], 5.0);
         let mut set = one(beta);
-        model.predict(&mut set, &StepContext::new(1, 0.1, 0.1), &mut seeded(1));
+        model
+            .predict(&mut set, &StepContext::new(1, 0.1, 0.1), &mut seeded(1))
+            .unwrap();
         for (a, b) in set.state(0).iter().zip(beta) {
             assert!((a - b).abs() < 1e-15);
         }
     }
 
+    /// A noise-free vehicle model moves every particle as the measured poses of its mean step
+    /// do, the mounting included: the sensor poses are P C⁻¹.
     #[test]
     fn predicted_ego_without_noise_equals_measured() {
         let vehicle = [12.0, 8.0, -3.0, 2.0, 0.4, 0.15];
         let dt = 0.1;
         let next = ExtendedConstantTurn::step_noiseless(&vehicle, dt);
-        let prev_pose = ExtendedConstantTurn::pose_of(&vehicle);
-        let cur_pose = ExtendedConstantTurn::pose_of(&next);
+        let mounting = pose([0.8, -0.3, 1.7], [0.01, -0.02, 0.03]);
+        let prev_pose = ExtendedConstantTurn::pose_of(&vehicle) * mounting.inverse();
+        let cur_pose = ExtendedConstantTurn::pose_of(&next) * mounting.inverse();
         let measured = PlaneTransition::new(EgoSource::Measured, 0.0, 0.0).unwrap();
-        let predicted = PlaneTransition::new(
-            EgoSource::Predicted {
-                ect: ExtendedConstantTurn::noiseless(),
-                vehicle_state: vehicle,
-            },
-            0.0,
-            0.0,
-        )
-        .unwrap();
+        let model = predicted(
+            Arc::new(ExtendedConstantTurn::noiseless()),
+            vehicle.to_vec(),
+            mounting,
+        );
         let rows: Vec<Vec<f64>> = (0..20)
             .map(|i| {
                 let a = i as f64 * 0.3;
@@ -576,8 +508,10 @@ mod tests {
         let mut a = ParticleSet::from_rows(&rows, &vec![1.0; rows.len()]).unwrap();
         let mut b = a.clone();
         let ctx = ctx_with(prev_pose, cur_pose, dt);
-        measured.predict(&mut a, &ctx, &mut seeded(1));
-        predicted.predict(&mut b, &StepContext::new(1, dt, dt), &mut seeded(2));
+        measured.predict(&mut a, &ctx, &mut seeded(1)).unwrap();
+        model
+            .predict(&mut b, &StepContext::new(1, dt, dt), &mut seeded(2))
+            .unwrap();
         for i in 0..rows.len() {
             for (x, y) in a.state(i).iter().zip(b.state(i)) {
                 assert!(
@@ -592,20 +526,17 @@ mod tests {
 
     #[test]
     fn predicted_ego_noise_spreads_planes() {
-        let vehicle = [0.0, 10.0, 0.0, 0.0, 0.0, 0.0];
-        let model = PlaneTransition::new(
-            EgoSource::Predicted {
-                ect: ExtendedConstantTurn::new(1.0, 0.1).unwrap(),
-                vehicle_state: vehicle,
-            },
-            0.0,
-            0.0,
-        )
-        .unwrap();
+        let model = predicted(
+            Arc::new(ExtendedConstantTurn::new(1.0, 0.1).unwrap()),
+            vec![0.0, 10.0, 0.0, 0.0, 0.0, 0.0],
+            Isometry3::identity(),
+        );
         let n = 5_000;
         let rows = vec![vec![-1.0, 0.0, 0.0, 10.0]; n];
         let mut set = ParticleSet::from_rows(&rows, &vec![1.0; n]).unwrap();
-        model.predict(&mut set, &StepContext::new(1, 0.1, 0.1), &mut seeded(3));
+        model
+            .predict(&mut set, &StepContext::new(1, 0.1, 0.1), &mut seeded(3))
+            .unwrap();
         let mean = set.mean();
         // the vehicle drives 1 m towards the wall on average
         assert!((mean[3] - 9.0).abs() < 0.01, "{mean:?}");
@@ -614,12 +545,46 @@ mod tests {
     }
 
     #[test]
+    fn a_vehicle_state_that_does_not_fit_its_model_is_an_error() {
+        let ect: Arc<dyn VehicleModel> = Arc::new(ExtendedConstantTurn::noiseless());
+        let e = PlaneTransition::new(
+            EgoSource::Predicted {
+                vehicle: ect.clone(),
+                vehicle_state: vec![0.0; 5],
+                vehicle_to_sensor: Isometry3::identity(),
+            },
+            0.0,
+            0.0,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("ExtendedConstantTurn") && e.contains("5 components"),
+            "{e}"
+        );
+        let model = predicted(ect, vec![0.0; 6], Isometry3::identity());
+        let mut set = one([1.0, 0.0, 0.0, 3.0]);
+        let ctx = StepContext::new(1, 0.1, 0.1);
+        assert!(model
+            .predict_from(
+                &[0.0, f64::NAN, 0.0, 0.0, 0.0, 0.0],
+                &mut set,
+                &ctx,
+                &mut seeded(1)
+            )
+            .is_err());
+        assert_eq!(set.state(0), vec![1.0, 0.0, 0.0, 3.0]);
+    }
+
+    #[test]
     fn process_noise_keeps_normals_unit_and_has_the_right_spread() {
         let model = PlaneTransition::new(EgoSource::Measured, 0.01, 0.05).unwrap();
         let n = 20_000;
         let rows = vec![vec![0.0, 0.0, 1.0, 2.0]; n];
         let mut set = ParticleSet::from_rows(&rows, &vec![1.0; n]).unwrap();
-        model.predict(&mut set, &StepContext::new(1, 0.1, 0.1), &mut seeded(4));
+        model
+            .predict(&mut set, &StepContext::new(1, 0.1, 0.1), &mut seeded(4))
+            .unwrap();
         for i in 0..n {
             let s = set.state(i);
             assert!(((s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt() - 1.0).abs() < 1e-12);
@@ -656,7 +621,7 @@ mod tests {
         assert!((out[0] - (want - 0.5)).abs() < 1e-12);
         assert!((out[1] - (want - 0.5)).abs() < 1e-12);
         // an angle residual of one σ costs ½
-        let rot = transform_plane(&beta, &pose([0.0; 3], [0.0, 0.0, 0.05]));
+        let rot = FrameChange::from_isometry(&pose([0.0; 3], [0.0, 0.0, 0.05])).move_plane(beta);
         m.log_likelihood(&rot, &set, &ctx, &mut out);
         assert!((out[0] - (want - 0.5)).abs() < 1e-9, "{out:?}");
     }

@@ -1,16 +1,16 @@
-//! Plane prediction between consecutive LiDAR frames, scored as in seed 001 (Sec. 5,
-//! Algorithm 1, Tables 1–6).
+//! Plane prediction between consecutive LiDAR frames, scored as Gostar et al. (2019, Sec. 5,
+//! Algorithm 1, Tables 1–6) score it, for any vehicle model.
 //!
 //! For a frame pair (k, k + 1):
 //! 1. the building walls of both frames are segmented with
 //!    [`crate::cloud::planes::extract_planes`];
-//! 2. every wall patch of frame k is moved into the sensor frame of k + 1 with the ego motion
-//!    M = T_{k+1}⁻¹ T_k ([`relative_motion`]). With [`EgoMotion::Measured`] M comes from the
+//! 2. every wall patch of frame k is moved into the sensor frame of k + 1 with the frame change
+//!    M ([`FrameChange`]). With [`EgoMotion::Measured`] M = T_{k+1}⁻¹ T_k comes from the
 //!    measured poses. With [`EgoMotion::Sampled`] (Algorithm 1) each Monte-Carlo run draws
-//!    the vehicle state at k + 1 from the state at k with
-//!    [`ExtendedConstantTurn::sample_step`], takes M_vehicle = P(s_{k+1})⁻¹ P(s_k)
-//!    ([`ExtendedConstantTurn::pose_of`]) and expresses it in the sensor frame,
-//!    M = C M_vehicle C⁻¹ with C the vehicle → sensor calibration;
+//!    the vehicle state at k + 1 from the state at k with the configured [`VehicleModel`](crate::models::VehicleModel)
+//!    (extended constant turn by default) and moves the patches by
+//!    M = C (P(s_{k+1})⁻¹ P(s_k)) C⁻¹ ([`FrameChange::of_vehicle`]), C the vehicle → sensor
+//!    calibration;
 //! 3. the predicted patches are associated with the segmented walls of k + 1
 //!    ([`associate_planes`]) and each pair's errors are computed ([`PlanePairError`]).
 //!
@@ -25,11 +25,11 @@
 use crate::cloud::planes::{extract_planes, PlaneConfig};
 use crate::cloud::PointCloud;
 use crate::error::{Error, Result};
-use crate::geometry::PlanePatch;
+use crate::geometry::{FrameChange, PlanePatch};
 use crate::kitti::{OdometrySequence, RawDrive, TrackingSequence};
 use crate::metrics::plane_prediction::{associate_planes, PlanePairError};
-use crate::models::plane::relative_motion;
-use crate::models::ExtendedConstantTurn;
+use crate::models::vehicle::check_vehicle_state;
+use crate::models::{ExtendedConstantTurn, SharedVehicleModel, VehicleState};
 use crate::rng::FilterRng;
 use nalgebra::Isometry3;
 use std::collections::BTreeMap;
@@ -40,8 +40,9 @@ use std::time::Instant;
 pub struct PlanePredictionConfig {
     /// Plane segmentation of every frame.
     pub planes: PlaneConfig,
-    /// Vehicle motion model for the Monte-Carlo prediction.
-    pub ect: ExtendedConstantTurn,
+    /// Vehicle motion model for the Monte-Carlo prediction (default: extended constant turn
+    /// with σ_a = 0.5 m/s², σ_ω = 0.1 rad/s²); any [`VehicleModel`](crate::models::VehicleModel).
+    pub vehicle: SharedVehicleModel,
     /// Step length used when no timestamps give it (s); KITTI records at 10 Hz.
     pub dt: f64,
     /// Vehicle (IMU) → sensor (Velodyne) transform C: `p_sensor = C p_vehicle`.
@@ -59,8 +60,10 @@ impl Default for PlanePredictionConfig {
     fn default() -> Self {
         PlanePredictionConfig {
             planes: PlaneConfig::default(),
-            ect: ExtendedConstantTurn::new(0.5, 0.1)
-                .expect("constant noise levels are finite and non-negative"),
+            vehicle: SharedVehicleModel::new(
+                ExtendedConstantTurn::new(0.5, 0.1)
+                    .expect("constant noise levels are finite and non-negative"),
+            ),
             dt: 0.1,
             vehicle_to_sensor: Isometry3::identity(),
             max_angle: 10f64.to_radians(),
@@ -91,16 +94,16 @@ impl PlanePredictionConfig {
 }
 
 /// How frame k is moved into the sensor frame of k + 1.
-#[derive(Copy, Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub enum EgoMotion {
-    /// A fixed motion M = T_{k+1}⁻¹ T_k (sensor frame k → sensor frame k + 1).
-    Measured(Isometry3<f64>),
-    /// Monte-Carlo prediction from the vehicle state at k (seed 001, Algorithm 1).
+    /// A fixed motion (sensor frame k → sensor frame k + 1).
+    Measured(FrameChange),
+    /// Monte-Carlo prediction from the vehicle state at k (Gostar et al. 2019, Algorithm 1).
     Sampled {
         /// Vehicle motion model.
-        ect: ExtendedConstantTurn,
-        /// Vehicle state `[X, Ẋ, Y, Ẏ, φ, φ̇]` at k.
-        vehicle_state: [f64; 6],
+        vehicle: SharedVehicleModel,
+        /// Vehicle state at k, in the model's layout.
+        vehicle_state: Vec<f64>,
         /// Step length (s).
         dt: f64,
         /// Vehicle → sensor transform C.
@@ -109,22 +112,34 @@ pub enum EgoMotion {
 }
 
 impl EgoMotion {
-    /// One draw of the motion M (sensor frame k → sensor frame k + 1).
-    fn draw(&self, rng: &mut FilterRng) -> Isometry3<f64> {
+    /// One draw of the frame change (sensor frame k → sensor frame k + 1); a vehicle model
+    /// whose draw is not finite is an error naming it.
+    fn draw(&self, rng: &mut FilterRng) -> Result<FrameChange> {
         match self {
-            EgoMotion::Measured(m) => *m,
+            EgoMotion::Measured(m) => Ok(*m),
             EgoMotion::Sampled {
-                ect,
+                vehicle,
                 vehicle_state,
                 dt,
                 vehicle_to_sensor,
             } => {
-                let next = ect.sample_step(vehicle_state, *dt, rng);
-                let m = relative_motion(
-                    &ExtendedConstantTurn::pose_of(vehicle_state),
-                    &ExtendedConstantTurn::pose_of(&next),
+                let mut next = [Isometry3::identity()];
+                vehicle.sample_poses(vehicle_state, *dt, rng, &mut next);
+                let m = FrameChange::of_vehicle(
+                    &vehicle.pose_of(vehicle_state),
+                    &next[0],
+                    vehicle_to_sensor,
                 );
-                vehicle_to_sensor * m * vehicle_to_sensor.inverse()
+                if !m.is_finite() {
+                    return Err(Error::invalid(
+                        format!("vehicle model {}", vehicle.name()),
+                        format!(
+                            "a draw from the state {vehicle_state:?} over {dt} s gave a \
+                             non-finite pose"
+                        ),
+                    ));
+                }
+                Ok(m)
             }
         }
     }
@@ -166,7 +181,7 @@ pub fn segment_walls(
 }
 
 /// Predicts the wall patches `walls_k` into frame `frame` (= k + 1) `runs` times (at least
-/// once) and scores them against `walls_k1`.
+/// once) and scores them against `walls_k1`. A vehicle model's non-finite draw is an error.
 pub fn predict_walls(
     walls_k: &[PlanePatch],
     walls_k1: &[PlanePatch],
@@ -175,14 +190,14 @@ pub fn predict_walls(
     config: &PlanePredictionConfig,
     runs: usize,
     rng: &mut FilterRng,
-) -> PairPrediction {
+) -> Result<PairPrediction> {
     let runs = runs.max(1);
     let mut per_pair: BTreeMap<(usize, usize), Vec<PlanePairError>> = BTreeMap::new();
     let mut prediction_ms = Vec::with_capacity(runs);
     for _ in 0..runs {
         let start = Instant::now();
-        let m = ego.draw(rng);
-        let predicted: Vec<PlanePatch> = walls_k.iter().map(|p| p.transform(&m)).collect();
+        let m = ego.draw(rng)?;
+        let predicted: Vec<PlanePatch> = walls_k.iter().map(|p| p.moved_by(&m)).collect();
         prediction_ms.push(start.elapsed().as_secs_f64() * 1e3);
         for (i, j) in associate_planes(
             &predicted,
@@ -201,20 +216,21 @@ pub fn predict_walls(
         .filter(|errs| 2 * errs.len() >= runs)
         .filter_map(|errs| PlanePairError::mean(errs))
         .collect();
-    PairPrediction {
+    Ok(PairPrediction {
         frame,
         pairs,
         prediction_ms,
         predicted: walls_k.len(),
         segmented: walls_k1.len(),
-    }
+    })
 }
 
 /// Segments two consecutive clouds and predicts the walls of `cloud_k` into the frame of
 /// `cloud_k1` (frame number `frame_k + 1`).
 ///
-/// `pose_k`, `pose_k1` are the sensor poses (sensor → world) of the two frames. Given a
-/// `vehicle_state_k`, the prediction follows Algorithm 1 with `config.ect`, `config.dt` and
+/// `pose_k`, `pose_k1` are the sensor poses (sensor → world) of the two frames. Given the
+/// measured vehicle kinematics `vehicle_state_k` ([X, Ẋ, Y, Ẏ, φ, φ̇], see [`VehicleState`]),
+/// the prediction follows Algorithm 1 with `config.vehicle`, `config.dt` and
 /// `config.vehicle_to_sensor` over `runs` Monte-Carlo runs and the poses are not used;
 /// otherwise the measured motion T_{k+1}⁻¹ T_k is applied (the runs then only repeat the
 /// timing).
@@ -233,34 +249,40 @@ pub fn predict_planes_between(
     config.validate()?;
     let walls_k = segment_walls(cloud_k, &config.planes, rng)?;
     let walls_k1 = segment_walls(cloud_k1, &config.planes, rng)?;
-    let ego = ego_for(pose_k, pose_k1, vehicle_state_k, config.dt, config);
-    Ok(predict_walls(
-        &walls_k,
-        &walls_k1,
-        &ego,
-        frame_k + 1,
-        config,
-        runs,
-        rng,
-    ))
+    let ego = ego_for(pose_k, pose_k1, vehicle_state_k, config.dt, config)?;
+    predict_walls(&walls_k, &walls_k1, &ego, frame_k + 1, config, runs, rng)
 }
 
+/// The ego motion of a frame pair: the vehicle model's draws from the state it builds of the
+/// measured kinematics, or the measured frame change.
 fn ego_for(
     pose_k: &Isometry3<f64>,
     pose_k1: &Isometry3<f64>,
     vehicle_state_k: Option<[f64; 6]>,
     dt: f64,
     config: &PlanePredictionConfig,
-) -> EgoMotion {
-    match vehicle_state_k {
-        Some(vehicle_state) => EgoMotion::Sampled {
-            ect: config.ect,
-            vehicle_state,
-            dt,
-            vehicle_to_sensor: config.vehicle_to_sensor,
-        },
-        None => EgoMotion::Measured(relative_motion(pose_k, pose_k1)),
-    }
+) -> Result<EgoMotion> {
+    Ok(match vehicle_state_k {
+        Some([x, vx, y, vy, heading, yaw_rate]) => {
+            let measured = VehicleState {
+                x,
+                vx,
+                y,
+                vy,
+                heading,
+                yaw_rate,
+            };
+            let vehicle_state = config.vehicle.state_of(&measured);
+            check_vehicle_state(&*config.vehicle, &vehicle_state)?;
+            EgoMotion::Sampled {
+                vehicle: config.vehicle.clone(),
+                vehicle_state,
+                dt,
+                vehicle_to_sensor: config.vehicle_to_sensor,
+            }
+        }
+        None => EgoMotion::Measured(FrameChange::between(pose_k, pose_k1)),
+    })
 }
 
 /// Runs the prediction over consecutive frame pairs `(k, k + 1)` for `k` in `frames`, given a
@@ -304,7 +326,7 @@ fn predict_sequence(
             .filter(|d| d.is_finite() && *d > 0.0)
             .unwrap_or(config.dt);
         let state = states.map(|s| s[k]);
-        let ego = ego_for(&poses[k], &poses[k + 1], state, dt, config);
+        let ego = ego_for(&poses[k], &poses[k + 1], state, dt, config)?;
         out.push(predict_walls(
             &walls_k,
             &walls_k1,
@@ -313,7 +335,7 @@ fn predict_sequence(
             config,
             runs,
             rng,
-        ));
+        )?);
         previous = Some((k + 1, walls_k1));
     }
     Ok(out)

@@ -858,7 +858,9 @@ mod tests {
         let rows = states_for_comparison();
         let mut p = ParticleSet::from_rows(&rows, &vec![1.0; rows.len()]).unwrap();
         let model = CoordinatedTurn::new(0.0, 0.0).unwrap();
-        model.predict(&mut p, &StepContext::new(1, 1.0, 1.0), &mut seeded(1));
+        model
+            .predict(&mut p, &StepContext::new(1, 1.0, 1.0), &mut seeded(1))
+            .unwrap();
         for (i, row) in rows.iter().enumerate() {
             let mut s = row.clone();
             ct_step(&mut s, 1.0);
@@ -876,7 +878,9 @@ mod tests {
             .collect();
         let mut p = ParticleSet::from_rows(&rows, &vec![1.0; rows.len()]).unwrap();
         let model = ConstantVelocity::planar(0.0).unwrap();
-        model.predict(&mut p, &StepContext::new(1, 2.0, 2.0), &mut seeded(1));
+        model
+            .predict(&mut p, &StepContext::new(1, 2.0, 2.0), &mut seeded(1))
+            .unwrap();
         for (i, row) in rows.iter().enumerate() {
             let mut s = row.clone();
             cv_step(&mut s, 2.0);

@@ -92,6 +92,20 @@ pub trait BirthModel: Send + Sync {
         let _ = current;
         self.birth(ctx, evidence, rng)
     }
+
+    /// The length of the states this model's births have, for measurements of
+    /// `measurement_dim` components, when it knows it: the filter's builder compares it with
+    /// the transition's. `None` (the default) skips that check; the filter still refuses a
+    /// birth of the wrong length when it is drawn.
+    fn state_dim(&self, measurement_dim: usize) -> Option<usize> {
+        let _ = measurement_dim;
+        None
+    }
+
+    /// The model's name in errors; the type's name by default.
+    fn name(&self) -> String {
+        crate::filter::model_name::<Self>()
+    }
 }
 
 impl<T: BirthModel + ?Sized> BirthModel for Box<T> {
@@ -114,6 +128,12 @@ impl<T: BirthModel + ?Sized> BirthModel for Box<T> {
         rng: &mut FilterRng,
     ) -> Vec<BirthTrack> {
         (**self).birth_guided(ctx, evidence, current, rng)
+    }
+    fn state_dim(&self, measurement_dim: usize) -> Option<usize> {
+        (**self).state_dim(measurement_dim)
+    }
+    fn name(&self) -> String {
+        (**self).name()
     }
 }
 
@@ -175,6 +195,17 @@ impl StaticBirth {
             if t.std.iter().any(|s| *s < 0.0) {
                 return Err(Error::invalid(what, "negative standard deviation"));
             }
+            if t.mean.len() != terms[0].mean.len() {
+                return Err(Error::invalid(
+                    what,
+                    format!(
+                        "a state of {} components, but term 0 has {} (one filter moves states \
+                         of one length)",
+                        t.mean.len(),
+                        terms[0].mean.len()
+                    ),
+                ));
+            }
         }
         check_particles(particles)?;
         Ok(StaticBirth {
@@ -206,6 +237,10 @@ impl StaticBirth {
 }
 
 impl BirthModel for StaticBirth {
+    fn state_dim(&self, _measurement_dim: usize) -> Option<usize> {
+        self.terms.first().map(|t| t.mean.len())
+    }
+
     fn birth(
         &self,
         _: &StepContext,
@@ -216,7 +251,7 @@ impl BirthModel for StaticBirth {
             .iter()
             .map(|t| BirthTrack {
                 existence: t.existence,
-                particles: ParticleSet::gaussian(&t.mean, &t.std, self.particles, rng),
+                particles: ParticleSet::sampled(&t.mean, &t.std, self.particles, rng),
                 at_previous_step: false,
             })
             .collect()
@@ -287,6 +322,18 @@ impl StaticBirth {
 pub trait BirthSampler: Send + Sync {
     /// `n` particles for an object that produced `z` at the step described by `ctx`.
     fn sample(&self, z: &[f64], ctx: &StepContext, n: usize, rng: &mut FilterRng) -> ParticleSet;
+
+    /// The length of the states drawn for a measurement of `measurement_dim` components,
+    /// when the sampler knows it (see [`BirthModel::state_dim`]); `None` by default.
+    fn state_dim(&self, measurement_dim: usize) -> Option<usize> {
+        let _ = measurement_dim;
+        None
+    }
+
+    /// The sampler's name in errors; the type's name by default.
+    fn name(&self) -> String {
+        crate::filter::model_name::<Self>()
+    }
 }
 
 impl<F> BirthSampler for F
@@ -315,7 +362,11 @@ impl BirthSampler for PositionBirthSampler {
             .iter()
             .flat_map(|_| [self.position_std, self.velocity_std])
             .collect();
-        ParticleSet::gaussian(&mean, &std, n, rng)
+        ParticleSet::sampled(&mean, &std, n, rng)
+    }
+
+    fn state_dim(&self, measurement_dim: usize) -> Option<usize> {
+        Some(2 * measurement_dim)
     }
 }
 
@@ -394,6 +445,14 @@ impl AdaptiveBirth {
 }
 
 impl BirthModel for AdaptiveBirth {
+    fn state_dim(&self, measurement_dim: usize) -> Option<usize> {
+        self.sampler.state_dim(measurement_dim)
+    }
+
+    fn name(&self) -> String {
+        format!("AdaptiveBirth with {}", self.sampler.name())
+    }
+
     fn birth(
         &self,
         _: &StepContext,

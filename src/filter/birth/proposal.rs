@@ -263,7 +263,7 @@ fn sample_plan(
     n: usize,
     rng: &mut FilterRng,
 ) -> ParticleSet {
-    let mut set = ParticleSet::zeros(term.mean.len(), n);
+    let mut set = ParticleSet::zeroed(term.mean.len(), n);
     let p0 = plan.prior_count;
     for (c, (&m, &s)) in term.mean.iter().zip(&term.std).enumerate() {
         let k = observed.iter().position(|&o| o == c);

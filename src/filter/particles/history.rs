@@ -93,7 +93,7 @@ mod tests {
     #[test]
     fn resampling_carries_each_particles_past_along() {
         let mut rng = seeded(5);
-        let mut p = ParticleSet::zeros(2, 6);
+        let mut p = ParticleSet::zeroed(2, 6);
         p.keep_history(2);
         // Particle i starts at (i, −i); each step adds 10 to the first component.
         for (c, sign) in [(0, 1.0), (1, -1.0)] {
@@ -164,7 +164,7 @@ mod tests {
             smooth[k] = m[k] + c * (smooth[k + 1] - m[k]);
         }
         // Bootstrap particle filter with its history.
-        let mut set = ParticleSet::gaussian(&[0.0], &[p0.sqrt()], n, &mut rng);
+        let mut set = ParticleSet::sampled(&[0.0], &[p0.sqrt()], n, &mut rng);
         set.keep_history(lag);
         for (k, &y) in ys.iter().enumerate() {
             if k > 0 {

@@ -108,6 +108,11 @@ impl MeasurementModel for PositionMeasurement {
         self.dims
     }
 
+    fn state_dim(&self) -> Option<usize> {
+        // reads the positions in components 0, 2 (and 4)
+        Some(2 * self.dims - 1)
+    }
+
     fn log_likelihood(
         &self,
         z: &[f64],
@@ -192,7 +197,7 @@ mod tests {
     #[test]
     fn bad_input_gives_minus_infinity_not_nan() {
         let m = PositionMeasurement::new(2, 1.0).unwrap();
-        let p = ParticleSet::zeros(4, 2);
+        let p = ParticleSet::zeroed(4, 2);
         let mut out = vec![0.0; 2];
         m.log_likelihood(&[1.0], &p, &ctx(), &mut out);
         assert_eq!(out, vec![f64::NEG_INFINITY; 2]);

@@ -374,6 +374,11 @@ impl MeasurementModel for RangeBearing {
         2
     }
 
+    fn state_dim(&self) -> Option<usize> {
+        // reads the position in components 0 and 2
+        Some(3)
+    }
+
     fn log_likelihood(
         &self,
         z: &[f64],
@@ -687,7 +692,7 @@ mod tests {
             .with_offset(0.3, -0.1)
             .unwrap();
         let mut rng = crate::rng::seeded(5);
-        let p = ParticleSet::gaussian(&[3.0, 0.0, 4.0, 0.0], &[1.0, 1.0, 1.0, 1.0], 50, &mut rng);
+        let p = ParticleSet::sampled(&[3.0, 0.0, 4.0, 0.0], &[1.0, 1.0, 1.0, 1.0], 50, &mut rng);
         let zs: [&[f64]; 3] = [&[5.0, 0.9], &[4.0, -3.1], &[f64::NAN, 0.0]];
         let mut batch = vec![vec![0.0; 50]; 3];
         m.log_likelihood_batch(&zs, &p, &ctx(), &mut batch);
@@ -720,7 +725,7 @@ mod tests {
                 .unwrap()
                 .with_convention(convention);
             let mut rng = crate::rng::seeded(seed);
-            let p = ParticleSet::gaussian(&[-1.0, 0.0, 0.5, 0.0], &[4.0, 1.0, 4.0, 1.0], 150, &mut rng);
+            let p = ParticleSet::sampled(&[-1.0, 0.0, 0.5, 0.0], &[4.0, 1.0, 4.0, 1.0], 150, &mut rng);
             let c = with_pose(0.3, -0.2, heading);
             let rows: Vec<[f64; 2]> = zs.iter().map(|z| [z.0, z.1]).collect();
             let refs: Vec<&[f64]> = rows.iter().map(|r| &r[..]).collect();

@@ -31,7 +31,7 @@
 
 use crate::error::{Error, Result};
 use crate::filter::ParticleSet;
-use crate::filter::{StepContext, TransitionModel};
+use crate::filter::{check_state_dim, StepContext, TransitionModel};
 use crate::rng::FilterRng;
 use nalgebra::DMatrix;
 use rand_distr::{Distribution, StandardNormal};
@@ -43,7 +43,7 @@ const SERIES_THRESHOLD: f64 = 1e-4;
 ///
 /// `sigma_vel` (m/s²) drives the velocity and position of each axis like a white-noise
 /// acceleration; `sigma_turn` (rad/s²) drives the turn rate. The step length is `ctx.dt`.
-/// Particle sets with fewer than 5 components are left unchanged.
+/// Particle sets with fewer than 5 components are an error.
 #[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CoordinatedTurn {
     sigma_vel: f64,
@@ -124,9 +124,15 @@ impl TransitionModel for CoordinatedTurn {
         5
     }
 
-    fn predict(&self, particles: &mut ParticleSet, ctx: &StepContext, rng: &mut FilterRng) {
-        if particles.dim() < 5 || particles.is_empty() {
-            return;
+    fn predict(
+        &self,
+        particles: &mut ParticleSet,
+        ctx: &StepContext,
+        rng: &mut FilterRng,
+    ) -> Result<()> {
+        check_state_dim(&self.name(), 5, particles)?;
+        if particles.is_empty() {
+            return Ok(());
         }
         let dt = ctx.dt;
         let gp = self.sigma_vel * dt * dt / 2.0;
@@ -136,7 +142,7 @@ impl TransitionModel for CoordinatedTurn {
         let noisy_turn = self.sigma_turn > 0.0;
         let mut comps = particles.components_mut();
         let [px, pvx, py, pvy, pw, ..] = comps.as_mut_slice() else {
-            return;
+            return Ok(());
         };
         let n = px.len();
         let (px, pvx, py, pvy, pw) = (
@@ -172,6 +178,7 @@ impl TransitionModel for CoordinatedTurn {
             pvy[i] = nvy;
             pw[i] = nw;
         }
+        Ok(())
     }
 }
 
@@ -196,7 +203,8 @@ mod tests {
     fn quarter_turn_rotates_velocity_by_ninety_degrees() {
         let ct = CoordinatedTurn::new(0.0, 0.0).unwrap();
         let mut p = one([0.0, 1.0, 0.0, 0.0, PI / 2.0]);
-        ct.predict(&mut p, &StepContext::new(1, 1.0, 1.0), &mut seeded(1));
+        ct.predict(&mut p, &StepContext::new(1, 1.0, 1.0), &mut seeded(1))
+            .unwrap();
         let s = p.state(0);
         // velocity (1, 0) turned left by 90° → (0, 1); a = sin(π/2)/(π/2) = 2/π,
         // b = (1 − 0)/(π/2) = 2/π, so the position is (2/π, 2/π).
@@ -210,7 +218,8 @@ mod tests {
     fn zero_turn_rate_is_constant_velocity() {
         let ct = CoordinatedTurn::new(0.0, 0.0).unwrap();
         let mut p = one([10.0, 3.0, -5.0, 4.0, 0.0]);
-        ct.predict(&mut p, &StepContext::new(1, 2.0, 2.0), &mut seeded(1));
+        ct.predict(&mut p, &StepContext::new(1, 2.0, 2.0), &mut seeded(1))
+            .unwrap();
         assert_eq!(p.state(0), vec![16.0, 3.0, 3.0, 4.0, 0.0]);
     }
 
@@ -242,7 +251,8 @@ mod tests {
         let ct = CoordinatedTurn::new(0.0, 0.0).unwrap();
         let mut st = [100.0, -10.0, 50.0, 7.0, 0.03];
         let mut p = one(st);
-        ct.predict(&mut p, &StepContext::new(1, 1.0, 1.0), &mut seeded(1));
+        ct.predict(&mut p, &StepContext::new(1, 1.0, 1.0), &mut seeded(1))
+            .unwrap();
         CoordinatedTurn::step_noiseless(&mut st, 1.0);
         assert_eq!(p.state(0), st.to_vec());
     }
@@ -251,8 +261,9 @@ mod tests {
     fn process_noise_covariance_matches_g_gt() {
         let ct = CoordinatedTurn::new(5.0, PI / 180.0).unwrap();
         let n = 20_000;
-        let mut p = ParticleSet::zeros(5, n);
-        ct.predict(&mut p, &StepContext::new(1, 1.0, 1.0), &mut seeded(7));
+        let mut p = ParticleSet::zeroed(5, n);
+        ct.predict(&mut p, &StepContext::new(1, 1.0, 1.0), &mut seeded(7))
+            .unwrap();
         let g = ct.noise_gain(1.0);
         let q = &g * g.transpose();
         let cov = p.covariance();

@@ -24,7 +24,7 @@
 
 use crate::error::{Error, Result};
 use crate::filter::ParticleSet;
-use crate::filter::{StepContext, TransitionModel};
+use crate::filter::{check_state_dim, StepContext, TransitionModel};
 use crate::rng::FilterRng;
 use nalgebra::DMatrix;
 use rand::RngExt;
@@ -35,7 +35,7 @@ use rand_distr::{Distribution, StandardNormal};
 ///
 /// `dims` is the number of spatial axes (2 or 3); the state has `2 · dims` components laid out
 /// `[x, ẋ, y, ẏ(, z, ż)]`. The step length is `ctx.dt`. Particle sets with fewer components
-/// than [`TransitionModel::state_dim`] are left unchanged; extra components are not touched.
+/// than [`TransitionModel::state_dim`] are an error; extra components are not touched.
 #[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ConstantVelocity {
     dims: usize,
@@ -173,9 +173,15 @@ impl TransitionModel for ConstantVelocity {
         2 * self.dims
     }
 
-    fn predict(&self, particles: &mut ParticleSet, ctx: &StepContext, rng: &mut FilterRng) {
-        if particles.dim() < self.state_dim() || particles.is_empty() {
-            return;
+    fn predict(
+        &self,
+        particles: &mut ParticleSet,
+        ctx: &StepContext,
+        rng: &mut FilterRng,
+    ) -> Result<()> {
+        check_state_dim(&self.name(), self.state_dim(), particles)?;
+        if particles.is_empty() {
+            return Ok(());
         }
         let (dt, sigma) = (ctx.dt, self.sigma_accel);
         if sigma == 0.0 {
@@ -186,7 +192,7 @@ impl TransitionModel for ConstantVelocity {
                     *p += dt * *v;
                 }
             }
-            return;
+            return Ok(());
         }
         match self.manoeuvre {
             None => self.accelerate(particles, dt, |_| sigma, rng),
@@ -204,6 +210,7 @@ impl TransitionModel for ConstantVelocity {
                 self.accelerate(particles, dt, |i| widths[i], rng)
             }
         }
+        Ok(())
     }
 }
 
@@ -227,7 +234,7 @@ mod tests {
         let rows = vec![vec![1.0, 2.0, -3.0, 0.5], vec![0.0, -1.0, 0.0, 4.0]];
         let mut p = ParticleSet::from_rows(&rows, &[1.0, 1.0]).unwrap();
         let ctx = StepContext::new(1, 2.0, 2.0);
-        cv.predict(&mut p, &ctx, &mut seeded(1));
+        cv.predict(&mut p, &ctx, &mut seeded(1)).unwrap();
         // x + 2·ẋ, y + 2·ẏ; velocities unchanged
         assert_eq!(p.state(0), vec![5.0, 2.0, -2.0, 0.5]);
         assert_eq!(p.state(1), vec![-2.0, -1.0, 8.0, 4.0]);
@@ -238,7 +245,8 @@ mod tests {
         let cv = ConstantVelocity::spatial(0.0).unwrap();
         let x = vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
         let mut p = ParticleSet::from_rows(std::slice::from_ref(&x), &[1.0]).unwrap();
-        cv.predict(&mut p, &StepContext::new(1, 0.5, 0.5), &mut seeded(1));
+        cv.predict(&mut p, &StepContext::new(1, 0.5, 0.5), &mut seeded(1))
+            .unwrap();
         let expected = cv.transition_matrix(0.5) * nalgebra::DVector::from_vec(x);
         for (a, b) in p.state(0).iter().zip(expected.iter()) {
             assert!((a - b).abs() < 1e-12);
@@ -248,11 +256,18 @@ mod tests {
     }
 
     #[test]
-    fn too_short_particles_are_left_alone() {
+    fn too_short_particles_are_an_error_and_left_alone() {
         let cv = ConstantVelocity::spatial(1.0).unwrap();
-        let mut p = ParticleSet::zeros(4, 3);
+        let mut p = ParticleSet::zeroed(4, 3);
         let before = p.clone();
-        cv.predict(&mut p, &StepContext::new(1, 1.0, 1.0), &mut seeded(1));
+        let e = cv
+            .predict(&mut p, &StepContext::new(1, 1.0, 1.0), &mut seeded(1))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("4 components") && e.contains("states of 6"),
+            "{e}"
+        );
         assert_eq!(p, before);
     }
 
@@ -262,11 +277,12 @@ mod tests {
         let dt = 2.0;
         let cv = ConstantVelocity::planar(sigma).unwrap();
         let n = 20_000;
-        let mut p = ParticleSet::zeros(4, n);
+        let mut p = ParticleSet::zeroed(4, n);
         for v in p.component_mut(1) {
             *v = 3.0;
         }
-        cv.predict(&mut p, &StepContext::new(1, dt, dt), &mut seeded(42));
+        cv.predict(&mut p, &StepContext::new(1, dt, dt), &mut seeded(42))
+            .unwrap();
         // remove the deterministic part (x += dt·3)
         for v in p.component_mut(0) {
             *v -= 3.0 * dt;
@@ -309,8 +325,9 @@ mod tests {
         let off = cv.with_manoeuvres(0.0, 3.0).unwrap();
         assert_eq!(off, cv);
         let step = |m: &ConstantVelocity| {
-            let mut p = ParticleSet::zeros(6, 50);
-            m.predict(&mut p, &StepContext::new(1, 0.1, 0.1), &mut seeded(5));
+            let mut p = ParticleSet::zeroed(6, 50);
+            m.predict(&mut p, &StepContext::new(1, 0.1, 0.1), &mut seeded(5))
+                .unwrap();
             p
         };
         assert_eq!(step(&off), step(&cv));
@@ -328,8 +345,9 @@ mod tests {
             .with_manoeuvres(p, k)
             .unwrap();
         let n = 200_000;
-        let mut set = ParticleSet::zeros(6, n);
-        cv.predict(&mut set, &StepContext::new(1, dt, dt), &mut seeded(9));
+        let mut set = ParticleSet::zeroed(6, n);
+        cv.predict(&mut set, &StepContext::new(1, dt, dt), &mut seeded(9))
+            .unwrap();
         let s = sigma * dt;
         let widen = 1.0 - p + p * k * k;
         for axis in 0..3 {

@@ -38,7 +38,7 @@
 
 use crate::error::{Error, Result};
 use crate::filter::ParticleSet;
-use crate::filter::{StepContext, TransitionModel};
+use crate::filter::{check_state_dim, StepContext, TransitionModel};
 use crate::models::CoordinatedTurn;
 use crate::rng::FilterRng;
 use nalgebra::{DMatrix, Isometry3, Vector3};
@@ -46,7 +46,7 @@ use rand_distr::{Distribution, StandardNormal};
 
 /// Extended constant-turn transition, state `[X, Ẋ, Y, Ẏ, φ, φ̇]`.
 ///
-/// The step length is `ctx.dt`. Particle sets with fewer than 6 components are left unchanged;
+/// The step length is `ctx.dt`. Particle sets with fewer than 6 components are an error;
 /// components beyond the sixth are not touched.
 #[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ExtendedConstantTurn {
@@ -161,14 +161,20 @@ impl TransitionModel for ExtendedConstantTurn {
         6
     }
 
-    fn predict(&self, particles: &mut ParticleSet, ctx: &StepContext, rng: &mut FilterRng) {
-        if particles.dim() < 6 || particles.is_empty() {
-            return;
+    fn predict(
+        &self,
+        particles: &mut ParticleSet,
+        ctx: &StepContext,
+        rng: &mut FilterRng,
+    ) -> Result<()> {
+        check_state_dim(&self.name(), 6, particles)?;
+        if particles.is_empty() {
+            return Ok(());
         }
         let dt = ctx.dt;
         let mut comps = particles.components_mut();
         let [px, pvx, py, pvy, pphi, pw, ..] = comps.as_mut_slice() else {
-            return;
+            return Ok(());
         };
         let n = px.len();
         for i in 0..n {
@@ -181,6 +187,7 @@ impl TransitionModel for ExtendedConstantTurn {
             pphi[i] = s[4];
             pw[i] = s[5];
         }
+        Ok(())
     }
 }
 
@@ -255,7 +262,8 @@ mod tests {
         let m = ExtendedConstantTurn::noiseless();
         let st = [100.0, -10.0, 50.0, 7.0, 1.0, 0.03];
         let mut p = ParticleSet::from_rows(&[st.to_vec()], &[1.0]).unwrap();
-        m.predict(&mut p, &StepContext::new(1, 0.1, 0.1), &mut seeded(1));
+        m.predict(&mut p, &StepContext::new(1, 0.1, 0.1), &mut seeded(1))
+            .unwrap();
         assert_eq!(
             p.state(0),
             ExtendedConstantTurn::step_noiseless(&st, 0.1).to_vec()
@@ -273,9 +281,10 @@ mod tests {
     fn process_noise_covariance_matches_g_gt() {
         let m = ExtendedConstantTurn::new(2.0, 0.3).unwrap();
         let n = 20_000;
-        let mut p = ParticleSet::zeros(6, n);
+        let mut p = ParticleSet::zeroed(6, n);
         let dt = 0.5;
-        m.predict(&mut p, &StepContext::new(1, dt, dt), &mut seeded(11));
+        m.predict(&mut p, &StepContext::new(1, dt, dt), &mut seeded(11))
+            .unwrap();
         let g = m.noise_gain(dt);
         let q = &g * g.transpose();
         let cov = p.covariance();

@@ -27,7 +27,8 @@
 //! # Models
 //!
 //! - [`MixedTransition`]: planes move by the ego motion with [`PlaneTransition`] (measured
-//!   poses, or a per-particle ECT draw through a [`VehicleStateHandle`] updated every step);
+//!   poses, or a per-particle draw of a vehicle model through a [`VehicleStateHandle`] updated
+//!   every step);
 //!   clusters move by 3-D [`ConstantVelocity`].
 //! - [`MixedMeasurement`]: planes are scored by [`PlaneMeasurement`]; a cluster particle's
 //!   world position p is taken into the sensor frame, s = T⁻¹ p with T = `ctx.platform`, and
@@ -40,8 +41,9 @@
 //!   do, because two stretches of one facade are one plane state, each measured by its own
 //!   segment.
 //!
-//! The ECT option moves planes by the vehicle (IMU) motion without the IMU → Velodyne
-//! conjugation; for KITTI (a 1 m lever arm) the difference per 0.1 s step is below 1 cm.
+//! The predicted option moves planes by the sensor motion the vehicle (IMU) draw implies, the
+//! IMU → Velodyne calibration included ([`crate::geometry::FrameChange::of_vehicle`]), as the
+//! plane prediction of Gostar et al. (2019, Algorithm 1) does.
 //!
 //! Not for: segmenting planes or clusters out of point clouds (see
 //! [`crate::pipeline::drive_tracking`]).
@@ -50,13 +52,15 @@
 
 use crate::error::{ensure_positive, ensure_probability, Error, Result};
 use crate::filter::{
-    relative_from_logs, BirthSampler, LikelihoodFault, MergeDistance, ParticleSet, ScaledDistance,
+    check_state_dim, relative_from_logs, BirthSampler, LikelihoodFault, MergeDistance, ParticleSet,
+    ScaledDistance,
 };
 use crate::filter::{
     ClutterModel, DetectionModel, MeasurementModel, StepContext, TrackSummary, TransitionModel,
 };
-use crate::models::plane::{canonical_plane, EgoSource};
-use crate::models::{ConstantVelocity, ExtendedConstantTurn, PlaneMeasurement, PlaneTransition};
+use crate::geometry::plane::canonical;
+use crate::models::plane::EgoSource;
+use crate::models::{ConstantVelocity, PlaneMeasurement, PlaneTransition, VehicleModel};
 use crate::numerics::exp::exp_in_place;
 use crate::numerics::ln::ln_in_place;
 use crate::rng::FilterRng;
@@ -140,7 +144,7 @@ pub fn kind_of_measurement(z: &[f64]) -> Option<ObjectKind> {
 
 /// A plane measurement row `[n, d, 0]` (canonical sign).
 pub fn plane_measurement(beta: [f64; 4]) -> [f64; MEASUREMENT_DIM] {
-    let b = canonical_plane(&beta);
+    let b = canonical(&beta);
     [b[0], b[1], b[2], b[3], ObjectKind::Plane.code()]
 }
 
@@ -155,21 +159,22 @@ pub fn cluster_measurement(centroid: [f64; 3]) -> [f64; MEASUREMENT_DIM] {
     ]
 }
 
-/// A shared, updatable vehicle state `[X, Ẋ, Y, Ẏ, φ, φ̇]` for the ECT plane option: the
-/// caller writes the state of the previous step before each filter step.
+/// A shared, updatable vehicle state (in the vehicle model's layout) for the predicted plane
+/// option: the caller writes the state of the previous step before each filter step.
 #[derive(Clone, Debug, Default)]
-pub struct VehicleStateHandle(Arc<RwLock<[f64; 6]>>);
+pub struct VehicleStateHandle(Arc<RwLock<Vec<f64>>>);
 
 impl VehicleStateHandle {
     /// Replaces the vehicle state.
-    pub fn set(&self, state: [f64; 6]) {
+    pub fn set(&self, state: &[f64]) {
         let mut guard = self.0.write().unwrap_or_else(|e| e.into_inner());
-        *guard = state;
+        guard.clear();
+        guard.extend_from_slice(state);
     }
 
     /// The current vehicle state.
-    pub fn get(&self) -> [f64; 6] {
-        *self.0.read().unwrap_or_else(|e| e.into_inner())
+    pub fn get(&self) -> Vec<f64> {
+        self.0.read().unwrap_or_else(|e| e.into_inner()).clone()
     }
 }
 
@@ -201,19 +206,24 @@ impl MixedTransition {
         })
     }
 
-    /// As [`MixedTransition::measured`], but planes are moved by a per-particle ECT draw of
-    /// the vehicle motion from the state in the returned handle (seed 001, Algorithm 1).
+    /// As [`MixedTransition::measured`], but planes are moved by a per-particle draw of the
+    /// vehicle motion from `vehicle`, starting at the state in the returned handle, with the
+    /// vehicle → sensor transform `vehicle_to_sensor` (Gostar et al. 2019, Algorithm 1).
     pub fn predicted(
-        ect: ExtendedConstantTurn,
+        vehicle: Arc<dyn VehicleModel>,
+        vehicle_to_sensor: nalgebra::Isometry3<f64>,
         plane_sigma_angle: f64,
         plane_sigma_offset: f64,
         cluster_sigma_accel: f64,
     ) -> Result<(Self, VehicleStateHandle)> {
         let handle = VehicleStateHandle::default();
+        let state = vec![0.0; vehicle.state_dim()];
+        handle.set(&state);
         let plane = PlaneTransition::new(
             EgoSource::Predicted {
-                ect,
-                vehicle_state: [0.0; 6],
+                vehicle,
+                vehicle_state: state,
+                vehicle_to_sensor,
             },
             plane_sigma_angle,
             plane_sigma_offset,
@@ -243,18 +253,32 @@ impl TransitionModel for MixedTransition {
         STATE_DIM
     }
 
-    fn predict(&self, particles: &mut ParticleSet, ctx: &StepContext, rng: &mut FilterRng) {
+    fn predict(
+        &self,
+        particles: &mut ParticleSet,
+        ctx: &StepContext,
+        rng: &mut FilterRng,
+    ) -> Result<()> {
+        check_state_dim(&self.name(), STATE_DIM, particles)?;
+        if particles.is_empty() {
+            return Ok(());
+        }
         match kind_of_set(particles) {
             Some(ObjectKind::Plane) => match &self.vehicle {
                 None => self.plane.predict(particles, ctx, rng),
                 Some(h) => {
-                    let mut p = self.plane;
-                    p.set_vehicle_state(h.get());
-                    p.predict(particles, ctx, rng)
+                    let state = h.0.read().unwrap_or_else(|e| e.into_inner());
+                    self.plane.predict_from(&state, particles, ctx, rng)
                 }
             },
             Some(ObjectKind::Cluster) => self.cluster.predict(particles, ctx, rng),
-            None => {}
+            None => Err(Error::invalid(
+                format!("state handed to {}", self.name()),
+                format!(
+                    "component {KIND} of particle 0 is {}, neither a wall's nor a cluster's kind",
+                    particles.component(KIND)[0]
+                ),
+            )),
         }
     }
 }
@@ -420,6 +444,10 @@ impl SensorOffset {
 impl MeasurementModel for MixedMeasurement {
     fn measurement_dim(&self) -> usize {
         MEASUREMENT_DIM
+    }
+
+    fn state_dim(&self) -> Option<usize> {
+        Some(STATE_DIM)
     }
 
     fn log_likelihood(
@@ -672,9 +700,9 @@ impl MixedBirthSampler {
 
 impl BirthSampler for MixedBirthSampler {
     fn sample(&self, z: &[f64], ctx: &StepContext, n: usize, rng: &mut FilterRng) -> ParticleSet {
-        let mut set = ParticleSet::zeros(STATE_DIM, n);
+        let mut set = ParticleSet::zeroed(STATE_DIM, n);
         let Some(kind) = kind_of_measurement(z) else {
-            return ParticleSet::zeros(STATE_DIM, 0);
+            return ParticleSet::zeroed(STATE_DIM, 0);
         };
         let mut comps = set.components_mut();
         let [c0, c1, c2, c3, c4, c5, kind_col] = comps.as_mut_slice() else {
@@ -684,7 +712,7 @@ impl BirthSampler for MixedBirthSampler {
         let mut g = || -> f64 { StandardNormal.sample(rng) };
         match kind {
             ObjectKind::Plane => {
-                let b = canonical_plane(&[z[0], z[1], z[2], z[3]]);
+                let b = canonical(&[z[0], z[1], z[2], z[3]]);
                 for i in 0..n {
                     let nx = b[0] + self.plane_sigma_angle * g();
                     let ny = b[1] + self.plane_sigma_angle * g();
@@ -952,11 +980,11 @@ mod tests {
         let t = MixedTransition::measured(0.0, 0.0, 0.0).unwrap();
         let mut plane =
             ParticleSet::from_rows(&[vec![-1.0, 0.0, 0.0, 10.0, 0.0, 0.0, 0.0]], &[1.0]).unwrap();
-        t.predict(&mut plane, &c, &mut seeded(1));
+        t.predict(&mut plane, &c, &mut seeded(1)).unwrap();
         assert_eq!(plane.state(0), vec![-1.0, 0.0, 0.0, 9.0, 0.0, 0.0, 0.0]);
         let mut cluster =
             ParticleSet::from_rows(&[vec![0.0, 2.0, 0.0, -1.0, 0.0, 0.0, 1.0]], &[1.0]).unwrap();
-        t.predict(&mut cluster, &c, &mut seeded(1));
+        t.predict(&mut cluster, &c, &mut seeded(1)).unwrap();
         let s = cluster.state(0);
         assert!((s[0] - 0.2).abs() < 1e-12 && (s[2] + 0.1).abs() < 1e-12 && s[6] == 1.0);
     }

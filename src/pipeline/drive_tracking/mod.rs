@@ -38,7 +38,7 @@ pub use output::{
 };
 pub use repeatability::tracked_wall_pairs;
 pub use source::RecordingSource;
-pub use tracker::DriveTracker;
+pub use tracker::{DriveTracker, DriveTrackerBuilder};
 
 use crate::cloud::fragments::FragmentParams;
 use crate::cloud::odometry::{LidarOdometry, OdometryConfig};
@@ -47,25 +47,89 @@ use crate::cloud::PointCloud;
 use crate::error::{ensure_positive, ensure_probability, Error, Result};
 use crate::filter::{Jitter, LmbConfig};
 use crate::kitti::{OdometrySequence, RawDrive, TrackingSequence};
+use crate::models::{
+    vehicle_model_by_name, ExtendedConstantTurn, SharedVehicleModel, VehicleModel,
+};
 use crate::rng::stream;
 use nalgebra::Isometry3;
 use std::ops::Range;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// How walls are moved between frames.
-#[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+///
+/// In a configuration file: `ego = { kind = "measured" }`, `ego = { kind = "ect",
+/// sigma_accel = 0.5, sigma_turn_accel = 0.1 }`, or any built-in vehicle model by name,
+/// `ego = { kind = "vehicle", model = "bicycle", parameters = { wheelbase = 2.9 } }` (see
+/// [`vehicle_model_by_name`]). A user's own model is [`EgoModel::Custom`], set from code.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum EgoModel {
     /// By the measured OXTS poses (every particle alike).
     Measured,
     /// By a per-particle draw of the extended constant-turn vehicle model from the OXTS
-    /// vehicle state of the previous frame (seed 001, Algorithm 1).
+    /// vehicle state of the previous frame (Gostar et al. 2019, Algorithm 1).
     Ect {
         /// Longitudinal acceleration noise (m/s²).
         sigma_accel: f64,
         /// Yaw acceleration noise (rad/s²).
         sigma_turn_accel: f64,
     },
+    /// As `Ect`, with a built-in vehicle model chosen by name.
+    Vehicle {
+        /// `ect`, `ct` or `bicycle`.
+        model: String,
+        /// The model's parameters by name (the others keep their defaults).
+        #[serde(default)]
+        parameters: std::collections::BTreeMap<String, f64>,
+    },
+    /// As `Ect`, with a user's vehicle model (not in configuration files).
+    #[serde(skip)]
+    Custom(SharedVehicleModel),
+}
+
+impl EgoModel {
+    /// A user's vehicle model.
+    pub fn custom(model: impl VehicleModel + 'static) -> Self {
+        EgoModel::Custom(SharedVehicleModel::new(model))
+    }
+
+    /// The vehicle model that moves the walls, `None` for measured poses; an unknown name
+    /// or parameter is an error.
+    pub fn vehicle_model(&self) -> Result<Option<Arc<dyn VehicleModel>>> {
+        Ok(match self {
+            EgoModel::Measured => None,
+            EgoModel::Ect {
+                sigma_accel,
+                sigma_turn_accel,
+            } => Some(Arc::new(ExtendedConstantTurn::new(
+                *sigma_accel,
+                *sigma_turn_accel,
+            )?)),
+            EgoModel::Vehicle { model, parameters } => {
+                let params: Vec<(String, f64)> =
+                    parameters.iter().map(|(k, v)| (k.clone(), *v)).collect();
+                Some(vehicle_model_by_name(model, &params)?)
+            }
+            EgoModel::Custom(m) => Some(m.0.clone()),
+        })
+    }
+
+    /// Whether a vehicle model moves the walls (it then needs vehicle states).
+    pub fn is_predicted(&self) -> bool {
+        !matches!(self, EgoModel::Measured)
+    }
+
+    /// The suffix of the output's `ego` name: empty for measured poses, `+ect`, `+bicycle`, …,
+    /// or `+` and a user's model's name.
+    fn suffix(&self) -> String {
+        match self {
+            EgoModel::Measured => String::new(),
+            EgoModel::Ect { .. } => "+ect".into(),
+            EgoModel::Vehicle { model, .. } => format!("+{model}"),
+            EgoModel::Custom(m) => format!("+{}", m.name()),
+        }
+    }
 }
 
 /// Where the sensor poses (frame k → first frame) come from.
@@ -494,18 +558,16 @@ struct Recording<'a> {
     poses: Option<Vec<Isometry3<f64>>>,
     /// Where the poses come from, e.g. `oxts` (`none` when every pose is the identity).
     ego: String,
-    /// Vehicle states [X, Ẋ, Y, Ẏ, φ, φ̇] for the ECT ego model, one per frame.
-    vehicle: Option<Vec<[f64; 6]>>,
+    /// Measured vehicle kinematics [X, Ẋ, Y, Ẏ, φ, φ̇] for a vehicle ego model, one per
+    /// frame, and the recording's vehicle → sensor calibration.
+    vehicle: Option<(Vec<[f64; 6]>, Isometry3<f64>)>,
     /// Frame times, s, one per frame.
     times: Vec<f64>,
 }
 
 /// The pose source's name with `+ect` when the ECT ego model moves the walls.
 fn ego_name(source: &str, config: &TrackingConfig) -> String {
-    match config.ego {
-        EgoModel::Measured => source.to_string(),
-        EgoModel::Ect { .. } => format!("{source}+ect"),
-    }
+    format!("{source}{}", config.ego.suffix())
 }
 
 /// The poses of a recording (`None`: lidar odometry) and their source's name, given whether
@@ -528,14 +590,18 @@ fn choose_poses(
     }
 }
 
-/// The vehicle states the ECT ego model needs (`None` for measured poses).
+/// The measured vehicle kinematics and the vehicle → sensor calibration a vehicle ego model
+/// needs (`None` for measured poses).
 fn ect_states(
     config: &TrackingConfig,
     states: impl FnOnce() -> Result<Vec<crate::kitti::VehicleState>>,
-) -> Result<Option<Vec<[f64; 6]>>> {
-    match config.ego {
-        EgoModel::Measured => Ok(None),
-        EgoModel::Ect { .. } => Ok(Some(states()?.iter().map(|s| s.to_array()).collect())),
+    vehicle_to_sensor: impl FnOnce() -> Result<Isometry3<f64>>,
+) -> Result<Option<(Vec<[f64; 6]>, Isometry3<f64>)>> {
+    if config.ego.is_predicted() {
+        let measured = states()?.iter().map(|s| s.to_array()).collect();
+        Ok(Some((measured, vehicle_to_sensor()?)))
+    } else {
+        Ok(None)
     }
 }
 
@@ -563,10 +629,10 @@ pub fn track_drive(
     let n = drive.frame_count();
     check_frame_range(frames.as_ref(), n, &format!("drive {name}"))?;
     if !drive.has_oxts() {
-        if let EgoModel::Ect { .. } = config.ego {
+        if config.ego.is_predicted() {
             return Err(Error::invalid(
                 format!("drive {name}"),
-                "the ECT ego model needs OXTS packets (oxts/data)",
+                "the vehicle ego model needs OXTS packets (oxts/data)",
             ));
         }
     }
@@ -580,7 +646,11 @@ pub fn track_drive(
             .then_some(&oxts_poses as &dyn Fn() -> Result<Vec<Isometry3<f64>>>),
         "oxts",
     )?;
-    let vehicle = ect_states(config, || drive.vehicle_states())?;
+    let vehicle = ect_states(
+        config,
+        || drive.vehicle_states(),
+        || Ok(drive.calib_imu_to_velo()?.isometry),
+    )?;
     let times: Vec<f64> = if drive.velodyne_timestamps_path().is_file() {
         drive.scan_times()?
     } else {
@@ -646,7 +716,11 @@ pub fn track_tracking_sequence(
         read: &read,
         poses,
         ego,
-        vehicle: ect_states(config, || sequence.vehicle_states())?,
+        vehicle: ect_states(
+            config,
+            || sequence.vehicle_states(),
+            || Ok(sequence.calib()?.imu_to_velo),
+        )?,
         times: sequence.times(),
     };
     track_recording(&recording, frames, config, seed, on_frame)
@@ -666,10 +740,10 @@ pub fn track_odometry_sequence(
 ) -> Result<DriveTracks> {
     config.validate()?;
     let name = format!("odometry sequence {}", sequence.dir().display());
-    if let EgoModel::Ect { .. } = config.ego {
+    if config.ego.is_predicted() {
         return Err(Error::invalid(
             name,
-            "the ECT ego model needs OXTS vehicle states, which the odometry layout has not",
+            "the vehicle ego model needs OXTS vehicle states, which the odometry layout has not",
         ));
     }
     let n = sequence.frame_count();
@@ -844,8 +918,15 @@ fn track_recording(
             "hold no scan",
         ));
     }
-    let (times, vehicle) = (&rec.times, &rec.vehicle);
-    let mut tracker = DriveTracker::new(config, seed)?;
+    let times = &rec.times;
+    let vehicle = rec.vehicle.as_ref().map(|(states, _)| states);
+    let mut tracker = DriveTracker::builder(config)
+        .vehicle_to_sensor(
+            rec.vehicle
+                .as_ref()
+                .map_or_else(Isometry3::identity, |v| v.1),
+        )
+        .build(seed)?;
     let mut ego = match &rec.poses {
         Some(p) => Ego::Recorded(p),
         None => Ego::Lidar(Box::new(LidarOdometry::new(OdometryConfig::default())?)),
@@ -867,7 +948,7 @@ fn track_recording(
     let mut next = Some(read(scans[0])?);
     for (i, &k) in scans.iter().enumerate() {
         let (cloud, read_ms) = next.take().expect("each scan is read before its round");
-        let previous_state = vehicle.as_ref().map(|v| v[scans[i.saturating_sub(1)]]);
+        let previous_state = vehicle.map(|v| v[scans[i.saturating_sub(1)]]);
         let following = scans.get(i + 1).copied();
         let steps = if i == 0 { 1 } else { k - scans[i - 1] };
         let (pose, ego_ms) = ego.pose(k, steps, &cloud, &rec.name)?;

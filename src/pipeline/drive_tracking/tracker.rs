@@ -14,16 +14,17 @@
 use super::detect::{detect_here, FrameDetections};
 use super::output::{OrientedBox, StageTimes, TrackedCluster, TrackedFrame, TrackedPlane};
 use super::road_users::{contained_in_others, speed_evidence, travel_direction, RoadUserState};
-use super::{EgoModel, TrackingConfig};
+use super::TrackingConfig;
 use crate::cloud::classes::speed_log_likelihoods;
 use crate::cloud::classes::ClassModel;
 use crate::cloud::PointCloud;
 use crate::error::Result;
 use crate::filter::{AdaptiveBirth, Estimate, Frame, Label, LmbFilter, Track};
+use crate::geometry::plane::canonical;
 use crate::geometry::wrap_angle;
 use crate::geometry::Plane;
-use crate::models::plane::{canonical_plane, plane_residual};
-use crate::models::{ExtendedConstantTurn, PlaneMeasurement};
+use crate::models::plane::plane_residual;
+use crate::models::{PlaneMeasurement, VehicleModel, VehicleState};
 use crate::pipeline::drive_tracking::mixed::{
     MixedBirthSampler, MixedClutter, MixedDetection, MixedMeasurement, MixedMergeDistance,
     MixedTransition, ObjectKind, VehicleStateHandle, KIND,
@@ -31,6 +32,7 @@ use crate::pipeline::drive_tracking::mixed::{
 use crate::rng::{seeded, FilterRng};
 use nalgebra::{Isometry3, Point3, Vector3};
 use std::collections::{HashMap, HashSet};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Largest normal angle between a wall track and the detection it is matched to (rad).
@@ -56,7 +58,8 @@ fn rectangle_gap(a: &[Point3<f64>; 4], b: &[Point3<f64>; 4]) -> f64 {
 /// The tracker of one drive: the filter, its random state and what the report remembers.
 pub struct DriveTracker {
     filter: LmbFilter,
-    vehicle: Option<VehicleStateHandle>,
+    /// The vehicle model of a predicted ego and where its state of each step goes.
+    vehicle: Option<(Arc<dyn VehicleModel>, VehicleStateHandle)>,
     rng: FilterRng,
     /// The report's id of each live label; a label the filter dropped never returns, and its
     /// entries here and in the maps below leave with it (see [`DriveTracker::forget_dropped`]).
@@ -90,28 +93,66 @@ impl std::fmt::Debug for DriveTracker {
     }
 }
 
+/// Assembles a [`DriveTracker`] from a configuration and the recording's parts it does not
+/// hold: the vehicle → sensor calibration a vehicle ego model moves walls with.
+#[derive(Debug)]
+pub struct DriveTrackerBuilder<'a> {
+    config: &'a TrackingConfig,
+    vehicle_to_sensor: Isometry3<f64>,
+}
+
+impl DriveTrackerBuilder<'_> {
+    /// The vehicle (IMU) → sensor transform C, `p_sensor = C p_vehicle`, of the recording
+    /// (KITTI: `calib_imu_to_velo.txt`, `Tr_imu_velo`); default the identity. Only a vehicle
+    /// ego model ([`super::EgoModel`] other than `Measured`) uses it.
+    pub fn vehicle_to_sensor(mut self, c: Isometry3<f64>) -> Self {
+        self.vehicle_to_sensor = c;
+        self
+    }
+
+    /// The tracker; `seed` drives the filter's randomness.
+    pub fn build(self, seed: u64) -> Result<DriveTracker> {
+        DriveTracker::assemble(self.config, self.vehicle_to_sensor, seed)
+    }
+}
+
 impl DriveTracker {
     /// A tracker with the models and tuning of `config`; `seed` drives the filter's randomness.
+    /// The same as [`DriveTracker::builder`] with the identity vehicle → sensor transform.
     pub fn new(config: &TrackingConfig, seed: u64) -> Result<Self> {
+        Self::builder(config).build(seed)
+    }
+
+    /// A builder for the tracker of `config`.
+    pub fn builder(config: &TrackingConfig) -> DriveTrackerBuilder<'_> {
+        DriveTrackerBuilder {
+            config,
+            vehicle_to_sensor: Isometry3::identity(),
+        }
+    }
+
+    fn assemble(
+        config: &TrackingConfig,
+        vehicle_to_sensor: Isometry3<f64>,
+        seed: u64,
+    ) -> Result<Self> {
         config.validate()?;
         let p = &config.plane;
         let c = &config.cluster;
-        let (transition, vehicle) = match config.ego {
-            EgoModel::Measured => (
+        let (transition, vehicle) = match config.ego.vehicle_model()? {
+            None => (
                 MixedTransition::measured(p.process_angle, p.process_offset, c.sigma_accel)?,
                 None,
             ),
-            EgoModel::Ect {
-                sigma_accel,
-                sigma_turn_accel,
-            } => {
+            Some(model) => {
                 let (t, h) = MixedTransition::predicted(
-                    ExtendedConstantTurn::new(sigma_accel, sigma_turn_accel)?,
+                    model.clone(),
+                    vehicle_to_sensor,
                     p.process_angle,
                     p.process_offset,
                     c.sigma_accel,
                 )?;
-                (t, Some(h))
+                (t, Some((model, h)))
             }
         };
         let transition =
@@ -243,9 +284,7 @@ impl DriveTracker {
         vehicle_state: Option<[f64; 6]>,
     ) -> Result<()> {
         rayon::scope(|_| {
-            if let (Some(h), Some(s)) = (&self.vehicle, vehicle_state) {
-                h.set(s);
-            }
+            self.set_vehicle_state(vehicle_state);
             self.filter.predict_step(time, Some(pose), &mut self.rng)
         })?;
         self.predicted = Some((time, pose));
@@ -275,6 +314,23 @@ impl DriveTracker {
         })
     }
 
+    /// Hands a vehicle ego model the state of the previous frame, built from the measured
+    /// kinematics `[X, Ẋ, Y, Ẏ, φ, φ̇]` ([`VehicleModel::state_of`]).
+    fn set_vehicle_state(&self, measured: Option<[f64; 6]>) {
+        if let (Some((model, h)), Some([x, vx, y, vy, heading, yaw_rate])) =
+            (&self.vehicle, measured)
+        {
+            h.set(&model.state_of(&VehicleState {
+                x,
+                vx,
+                y,
+                vy,
+                heading,
+                yaw_rate,
+            }));
+        }
+    }
+
     fn step_here(
         &mut self,
         frame: usize,
@@ -284,9 +340,7 @@ impl DriveTracker {
         detections: &FrameDetections,
     ) -> Result<TrackedFrame> {
         let start = Instant::now();
-        if let (Some(h), Some(s)) = (&self.vehicle, vehicle_state) {
-            h.set(s);
-        }
+        self.set_vehicle_state(vehicle_state);
         let measurements = detections.measurements()?;
         let estimates = self.filter.step(
             &Frame {
@@ -369,7 +423,7 @@ impl DriveTracker {
             match e.state.get(KIND).copied().and_then(ObjectKind::from_code) {
                 Some(ObjectKind::Plane) => {
                     let s = &e.state;
-                    planes.push((e, canonical_plane(&[s[0], s[1], s[2], s[3]])));
+                    planes.push((e, canonical(&[s[0], s[1], s[2], s[3]])));
                 }
                 Some(ObjectKind::Cluster) => {
                     let w = Point3::new(e.state[0], e.state[2], e.state[4]);

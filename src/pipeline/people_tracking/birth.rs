@@ -145,7 +145,7 @@ impl PeopleBirth {
         let mean = [centre[0], 0.0, centre[1], 0.0, 1.0];
         let std = [p, v, p, v, 0.0];
         let dim = if self.with_detectability { 5 } else { 4 };
-        let mut set = ParticleSet::gaussian(&mean[..dim], &std[..dim], self.particles, rng);
+        let mut set = ParticleSet::sampled(&mean[..dim], &std[..dim], self.particles, rng);
         let (sr, sb) = self.sensor.noise();
         let mut comps = set.components_mut().into_iter();
         let (x, _, y) = (

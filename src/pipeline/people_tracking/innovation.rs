@@ -151,7 +151,7 @@ mod tests {
     #[test]
     fn an_empty_cloud_gives_none() {
         let sensor = RangeBearing::new(0.1, 0.02).unwrap();
-        let empty = ParticleSet::zeros(4, 0);
+        let empty = ParticleSet::zeroed(4, 0);
         let inn = particle_innovation(Label::new(0, 0), &empty, [5.0, 0.9], &sensor, &ctx());
         assert!(inn.is_none());
     }

@@ -145,7 +145,7 @@ mod tests {
         assert!((probability_moving(&p, 0.3) - 0.5).abs() < 1e-12);
         assert!((probability_moving(&p, 0.05) - 1.0).abs() < 1e-12);
         assert_eq!(probability_moving(&p, 2.0), 0.0);
-        assert_eq!(probability_moving(&ParticleSet::zeros(2, 3), 0.1), 0.0);
+        assert_eq!(probability_moving(&ParticleSet::zeroed(2, 3), 0.1), 0.0);
     }
 
     #[test]

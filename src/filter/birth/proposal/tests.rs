@@ -113,7 +113,7 @@ fn likelihood_integral_matches_the_closed_form() {
     for seed in 0..20 {
         let g = eta(&guided(1000, seed));
         assert!((g / exact - 1.0).abs() < 0.1, "seed {seed}: {g} vs {exact}");
-        let plain = ParticleSet::gaussian(&t.mean, &t.std, 1000, &mut seeded(seed));
+        let plain = ParticleSet::sampled(&t.mean, &t.std, 1000, &mut seeded(seed));
         if (eta(&plain) / exact - 1.0).abs() > 0.1 {
             plain_off += 1;
         }
@@ -145,7 +145,7 @@ fn same_seed_same_sample() {
 #[test]
 fn without_usable_measurements_it_is_plain_prior_sampling() {
     let t = term();
-    let plain = ParticleSet::gaussian(&t.mean, &t.std, 300, &mut seeded(2));
+    let plain = ParticleSet::sampled(&t.mean, &t.std, 300, &mut seeded(2));
     let z = far_measurements();
     // Every measurement explained by a track.
     let explained = CurrentMeasurements {
@@ -229,7 +229,7 @@ fn converted_points_with_their_own_spread_keep_the_prior() {
     );
     // A point whose spread is not usable gets no component: plain prior sampling.
     let bad = [f64::NAN, 1.0, 0.0, 1.0];
-    let plain = ParticleSet::gaussian(&t.mean, &t.std, 300, &mut seeded(2));
+    let plain = ParticleSet::sampled(&t.mean, &t.std, 300, &mut seeded(2));
     assert_eq!(
         proposal().sample_points(&t, &pts, &bad, &[], 300, &mut seeded(2)),
         plain

@@ -30,7 +30,7 @@
 
 use crate::error::{ensure_probability, Error, Result};
 use crate::filter::ParticleSet;
-use crate::filter::{DetectionModel, StepContext, TransitionModel};
+use crate::filter::{check_state_dim, DetectionModel, StepContext, TransitionModel};
 use crate::rng::FilterRng;
 use rand::RngExt;
 
@@ -118,11 +118,14 @@ impl<T: TransitionModel> TransitionModel for DetectabilityTransition<T> {
         self.component + 1
     }
 
-    fn predict(&self, particles: &mut ParticleSet, ctx: &StepContext, rng: &mut FilterRng) {
-        self.inner.predict(particles, ctx, rng);
-        if particles.dim() <= self.component {
-            return;
-        }
+    fn predict(
+        &self,
+        particles: &mut ParticleSet,
+        ctx: &StepContext,
+        rng: &mut FilterRng,
+    ) -> Result<()> {
+        check_state_dim(&self.name(), self.state_dim(), particles)?;
+        self.inner.predict(particles, ctx, rng)?;
         let (lose, regain) = (self.chain.lose, self.chain.regain);
         for m in particles.component_mut(self.component) {
             let u: f64 = rng.random();
@@ -134,6 +137,7 @@ impl<T: TransitionModel> TransitionModel for DetectabilityTransition<T> {
             let detectable = is_detectable(*m) != flip;
             *m = if detectable { 1.0 } else { 0.0 };
         }
+        Ok(())
     }
 }
 
@@ -197,7 +201,7 @@ mod tests {
     }
 
     fn set_with_modes(modes: &[f64]) -> ParticleSet {
-        let mut p = ParticleSet::zeros(5, modes.len());
+        let mut p = ParticleSet::zeroed(5, modes.len());
         p.component_mut(4).copy_from_slice(modes);
         p
     }
@@ -246,13 +250,13 @@ mod tests {
         let mut p = set_with_modes(&vec![1.0; n]);
         let mut rng = seeded(7);
         let ctx = StepContext::new(1, 0.125, 0.125);
-        t.predict(&mut p, &ctx, &mut rng);
+        t.predict(&mut p, &ctx, &mut rng).unwrap();
         let undetectable = p.component(4).iter().filter(|&&m| m == 0.0).count();
         let share = undetectable as f64 / n as f64;
         // binomial standard error ≈ 0.0017
         assert!((share - 0.06).abs() < 0.008, "{share}");
         for _ in 0..60 {
-            t.predict(&mut p, &ctx, &mut rng);
+            t.predict(&mut p, &ctx, &mut rng).unwrap();
         }
         let detectable = p.component(4).iter().filter(|&&m| m == 1.0).count() as f64 / n as f64;
         assert!((detectable - 0.2 / 0.26).abs() < 0.015, "{detectable}");
@@ -267,7 +271,7 @@ mod tests {
         let mut p = set_with_modes(&[1.0, 0.0]);
         p.component_mut(1).copy_from_slice(&[1.0, -2.0]);
         let ctx = StepContext::new(1, 0.5, 0.5);
-        t.predict(&mut p, &ctx, &mut seeded(1));
+        t.predict(&mut p, &ctx, &mut seeded(1)).unwrap();
         assert_eq!(p.component(0), &[0.5, -1.0]);
     }
 

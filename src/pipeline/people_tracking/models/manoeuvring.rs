@@ -17,7 +17,7 @@
 
 use crate::error::{ensure_probability, Error, Result};
 use crate::filter::ParticleSet;
-use crate::filter::{StepContext, TransitionModel};
+use crate::filter::{check_state_dim, StepContext, TransitionModel};
 use crate::models::ConstantVelocity;
 use crate::rng::FilterRng;
 use rand::RngExt;
@@ -61,9 +61,15 @@ impl TransitionModel for ManoeuvringVelocity {
         self.calm.state_dim()
     }
 
-    fn predict(&self, particles: &mut ParticleSet, ctx: &StepContext, rng: &mut FilterRng) {
-        if particles.dim() < self.state_dim() || particles.is_empty() {
-            return;
+    fn predict(
+        &self,
+        particles: &mut ParticleSet,
+        ctx: &StepContext,
+        rng: &mut FilterRng,
+    ) -> Result<()> {
+        check_state_dim(&self.name(), self.state_dim(), particles)?;
+        if particles.is_empty() {
+            return Ok(());
         }
         let dt = ctx.dt;
         let half_dt2 = 0.5 * dt * dt;
@@ -79,7 +85,7 @@ impl TransitionModel for ManoeuvringVelocity {
             let mut it = comps.iter_mut();
             let (x, vx, y, vy) = match (it.next(), it.next(), it.next(), it.next()) {
                 (Some(x), Some(vx), Some(y), Some(vy)) => (x, vx, y, vy),
-                _ => return,
+                _ => return Ok(()),
             };
             for (((x, vx), y), vy) in x
                 .iter_mut()
@@ -97,7 +103,7 @@ impl TransitionModel for ManoeuvringVelocity {
                 *y += dt * *vy + half_dt2 * ay;
                 *vy += dt * ay;
             }
-            return;
+            return Ok(());
         }
         for i in 0..comps[0].len() {
             let u: f64 = rng.random();
@@ -110,6 +116,7 @@ impl TransitionModel for ManoeuvringVelocity {
                 comps[2 * axis + 1][i] = v + dt * a;
             }
         }
+        Ok(())
     }
 }
 
@@ -135,9 +142,10 @@ mod tests {
         let cv = ConstantVelocity::planar(0.3).unwrap();
         let m = ManoeuvringVelocity::new(cv, 0.1, 3.0).unwrap();
         let n = 100_000;
-        let mut p = ParticleSet::zeros(4, n);
+        let mut p = ParticleSet::zeroed(4, n);
         let dt = 0.5;
-        m.predict(&mut p, &StepContext::new(1, dt, dt), &mut seeded(3));
+        m.predict(&mut p, &StepContext::new(1, dt, dt), &mut seeded(3))
+            .unwrap();
         let dv = p.component(1);
         let var = dv.iter().map(|v| v * v).sum::<f64>() / n as f64;
         let want = dt * dt * (0.9 * 0.09 + 0.1 * 9.0);
@@ -159,8 +167,9 @@ mod tests {
         let cv = ConstantVelocity::planar(0.3).unwrap();
         let m = ManoeuvringVelocity::new(cv, 0.0, 3.0).unwrap();
         let n = 20_000;
-        let mut p = ParticleSet::zeros(4, n);
-        m.predict(&mut p, &StepContext::new(1, 1.0, 1.0), &mut seeded(5));
+        let mut p = ParticleSet::zeroed(4, n);
+        m.predict(&mut p, &StepContext::new(1, 1.0, 1.0), &mut seeded(5))
+            .unwrap();
         let max = p.component(3).iter().fold(0.0f64, |a, v| a.max(v.abs()));
         assert!(max < 0.3 * 5.0, "{max}");
         let var = p.component(3).iter().map(|v| v * v).sum::<f64>() / n as f64;
