@@ -14,7 +14,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// Frames of sequence 0000 in the shared data.
-const FRAMES: usize = 50;
+const FRAMES: usize = 100;
 
 struct Shared {
     tracking: PathBuf,
@@ -99,7 +99,7 @@ fn labels_of_sequence_0000_hold_lidar_points() {
     assemble(&s, tmp.path(), FRAMES);
     let seq = TrackingSequence::open(tmp.path(), 0).unwrap();
     let labels = seq.labels().unwrap();
-    assert_eq!(labels.len(), 228);
+    assert_eq!(labels.len(), 525);
     assert_eq!(label_frame_count(&labels), FRAMES);
     let mut per_frame = BTreeMap::new();
     for l in &labels {
@@ -118,8 +118,8 @@ fn labels_of_sequence_0000_hold_lidar_points() {
         ])
     );
     let count = |t: ObjectType| labels.iter().filter(|l| l.object_type == t).count();
-    assert_eq!(count(ObjectType::Cyclist), 50);
-    assert_eq!(count(ObjectType::DontCare), 77);
+    assert_eq!(count(ObjectType::Cyclist), 100);
+    assert_eq!(count(ObjectType::DontCare), 224);
 
     let calib = seq.calib().unwrap();
     let rect_from_velo = calib.rect_from_velo();
@@ -216,7 +216,7 @@ fn broken_sequences_fail_naming_file_and_line() {
     std::fs::write(&oxts, &full).unwrap();
     assert_error(
         seq.poses().unwrap_err(),
-        &["oxts/0000.txt:4: packet: 50 packets for the 3 frames the scans in"],
+        &["oxts/0000.txt:4: packet: 100 packets for the 3 frames the scans in"],
     );
 
     // Calibration without Tr_imu_velo.
@@ -244,7 +244,7 @@ fn broken_sequences_fail_naming_file_and_line() {
     std::fs::remove_file(&calib).unwrap();
     assert_error(seq.poses().unwrap_err(), &["calib/0000.txt"]);
 
-    // Labels of 50 frames for 3 scans: the first label line beyond the scans.
+    // Labels of 100 frames for 3 scans: the first label line beyond the scans.
     assert_error(
         seq.labels().unwrap_err(),
         &[
@@ -264,7 +264,7 @@ fn broken_sequences_fail_naming_file_and_line() {
         &[&format!("label_02/0000.txt:{first_beyond}: frame")],
     );
     assert!(seq.check().iter().any(
-        |i| matches!(i, Issue::CountMismatch { a, a_count: 50, b_count: 3, .. } if a.ends_with("label_02/0000.txt"))
+        |i| matches!(i, Issue::CountMismatch { a, a_count: 100, b_count: 3, .. } if a.ends_with("label_02/0000.txt"))
     ));
 
     // A label line with 16 fields.
@@ -313,8 +313,8 @@ fn pipelines_run_on_the_tracking_layout_as_on_the_raw_drive() {
     assert_eq!(tracks.drive, "tracking_0000");
     assert_eq!(tracks.ego, "oxts");
     assert_eq!(tracks.frames.len(), 3);
-    let err = track_tracking_sequence(&seq, Some(40..60), &c, 1, |_| Ok(()))
+    let err = track_tracking_sequence(&seq, Some(90..110), &c, 1, |_| Ok(()))
         .unwrap_err()
         .to_string();
-    assert!(err.contains("beyond its 50 frames"), "{err}");
+    assert!(err.contains("beyond its 100 frames"), "{err}");
 }

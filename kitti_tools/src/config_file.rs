@@ -325,3 +325,21 @@ mod hostile {
         }
     }
 }
+
+/// `--vehicle-param NAME=VALUE` flags as (name, value) pairs; a flag without `=` or with a
+/// value that is not a number is an error naming it.
+pub fn vehicle_params(flags: &[String]) -> anyhow::Result<Vec<(String, f64)>> {
+    flags
+        .iter()
+        .map(|f| {
+            let Some((name, value)) = f.split_once('=') else {
+                anyhow::bail!("--vehicle-param `{f}`: expected NAME=VALUE, e.g. wheelbase=2.9");
+            };
+            let v: f64 = value
+                .trim()
+                .parse()
+                .map_err(|_| anyhow::anyhow!("--vehicle-param `{f}`: `{value}` is not a number"))?;
+            Ok((name.trim().to_string(), v))
+        })
+        .collect()
+}

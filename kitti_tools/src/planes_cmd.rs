@@ -70,6 +70,15 @@ pub struct Args {
     /// vegetation, hedges, car sides.
     #[arg(long)]
     any_vertical: bool,
+    /// The vehicle model that Algorithm 1 draws the ego motion from: `ect` (the paper's
+    /// extended constant turn), `ct` (constant turn rate and velocity) or `bicycle`
+    /// (kinematic bicycle).
+    #[arg(long, value_name = "NAME", default_value = "ect")]
+    vehicle_model: String,
+    /// A parameter of the vehicle model, `NAME=VALUE` (repeatable): `sigma_accel`,
+    /// `sigma_turn_accel` (ect, ct); `wheelbase`, `sigma_accel`, `sigma_steer_rate` (bicycle).
+    #[arg(long, value_name = "NAME=VALUE")]
+    vehicle_param: Vec<String>,
 }
 
 /// Source of the ego motion.
@@ -138,9 +147,13 @@ pub fn run(args: Args) -> Result<()> {
     if args.any_vertical {
         planes.wall_quality = None;
     }
+    let params = crate::config_file::vehicle_params(&args.vehicle_param)?;
+    let vehicle = smc_lmb::models::vehicle_model_by_name(&args.vehicle_model, &params)
+        .context("--vehicle-model")?;
     let config = PlanePredictionConfig {
         planes,
         use_vehicle_model: !args.measured,
+        vehicle: smc_lmb::models::SharedVehicleModel(vehicle),
         ..PlanePredictionConfig::default()
     };
     config.validate().context("plane segmentation settings")?;
@@ -202,8 +215,12 @@ pub fn run(args: Args) -> Result<()> {
     } else if args.measured || matches!(input, Input::Odometry(_)) {
         "ego motion: recorded poses (measured motion)".to_string()
     } else {
+        let model = match args.vehicle_model.as_str() {
+            "ect" => "ECT".to_string(),
+            other => other.to_string(),
+        };
         format!(
-            "ego motion: vehicle model (ECT, {} Monte-Carlo runs) from the recorded OXTS states",
+            "ego motion: vehicle model ({model}, {} Monte-Carlo runs) from the recorded OXTS states",
             args.runs
         )
     };

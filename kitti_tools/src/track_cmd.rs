@@ -80,9 +80,17 @@ pub struct Args {
     /// vegetation, hedges, car sides.
     #[arg(long)]
     any_vertical: bool,
-    /// Move walls by a per-particle draw of the vehicle model instead of the measured poses.
+    /// Move walls by a per-particle draw of the vehicle model instead of the measured poses
+    /// (the extended constant turn; `--vehicle-model` names another).
     #[arg(long)]
     ect: bool,
+    /// Move walls by a per-particle draw of this vehicle model: `ect`, `ct` or `bicycle`
+    /// (implies a vehicle ego like `--ect`).
+    #[arg(long, value_name = "NAME", conflicts_with = "ect")]
+    vehicle_model: Option<String>,
+    /// A parameter of the vehicle model, `NAME=VALUE` (repeatable; see `planes --help`).
+    #[arg(long, value_name = "NAME=VALUE", requires = "vehicle_model")]
+    vehicle_param: Vec<String>,
     /// Where the poses come from: the recording's own (OXTS, `poses/NN.txt`), lidar odometry
     /// on the scans, `auto` (recorded when the recording has them, lidar odometry otherwise)
     /// or `static` (a sensor that does not move). The output's `ego` says which was used.
@@ -155,6 +163,15 @@ pub fn run(args: Args) -> Result<()> {
             sigma_accel: 0.5,
             sigma_turn_accel: 0.1,
         };
+    }
+    if let Some(model) = &args.vehicle_model {
+        config.ego = EgoModel::Vehicle {
+            model: model.clone(),
+            parameters: crate::config_file::vehicle_params(&args.vehicle_param)?
+                .into_iter()
+                .collect(),
+        };
+        config.validate().context("--vehicle-model")?;
     }
     config.poses = args.ego.into();
     config.all_clusters = args.all_clusters;

@@ -8,6 +8,8 @@ import smc_lmb
 from conftest import shared_data
 
 DRIVE = "kitti_raw/2011_09_26/2011_09_26_drive_0005_sync"
+# Frames of drive 0005 (= tracking sequence 0000) in the shared data.
+FRAMES = 100
 
 
 def test_a_bin_written_with_numpy_reads_back(tmp_path):
@@ -68,24 +70,24 @@ def test_a_bad_label_line_names_file_and_line(tmp_path):
 def test_real_raw_drive_scans_poses_and_times():
     root = shared_data(DRIVE)
     drive = smc_lmb.RawDrive(root)
-    assert drive.frame_count == 50
-    assert all(drive.has_scan(k) for k in range(50)) and not drive.has_scan(50)
+    assert drive.frame_count == FRAMES
+    assert all(drive.has_scan(k) for k in range(FRAMES)) and not drive.has_scan(FRAMES)
     scan = drive.velodyne(11)
     raw = np.fromfile(root / "velodyne_points/data/0000000011.bin", dtype=np.float32).reshape(-1, 4)
     np.testing.assert_array_equal(scan, raw)
     assert len(scan) == 123334  # seed 001's point count of frame 11
     poses = drive.poses()
-    assert poses.shape == (50, 4, 4)
+    assert poses.shape == (FRAMES, 4, 4)
     np.testing.assert_allclose(poses[0], np.eye(4), atol=1e-12)
     for p in poses:
         np.testing.assert_allclose(p[:3, :3].T @ p[:3, :3], np.eye(3), atol=1e-9)
-    # A slow bend at about 3.5 m/s: 49 frames of ~0.1 s cover 15 to 20 m.
-    travelled = np.linalg.norm(np.diff(poses[:, :3, 3], axis=0), axis=1).sum()
+    # A slow bend at about 3.5 m/s: the first 49 frame steps of ~0.1 s cover 15 to 20 m.
+    travelled = np.linalg.norm(np.diff(poses[:50, :3, 3], axis=0), axis=1).sum()
     assert 15.0 < travelled < 20.0, travelled
     times = drive.times()
     assert times[0] == 0.0 and np.all(np.diff(times) > 0.09) and np.all(np.diff(times) < 0.11)
     states = drive.vehicle_states()
-    assert states.shape == (50, 6)
+    assert states.shape == (FRAMES, 6)
     speed = np.hypot(states[:, 1], states[:, 3])
     assert 2.5 < speed.mean() < 4.5
 
@@ -155,11 +157,11 @@ def test_a_bad_pose_line_names_the_file_and_line(tmp_path):
 def test_real_tracking_sequence_poses_and_labels():
     root = shared_data("kitti_tracking/training")
     seq = smc_lmb.TrackingSequence(root, 0)
-    assert seq.name == "0000" and seq.frame_count == 50
+    assert seq.name == "0000" and seq.frame_count == FRAMES
     # The shared copy keeps no scans (they are raw drive 0005's): frames come from OXTS.
     assert not seq.has_scan(0)
     poses = seq.poses()
-    assert poses.shape == (50, 4, 4)
+    assert poses.shape == (FRAMES, 4, 4)
     np.testing.assert_allclose(poses[0], np.eye(4), atol=1e-12)
     np.testing.assert_allclose(seq.times()[:3], [0.0, 0.1, 0.2])
     lab = seq.labels()

@@ -41,7 +41,8 @@ pub use measurements::Measurements;
 pub use merge::{MergeDistance, ScaledDistance};
 pub use model::{
     check_state_dim, model_name, relative_from_logs, ClutterModel, DetectionModel, LikelihoodFault,
-    MeasurementModel, StepContext, SurvivalModel, TrackSummary, TransitionModel,
+    MeasurementModel, SharedTransitionModel, StepContext, SurvivalModel, TrackSummary,
+    TransitionModel,
 };
 pub use particles::{Jitter, ParticleSet};
 pub use smoothing::FixedLagSmoother;

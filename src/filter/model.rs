@@ -150,6 +150,46 @@ pub trait TransitionModel: Send + Sync {
     }
 }
 
+/// A transition model held by a configuration: shared, compared by identity, shown by name.
+#[derive(Clone)]
+pub struct SharedTransitionModel(pub std::sync::Arc<dyn TransitionModel>);
+
+impl SharedTransitionModel {
+    /// Shares `model`.
+    pub fn new(model: impl TransitionModel + 'static) -> Self {
+        SharedTransitionModel(std::sync::Arc::new(model))
+    }
+}
+
+impl std::fmt::Debug for SharedTransitionModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0.name())
+    }
+}
+
+impl PartialEq for SharedTransitionModel {
+    fn eq(&self, other: &Self) -> bool {
+        std::sync::Arc::ptr_eq(&self.0, &other.0)
+    }
+}
+
+impl<T: TransitionModel + ?Sized> TransitionModel for std::sync::Arc<T> {
+    fn state_dim(&self) -> usize {
+        (**self).state_dim()
+    }
+    fn predict(
+        &self,
+        particles: &mut ParticleSet,
+        ctx: &StepContext,
+        rng: &mut FilterRng,
+    ) -> Result<()> {
+        (**self).predict(particles, ctx, rng)
+    }
+    fn name(&self) -> String {
+        (**self).name()
+    }
+}
+
 /// Probability p_S(x) that an object survives from the previous step to this one.
 pub trait SurvivalModel: Send + Sync {
     /// Writes p_S of every particle into `out` (values in [0, 1]).

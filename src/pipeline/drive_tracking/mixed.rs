@@ -178,12 +178,24 @@ impl VehicleStateHandle {
     }
 }
 
-/// Plane transition or constant velocity, chosen by the kind of the set.
-#[derive(Clone, Debug)]
+/// Plane transition or the road users' motion, chosen by the kind of the set.
+#[derive(Clone)]
 pub struct MixedTransition {
     plane: PlaneTransition,
     vehicle: Option<VehicleStateHandle>,
     cluster: ConstantVelocity,
+    /// A user's road-user model, used instead of `cluster` when set.
+    road_users: Option<Arc<dyn TransitionModel>>,
+}
+
+impl std::fmt::Debug for MixedTransition {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("MixedTransition")
+            .field("plane", &self.plane)
+            .field("cluster", &self.cluster)
+            .field("road_users", &self.road_users.as_ref().map(|m| m.name()))
+            .finish_non_exhaustive()
+    }
 }
 
 impl MixedTransition {
@@ -203,6 +215,7 @@ impl MixedTransition {
             )?,
             vehicle: None,
             cluster: ConstantVelocity::spatial(cluster_sigma_accel)?,
+            road_users: None,
         })
     }
 
@@ -233,6 +246,7 @@ impl MixedTransition {
                 plane,
                 vehicle: Some(handle.clone()),
                 cluster: ConstantVelocity::spatial(cluster_sigma_accel)?,
+                road_users: None,
             },
             handle,
         ))
@@ -244,6 +258,22 @@ impl MixedTransition {
     /// ([`ConstantVelocity::with_manoeuvres`]).
     pub fn with_cluster_manoeuvres(mut self, probability: f64, scale: f64) -> Result<Self> {
         self.cluster = self.cluster.with_manoeuvres(probability, scale)?;
+        Ok(self)
+    }
+
+    /// The same transition whose clusters move by `model` instead of constant velocity: it
+    /// gets a cluster's state [x, ẋ, y, ẏ, z, ż] (and the kind tag after it, which it must
+    /// not need: the tag is written back after each prediction). A model of neither 4 nor 6
+    /// components is an error naming it.
+    pub fn with_road_users(mut self, model: Arc<dyn TransitionModel>) -> Result<Self> {
+        let d = model.state_dim();
+        if d != 4 && d != 6 {
+            return Err(Error::invalid(
+                format!("road-user motion {}", model.name()),
+                format!("moves states of {d} components; a cluster's state has 4 or 6"),
+            ));
+        }
+        self.road_users = Some(model);
         Ok(self)
     }
 }
@@ -271,7 +301,16 @@ impl TransitionModel for MixedTransition {
                     self.plane.predict_from(&state, particles, ctx, rng)
                 }
             },
-            Some(ObjectKind::Cluster) => self.cluster.predict(particles, ctx, rng),
+            Some(ObjectKind::Cluster) => match &self.road_users {
+                None => self.cluster.predict(particles, ctx, rng),
+                Some(m) => {
+                    m.predict(particles, ctx, rng)?;
+                    particles
+                        .component_mut(KIND)
+                        .fill(ObjectKind::Cluster.code());
+                    Ok(())
+                }
+            },
             None => Err(Error::invalid(
                 format!("state handed to {}", self.name()),
                 format!(

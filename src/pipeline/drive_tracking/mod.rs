@@ -45,7 +45,7 @@ use crate::cloud::odometry::{LidarOdometry, OdometryConfig};
 use crate::cloud::planes::PlaneConfig;
 use crate::cloud::PointCloud;
 use crate::error::{ensure_positive, ensure_probability, Error, Result};
-use crate::filter::{Jitter, LmbConfig};
+use crate::filter::{Jitter, LmbConfig, SharedTransitionModel, TransitionModel};
 use crate::kitti::{OdometrySequence, RawDrive, TrackingSequence};
 use crate::models::{
     vehicle_model_by_name, ExtendedConstantTurn, SharedVehicleModel, VehicleModel,
@@ -238,6 +238,55 @@ pub struct ClusterTuning {
     /// the next resampling. `None` (or `--all-clusters`) carries every track at full count.
     /// Default 400.
     pub clutter_particles: Option<usize>,
+    /// How road users move. Default: 3-D constant velocity with `sigma_accel` and the
+    /// manoeuvre fringe.
+    #[serde(skip_serializing_if = "RoadUserMotion::is_default")]
+    pub motion: RoadUserMotion,
+}
+
+/// How the drive tracker's road users (clusters) move. A cluster's state is
+/// [x, ẋ, y, ẏ, z, ż] in the world frame; a model moves its first 4 or all 6 components.
+///
+/// In a configuration file: `motion = { kind = "constant_velocity" }` (the default; its
+/// parameters are `sigma_accel`, `manoeuvre_probability` and `manoeuvre_scale` beside it). A
+/// user's own model is [`RoadUserMotion::Custom`], set from code (Rust or Python).
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum RoadUserMotion {
+    /// 3-D constant velocity ([`crate::models::ConstantVelocity`]) with the manoeuvre fringe.
+    #[default]
+    ConstantVelocity,
+    /// A user's transition model (not in configuration files).
+    #[serde(skip)]
+    Custom(SharedTransitionModel),
+}
+
+impl RoadUserMotion {
+    /// A user's road-user motion model.
+    pub fn custom(model: impl TransitionModel + 'static) -> Self {
+        RoadUserMotion::Custom(SharedTransitionModel::new(model))
+    }
+
+    fn is_default(&self) -> bool {
+        *self == RoadUserMotion::ConstantVelocity
+    }
+
+    /// Checks that a user's model moves a cluster's state (4 or 6 components), naming it.
+    fn validate(&self) -> Result<()> {
+        if let RoadUserMotion::Custom(m) = self {
+            let d = m.0.state_dim();
+            if d != 4 && d != 6 {
+                return Err(Error::invalid(
+                    format!("road-user motion {}", m.0.name()),
+                    format!(
+                        "moves states of {d} components, but a cluster's state is \
+                         [x, ẋ, y, ẏ, z, ż]: a model must move its first 4 or all 6"
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
 }
 
 impl Default for ClusterTuning {
@@ -257,6 +306,7 @@ impl Default for ClusterTuning {
             birth_velocity: 4.0,
             birth_vertical: 0.3,
             clutter_particles: Some(400),
+            motion: RoadUserMotion::ConstantVelocity,
         }
     }
 }
@@ -449,6 +499,8 @@ impl TrackingConfig {
     pub fn validate(&self) -> Result<()> {
         self.filter.validate()?;
         self.planes.validate()?;
+        self.ego.vehicle_model()?;
+        self.cluster.motion.validate()?;
         ensure_positive("tracking config field dt", self.dt)?;
         ensure_probability("tracking config field birth.survival", self.birth.survival)?;
         ensure_probability(

@@ -155,8 +155,11 @@ impl DriveTracker {
                 (t, Some((model, h)))
             }
         };
-        let transition =
+        let mut transition =
             transition.with_cluster_manoeuvres(c.manoeuvre_probability, c.manoeuvre_scale)?;
+        if let super::RoadUserMotion::Custom(m) = &c.motion {
+            transition = transition.with_road_users(m.0.clone())?;
+        }
         let plane_meas = PlaneMeasurement::new(p.sigma_angle, p.sigma_offset)?.with_gate(p.gate)?;
         let sampler = MixedBirthSampler {
             plane_sigma_angle: p.birth_angle,
