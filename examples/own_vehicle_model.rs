@@ -145,8 +145,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (b, _) = plane_prediction(&drive, frames.clone(), own)?;
     println!("plane prediction k → k+1 over {n} frame pairs, 10 Monte-Carlo runs each:");
     println!("{:<28} {:>14} {:>14}", "", "ECT", "StraightAhead");
+    println!("{:<28} {:>14} {:>14}", "wall pairs", a.pairs, b.pairs);
     for (what, x, y) in [
-        ("wall pairs", a.pairs as f64, b.pairs as f64),
         (
             "normal angle median (°)",
             a.median_normal_angle_deg,
