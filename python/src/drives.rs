@@ -7,12 +7,20 @@
 //! Not for: the tracker itself (`smc_lmb::pipeline::drive_tracking`).
 
 use crate::convert::{lib, read_config_as};
+use crate::filter::SharedModel;
+use crate::transition::PyTransition;
+use crate::vehicle::PyVehicleModel;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use smc_lmb::pipeline::drive_tracking::{DriveTracks, RecordingSource, TrackingConfig};
+use smc_lmb::filter::SharedTransitionModel;
+use smc_lmb::models::SharedVehicleModel;
+use smc_lmb::pipeline::drive_tracking::{
+    DriveTracks, EgoModel, RecordingSource, RoadUserMotion, TrackingConfig,
+};
 use smc_lmb::sim::street::{write_drive, StreetConfig};
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// A run's summary as a dict: `name`, `frames`, `ego`, `walls_per_frame`,
 /// `clusters_per_frame`, `wall_labels`, `cluster_labels`, `ms_per_frame` (read, planes,
@@ -39,8 +47,16 @@ fn summary<'py>(py: Python<'py>, t: &DriveTracks) -> PyResult<Bound<'py, PyDict>
 /// a dict or TOML text; default: the library's); `particles` overrides its particles per
 /// track. With `out`, the per-frame tracks are written there as JSON (atomically), as
 /// `kitti-tools track --out` writes them. The GIL is released while it runs.
+///
+/// `transition`, a callable `f(particles: ndarray[N, 6], dt, rng) -> ndarray[N, 6]` as
+/// `LmbFilter(config, transition=f)` takes, moves the road users (clusters, state
+/// [x, ẋ, y, ẏ, z, ż] in the world frame) instead of constant velocity. `vehicle_model`, a
+/// built-in model's name (`"ect"`, `"ct"`, `"bicycle"`) or a callable
+/// `g(kinematics, dt, n, rng) -> poses (n, 3)` (see `predict_plane_pairs`), moves the walls by
+/// per-particle draws of the vehicle's motion instead of the measured poses. A callable's
+/// exception is raised as it is.
 #[pyfunction]
-#[pyo3(signature = (path, layout = "raw", sequence = None, out = None, config = None, seed = 1, particles = None))]
+#[pyo3(signature = (path, layout = "raw", sequence = None, out = None, config = None, seed = 1, particles = None, transition = None, vehicle_model = None))]
 #[allow(clippy::too_many_arguments)]
 fn track<'py>(
     py: Python<'py>,
@@ -51,6 +67,8 @@ fn track<'py>(
     config: Option<&Bound<'py, PyAny>>,
     seed: u64,
     particles: Option<usize>,
+    transition: Option<Py<PyAny>>,
+    vehicle_model: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut cfg: TrackingConfig = match config {
         Some(c) => read_config_as(c, "tracking config")?,
@@ -59,6 +77,32 @@ fn track<'py>(
     if let Some(n) = particles {
         cfg.filter.particles = n;
     }
+    let road_users = match transition {
+        None => None,
+        Some(f) => {
+            let m = Arc::new(PyTransition::new(py, f, 6)?);
+            cfg.cluster.motion =
+                RoadUserMotion::Custom(SharedTransitionModel(Arc::new(SharedModel(m.clone()))));
+            Some(m)
+        }
+    };
+    let vehicle = match vehicle_model {
+        None => None,
+        Some(v) => {
+            if let Ok(name) = v.extract::<String>() {
+                cfg.ego = EgoModel::Vehicle {
+                    model: name,
+                    parameters: Default::default(),
+                };
+                None
+            } else {
+                let m = Arc::new(PyVehicleModel::new(py, v.clone().unbind())?);
+                cfg.ego = EgoModel::Custom(SharedVehicleModel(m.clone()));
+                Some(m)
+            }
+        }
+    };
+    lib(cfg.validate())?;
     let need_sequence = || {
         sequence.ok_or_else(|| {
             PyValueError::new_err(format!("layout \"{layout}\" needs a sequence number"))
@@ -75,6 +119,13 @@ fn track<'py>(
         }
     };
     let tracks = py.detach(|| source.track(None, &cfg, seed, |_| Ok(())));
+    let user_error = road_users
+        .as_ref()
+        .and_then(|m| m.take_error())
+        .or_else(|| vehicle.as_ref().and_then(|m| m.take_error()));
+    if let Some(e) = user_error {
+        return Err(e);
+    }
     let tracks = lib(tracks)?;
     if let Some(out) = &out {
         lib(py.detach(|| tracks.write_json(out)))?;

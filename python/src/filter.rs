@@ -309,7 +309,7 @@ impl PyLmbFilter {
 }
 
 /// Lets the filter own a model the wrapper also keeps a handle on (for its errors).
-struct SharedModel(Arc<PyTransition>);
+pub struct SharedModel(pub Arc<PyTransition>);
 
 impl smc_lmb::filter::TransitionModel for SharedModel {
     fn state_dim(&self) -> usize {

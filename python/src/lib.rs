@@ -14,6 +14,7 @@ mod metrics;
 mod planes;
 mod sim;
 mod transition;
+mod vehicle;
 
 use pyo3::prelude::*;
 

@@ -11,6 +11,7 @@
 //! `smc_lmb::pipeline::plane_prediction`).
 
 use crate::convert::{fixed_rows, lib, pose, table, vec_array, vector};
+use crate::vehicle::PyVehicleModel;
 use numpy::ndarray::Array2;
 use numpy::IntoPyArray;
 use pyo3::exceptions::PyValueError;
@@ -21,10 +22,11 @@ use smc_lmb::cloud::PointCloud;
 use smc_lmb::geometry::PlanePatch;
 use smc_lmb::kitti::{OdometrySequence, RawDrive, TrackingSequence};
 use smc_lmb::metrics::{PlanePairError, PlanePredictionSummary};
-use smc_lmb::models::{ExtendedConstantTurn, SharedVehicleModel};
+use smc_lmb::models::{vehicle_model_by_name, ExtendedConstantTurn, SharedVehicleModel};
 use smc_lmb::pipeline::plane_prediction::{self as pp, PairPrediction, PlanePredictionConfig};
 use smc_lmb::rng::seeded;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// An `N × 3` (or wider: x, y, z first) array as a cloud.
 fn cloud(points: &Bound<'_, PyAny>, what: &str) -> PyResult<PointCloud> {
@@ -160,11 +162,17 @@ fn extract_planes<'py>(
 }
 
 /// Keyword options of plane prediction: `PlanePredictionConfig`'s `dt`, `max_angle`,
-/// `max_centre_distance`, `use_vehicle_model`, the vehicle model's `sigma_accel` and
-/// `sigma_turn_accel`, and `planes` (a dict of `PlaneConfig` options).
-fn prediction_config(options: Option<&Bound<'_, PyDict>>) -> PyResult<PlanePredictionConfig> {
+/// `max_centre_distance`, `use_vehicle_model`, the ECT's `sigma_accel` and
+/// `sigma_turn_accel`, `vehicle_model` (a built-in model's name, or a callable: see
+/// [`PyVehicleModel`]) and `planes` (a dict of `PlaneConfig` options). The Python vehicle
+/// model, if any, comes back beside the configuration (for its exceptions).
+fn prediction_config(
+    py: Python<'_>,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<(PlanePredictionConfig, Option<Arc<PyVehicleModel>>)> {
     let mut c = PlanePredictionConfig::default();
     let (mut sa, mut st) = (None, None);
+    let mut user = None;
     if let Some(options) = options {
         for (k, v) in options.iter() {
             let key: String = k.extract()?;
@@ -178,6 +186,15 @@ fn prediction_config(options: Option<&Bound<'_, PyDict>>) -> PyResult<PlanePredi
                 "sigma_accel" => sa = Some(v.extract::<f64>().map_err(bad)?),
                 "sigma_turn_accel" => st = Some(v.extract::<f64>().map_err(bad)?),
                 "planes" => c.planes = plane_config(Some(v.cast::<PyDict>()?))?,
+                "vehicle_model" => {
+                    if let Ok(name) = v.extract::<String>() {
+                        c.vehicle = SharedVehicleModel(lib(vehicle_model_by_name(&name, &[]))?);
+                    } else {
+                        let m = Arc::new(PyVehicleModel::new(py, v.clone().unbind())?);
+                        c.vehicle = SharedVehicleModel(m.clone());
+                        user = Some(m);
+                    }
+                }
                 other => {
                     return Err(PyValueError::new_err(format!(
                         "unknown plane prediction option `{other}`"
@@ -187,13 +204,19 @@ fn prediction_config(options: Option<&Bound<'_, PyDict>>) -> PyResult<PlanePredi
         }
     }
     if sa.is_some() || st.is_some() {
+        if user.is_some() {
+            return Err(PyValueError::new_err(
+                "sigma_accel and sigma_turn_accel are the ECT's: a Python vehicle_model draws \
+                 its own noise",
+            ));
+        }
         c.vehicle = SharedVehicleModel::new(lib(ExtendedConstantTurn::new(
             sa.unwrap_or(0.5),
             st.unwrap_or(0.1),
         ))?);
     }
     lib(c.validate())?;
-    Ok(c)
+    Ok((c, user))
 }
 
 fn pairs_dict<'py>(py: Python<'py>, pairs: &[PlanePairError]) -> PyResult<Bound<'py, PyDict>> {
@@ -277,8 +300,8 @@ fn predict_planes_between<'py>(
             })?)
         }
     };
-    let config = prediction_config(options)?;
-    let p = lib(py.detach(|| {
+    let (config, user) = prediction_config(py, options)?;
+    let p = py.detach(|| {
         pp::predict_planes_between(
             frame,
             &ck,
@@ -290,8 +313,12 @@ fn predict_planes_between<'py>(
             runs,
             &mut seeded(seed),
         )
-    }))?;
-    prediction_dict(py, p)
+    });
+    match (p, user.as_ref().and_then(|m| m.take_error())) {
+        (Ok(p), None) => prediction_dict(py, p),
+        (_, Some(e)) => Err(e),
+        (Err(e), None) => Err(crate::convert::to_py_err(e)),
+    }
 }
 
 /// Plane prediction over consecutive frame pairs of a KITTI recording: `layout` is `"raw"`
@@ -313,7 +340,7 @@ fn predict_plane_pairs<'py>(
     seed: u64,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let config = prediction_config(options)?;
+    let (config, user) = prediction_config(py, options)?;
     let range = frames.map(|(a, b)| a..b);
     let need_seq = || {
         sequence.ok_or_else(|| {
@@ -321,6 +348,15 @@ fn predict_plane_pairs<'py>(
         })
     };
     let mut rng = seeded(seed);
+    // A Python vehicle model's exception replaces the library's error about its draw.
+    let lib = |r: smc_lmb::Result<Vec<pp::PairPrediction>>| match (
+        r,
+        user.as_ref().and_then(|m| m.take_error()),
+    ) {
+        (Ok(v), None) => Ok(v),
+        (_, Some(e)) => Err(e),
+        (Err(e), None) => lib(Err(e)),
+    };
     let preds = match layout {
         "raw" => lib(py.detach(|| {
             let drive = RawDrive::open(&path)?;

@@ -61,9 +61,11 @@ impl PyTransition {
         dt: f64,
         seed: u64,
     ) -> PyResult<()> {
-        let (n, d) = (particles.len(), particles.dim());
+        // The model's own components: a longer state (the drive tracker's kind tag after a
+        // road user's [x, ẋ, y, ẏ, z, ż]) keeps the rest as it is.
+        let (n, d) = (particles.len(), self.dim);
         // The set is stored column by column: one Fortran-order array, no reordering.
-        let data: Vec<f64> = particles.components().concat();
+        let data: Vec<f64> = particles.components()[..d].concat();
         let arr = Array2::from_shape_vec((n, d).f(), data)
             .expect("n × d values")
             .into_pyarray(py);
@@ -79,7 +81,7 @@ impl PyTransition {
                 t.rows, t.cols
             )));
         }
-        for (c, col) in particles.components_mut().into_iter().enumerate() {
+        for (c, col) in particles.components_mut().into_iter().take(d).enumerate() {
             for (i, v) in col.iter_mut().enumerate() {
                 *v = t.data[i * d + c];
             }
