@@ -248,3 +248,88 @@ fn any_vertical_keeps_what_the_facade_test_rejects() {
     assert_eq!(pairs(&[]), 0);
     assert!(pairs(&["--any-vertical"]) >= 3);
 }
+
+/// `--vehicle-model` chooses the model Algorithm 1 draws from (and `track`'s walls follow);
+/// an unknown name, an unknown parameter or a malformed `--vehicle-param` is an error naming
+/// it, with nothing written.
+#[test]
+fn vehicle_models_by_name_in_planes_and_track() {
+    let dir = tempfile::tempdir().unwrap();
+    let drive = street_drive(dir.path(), 4);
+    let d = drive.to_str().unwrap();
+    let base = ["planes", "--drive", d, "--frame", "1", "--runs", "3"];
+    for (name, label) in [("ect", "ECT"), ("ct", "ct"), ("bicycle", "bicycle")] {
+        let mut a = base.to_vec();
+        a.extend(["--vehicle-model", name]);
+        let text = ok(&run(&a));
+        assert!(
+            text.starts_with(&format!(
+                "ego motion: vehicle model ({label}, 3 Monte-Carlo runs)"
+            )),
+            "{text}"
+        );
+        assert!(text.contains("frame"), "{text}");
+    }
+    let mut a = base.to_vec();
+    a.extend([
+        "--vehicle-model",
+        "bicycle",
+        "--vehicle-param",
+        "wheelbase=3.1",
+    ]);
+    ok(&run(&a));
+    for (flags, needle) in [
+        (vec!["--vehicle-model", "hovercraft"], "hovercraft"),
+        (
+            vec!["--vehicle-model", "ect", "--vehicle-param", "wheelbase=3"],
+            "wheelbase",
+        ),
+        (
+            vec!["--vehicle-model", "bicycle", "--vehicle-param", "wheelbase"],
+            "NAME=VALUE",
+        ),
+        (
+            vec![
+                "--vehicle-model",
+                "bicycle",
+                "--vehicle-param",
+                "wheelbase=long",
+            ],
+            "not a number",
+        ),
+    ] {
+        let mut a = base.to_vec();
+        a.extend(flags);
+        let out = run(&a);
+        assert!(!out.status.success());
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(needle), "{needle}: {stderr}");
+    }
+    let tracks = dir.path().join("tracks.json");
+    let t = tracks.to_str().unwrap();
+    let text = ok(&run(&[
+        "track",
+        "--drive",
+        d,
+        "--out",
+        t,
+        "--quiet",
+        "--vehicle-model",
+        "ct",
+    ]));
+    assert!(text.contains("oxts+ct"), "{text}");
+    let _ = std::fs::remove_file(&tracks);
+    let out = run(&[
+        "track",
+        "--drive",
+        d,
+        "--out",
+        t,
+        "--quiet",
+        "--vehicle-model",
+        "hovercraft",
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("hovercraft"));
+    assert!(!tracks.exists(), "a refused run wrote {t}");
+}

@@ -10,11 +10,10 @@
 //!
 //! Not for: tyre slip or dynamics (it is kinematic), tracked objects.
 
-use super::{VehicleModel, VehicleState};
+use super::{accelerate, arc, planar_pose, VehicleModel, VehicleState};
 use crate::error::{ensure_non_negative, ensure_positive, Result};
-use crate::models::CoordinatedTurn;
 use crate::rng::FilterRng;
-use nalgebra::{Isometry3, Vector3};
+use nalgebra::Isometry3;
 use rand_distr::{Distribution, StandardNormal};
 
 /// Below this speed (m/s) the steering angle of measured kinematics is taken as 0: the yaw
@@ -51,17 +50,12 @@ impl KinematicBicycle {
         self.wheelbase
     }
 
-    fn arc(&self, state: &[f64], dt: f64, next: &mut [f64]) {
-        let (x, y, psi, v, delta) = (state[0], state[1], state[2], state[3], state[4]);
+    /// The arc of a step at constant speed and steering angle.
+    fn step(&self, state: &[f64], dt: f64, next: &mut [f64]) {
+        let (v, delta) = (state[3], state[4]);
         let w = v * delta.tan() / self.wheelbase;
-        let (a, b, _, _) = CoordinatedTurn::coefficients(w, dt);
-        let (s, c) = psi.sin_cos();
-        let (vx, vy) = (v * c, v * s);
-        next[0] = x + a * vx - b * vy;
-        next[1] = y + b * vx + a * vy;
-        next[2] = psi + w * dt;
-        next[3] = v;
-        next[4] = delta;
+        let (x, y, psi) = arc(state[0], state[1], state[2], v, w, dt);
+        next.copy_from_slice(&[x, y, psi, v, delta]);
     }
 }
 
@@ -84,15 +78,8 @@ impl VehicleModel for KinematicBicycle {
     }
 
     fn sample_step(&self, state: &[f64], dt: f64, rng: &mut FilterRng, next: &mut [f64]) {
-        self.arc(state, dt, next);
-        if self.sigma_accel > 0.0 {
-            let e: f64 = StandardNormal.sample(rng);
-            let (s, c) = state[2].sin_cos();
-            let half = 0.5 * dt * dt;
-            next[0] += self.sigma_accel * half * e * c;
-            next[1] += self.sigma_accel * half * e * s;
-            next[3] += self.sigma_accel * dt * e;
-        }
+        self.step(state, dt, next);
+        accelerate(self.sigma_accel, state[2], dt, rng, next);
         if self.sigma_steer_rate > 0.0 {
             let e: f64 = StandardNormal.sample(rng);
             next[4] += self.sigma_steer_rate * dt * e;
@@ -100,14 +87,11 @@ impl VehicleModel for KinematicBicycle {
     }
 
     fn mean_step(&self, state: &[f64], dt: f64, next: &mut [f64]) {
-        self.arc(state, dt, next);
+        self.step(state, dt, next);
     }
 
     fn pose_of(&self, state: &[f64]) -> Isometry3<f64> {
-        Isometry3::new(
-            Vector3::new(state[0], state[1], 0.0),
-            Vector3::new(0.0, 0.0, state[2]),
-        )
+        planar_pose(state)
     }
 }
 

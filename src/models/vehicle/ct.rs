@@ -12,11 +12,10 @@
 //! Unlike the extended constant turn (Gostar et al. 2019), the vehicle always points along its
 //! velocity: no side slip. Not for: tracked objects (see [`crate::models::CoordinatedTurn`]).
 
-use super::{VehicleModel, VehicleState};
+use super::{accelerate, arc, planar_pose, VehicleModel, VehicleState};
 use crate::error::{ensure_non_negative, Result};
-use crate::models::CoordinatedTurn;
 use crate::rng::FilterRng;
-use nalgebra::{Isometry3, Vector3};
+use nalgebra::Isometry3;
 use rand_distr::{Distribution, StandardNormal};
 
 /// Constant turn rate and velocity, state [X, Y, φ, v, ω].
@@ -43,17 +42,9 @@ impl CoordinatedTurnVehicle {
 }
 
 /// The arc of a step: position, heading and turn rate after `dt` at constant v and ω.
-fn arc(state: &[f64], dt: f64, next: &mut [f64]) {
-    let (x, y, phi, v, w) = (state[0], state[1], state[2], state[3], state[4]);
-    let (a, b, _, _) = CoordinatedTurn::coefficients(w, dt);
-    let (s, c) = phi.sin_cos();
-    // velocity (v cos φ, v sin φ) turned through the arc
-    let (vx, vy) = (v * c, v * s);
-    next[0] = x + a * vx - b * vy;
-    next[1] = y + b * vx + a * vy;
-    next[2] = phi + w * dt;
-    next[3] = v;
-    next[4] = w;
+fn step(state: &[f64], dt: f64, next: &mut [f64]) {
+    let (x, y, phi) = arc(state[0], state[1], state[2], state[3], state[4], dt);
+    next.copy_from_slice(&[x, y, phi, state[3], state[4]]);
 }
 
 impl VehicleModel for CoordinatedTurnVehicle {
@@ -67,31 +58,21 @@ impl VehicleModel for CoordinatedTurnVehicle {
     }
 
     fn sample_step(&self, state: &[f64], dt: f64, rng: &mut FilterRng, next: &mut [f64]) {
-        arc(state, dt, next);
-        let half = 0.5 * dt * dt;
-        if self.sigma_accel > 0.0 {
-            let e: f64 = StandardNormal.sample(rng);
-            let (s, c) = state[2].sin_cos();
-            next[0] += self.sigma_accel * half * e * c;
-            next[1] += self.sigma_accel * half * e * s;
-            next[3] += self.sigma_accel * dt * e;
-        }
+        step(state, dt, next);
+        accelerate(self.sigma_accel, state[2], dt, rng, next);
         if self.sigma_turn_accel > 0.0 {
             let e: f64 = StandardNormal.sample(rng);
-            next[2] += self.sigma_turn_accel * half * e;
+            next[2] += self.sigma_turn_accel * 0.5 * dt * dt * e;
             next[4] += self.sigma_turn_accel * dt * e;
         }
     }
 
     fn mean_step(&self, state: &[f64], dt: f64, next: &mut [f64]) {
-        arc(state, dt, next);
+        step(state, dt, next);
     }
 
     fn pose_of(&self, state: &[f64]) -> Isometry3<f64> {
-        Isometry3::new(
-            Vector3::new(state[0], state[1], 0.0),
-            Vector3::new(0.0, 0.0, state[2]),
-        )
+        planar_pose(state)
     }
 }
 

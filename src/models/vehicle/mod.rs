@@ -119,6 +119,39 @@ impl<T: VehicleModel + ?Sized> VehicleModel for Arc<T> {
     }
 }
 
+/// The arc a vehicle at (`x`, `y`) with heading `heading` drives in `dt` seconds at speed `v`
+/// along its heading and turn rate `w`: the new (x, y, heading). Written with the coordinated
+/// turn's well-conditioned coefficients ([`crate::models::CoordinatedTurn::coefficients`]), so
+/// a small `w` needs no division by it.
+fn arc(x: f64, y: f64, heading: f64, v: f64, w: f64, dt: f64) -> (f64, f64, f64) {
+    let (a, b, _, _) = crate::models::CoordinatedTurn::coefficients(w, dt);
+    let (s, c) = heading.sin_cos();
+    let (vx, vy) = (v * c, v * s);
+    (x + a * vx - b * vy, y + b * vx + a * vy, heading + w * dt)
+}
+
+/// A white longitudinal acceleration of `sigma` over `dt` on a state [X, Y, heading, v, …]:
+/// speed + σ T e, position + σ T²/2 e along `heading` (the heading at the start of the step).
+fn accelerate(sigma: f64, heading: f64, dt: f64, rng: &mut FilterRng, next: &mut [f64]) {
+    if sigma > 0.0 {
+        use rand_distr::{Distribution, StandardNormal};
+        let e: f64 = StandardNormal.sample(rng);
+        let (s, c) = heading.sin_cos();
+        let half = 0.5 * dt * dt;
+        next[0] += sigma * half * e * c;
+        next[1] += sigma * half * e * s;
+        next[3] += sigma * dt * e;
+    }
+}
+
+/// The planar pose of a state [X, Y, heading, …].
+fn planar_pose(state: &[f64]) -> Isometry3<f64> {
+    Isometry3::new(
+        nalgebra::Vector3::new(state[0], state[1], 0.0),
+        nalgebra::Vector3::new(0.0, 0.0, state[2]),
+    )
+}
+
 /// A vehicle model held by a configuration: shared, compared by identity, shown by name.
 #[derive(Clone)]
 pub struct SharedVehicleModel(pub Arc<dyn VehicleModel>);
