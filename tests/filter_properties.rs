@@ -5,7 +5,7 @@
 use proptest::prelude::*;
 use smc_lmb::filter::{
     AdaptiveBirth, AssociationMethod, Frame, LmbConfig, LmbFilter, Measurements,
-    PositionBirthSampler,
+    PositionBirthSampler, StepData,
 };
 use smc_lmb::models::{ConstantDetection, ConstantVelocity, PositionMeasurement, UniformClutter};
 use smc_lmb::rng::seeded;
@@ -90,7 +90,7 @@ proptest! {
             let z = Measurements::from_rows(2, &rows).unwrap();
             let t = k as f64 * 0.5;
             let a = whole.step(&Frame::new(t, z.clone()), &mut rng_a).unwrap();
-            halves.predict_step(t, None, &mut rng_b).unwrap();
+            halves.predict_step(t, None, StepData::new(), &mut rng_b).unwrap();
             let b = halves.update_step(&z).unwrap();
             prop_assert_eq!(a.len(), b.len());
             for (ea, eb) in a.iter().zip(&b) {
@@ -117,8 +117,12 @@ fn halves_out_of_order_are_errors_that_change_nothing() {
     let z = Measurements::from_rows(2, &[[1.0, 2.0]]).unwrap();
     let err = f.update_step(&z).unwrap_err().to_string();
     assert!(err.contains("not predicted"), "{err}");
-    f.predict_step(0.0, None, &mut rng).unwrap();
-    let err = f.predict_step(0.5, None, &mut rng).unwrap_err().to_string();
+    f.predict_step(0.0, None, StepData::new(), &mut rng)
+        .unwrap();
+    let err = f
+        .predict_step(0.5, None, StepData::new(), &mut rng)
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("predicted already"), "{err}");
     let err = f
         .step(&Frame::new(0.5, z.clone()), &mut rng)
@@ -132,8 +136,10 @@ fn halves_out_of_order_are_errors_that_change_nothing() {
     f.update_step(&z).unwrap();
     assert_eq!(f.steps(), 1);
     // A reset forgets a pending prediction.
-    f.predict_step(0.5, None, &mut rng).unwrap();
+    f.predict_step(0.5, None, StepData::new(), &mut rng)
+        .unwrap();
     f.reset();
-    f.predict_step(0.0, None, &mut rng).unwrap();
+    f.predict_step(0.0, None, StepData::new(), &mut rng)
+        .unwrap();
     f.update_step(&z).unwrap();
 }

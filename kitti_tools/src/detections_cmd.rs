@@ -109,6 +109,7 @@ pub fn run(args: Args) -> Result<()> {
                     time: f.time,
                     measurements: z,
                     platform,
+                    data: smc_lmb::filter::StepData::new(),
                 },
                 &mut rng,
             )

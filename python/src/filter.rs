@@ -132,6 +132,7 @@ fn frame(time: f64, z: &Table, pose: Option<Isometry3<f64>>) -> smc_lmb::Result<
         time,
         measurements,
         platform: pose,
+        data: smc_lmb::filter::StepData::new(),
     })
 }
 

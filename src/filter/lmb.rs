@@ -17,7 +17,7 @@ use super::estimate::map_estimates;
 use super::groups::partition;
 use super::merge::{duplicate_pairs, merge_into, MergeDistance, ScaledDistance};
 use super::track::{Estimate, Track};
-use super::{Jitter, Label, Measurements, ParticleSet};
+use super::{Jitter, Label, Measurements, ParticleSet, StepData};
 use crate::error::{Error, Result};
 use crate::filter::{
     ClutterModel, ConstantSurvival, DetectionModel, MeasurementModel, StepContext, SurvivalModel,
@@ -176,6 +176,9 @@ pub struct Frame {
     pub measurements: Measurements,
     /// Pose of the sensing platform in the world frame, if it moves.
     pub platform: Option<Isometry3<f64>>,
+    /// What the frame brings for particular models (a vehicle state, a scan's beams, ...),
+    /// handed to every model in the step's [`StepContext::data`].
+    pub data: StepData,
 }
 
 impl Frame {
@@ -185,7 +188,20 @@ impl Frame {
             time,
             measurements,
             platform: None,
+            data: StepData::new(),
         }
+    }
+
+    /// The same frame seen from `platform` (world frame).
+    pub fn at(mut self, platform: Isometry3<f64>) -> Self {
+        self.platform = Some(platform);
+        self
+    }
+
+    /// The same frame with `data` for the models.
+    pub fn with_data(mut self, data: StepData) -> Self {
+        self.data = data;
+        self
     }
 }
 
@@ -548,6 +564,7 @@ impl LmbFilter {
         self.predict_phase(
             frame.time,
             frame.platform,
+            frame.data.clone(),
             rng,
             !frame.measurements.is_empty(),
         )?;
@@ -555,17 +572,19 @@ impl LmbFilter {
     }
 
     /// The first half of a step: the survival and transition of every track to `time`, the
-    /// platform at `platform`. Needs no measurements, so a caller can run it while the frame's
-    /// measurements are still being made (the drive tracker predicts while it segments the
-    /// scan). Draws the step seed from `rng`, as [`LmbFilter::step`] does; an error when the
-    /// step before is predicted and not yet updated.
+    /// platform at `platform`, the models handed `data` (as [`Frame::data`]; it stays the
+    /// step's through the update). Needs no measurements, so a caller can run it while the
+    /// frame's measurements are still being made (the drive tracker predicts while it
+    /// segments the scan). Draws the step seed from `rng`, as [`LmbFilter::step`] does; an
+    /// error when the step before is predicted and not yet updated.
     pub fn predict_step(
         &mut self,
         time: f64,
         platform: Option<Isometry3<f64>>,
+        data: StepData,
         rng: &mut FilterRng,
     ) -> Result<()> {
-        self.predict_phase(time, platform, rng, true)
+        self.predict_phase(time, platform, data, rng, true)
     }
 
     /// The second half of a step predicted by [`LmbFilter::predict_step`]: births, update with
@@ -610,6 +629,7 @@ impl LmbFilter {
         &mut self,
         time: f64,
         platform: Option<Isometry3<f64>>,
+        data: StepData,
         rng: &mut FilterRng,
         summaries: bool,
     ) -> Result<()> {
@@ -619,7 +639,7 @@ impl LmbFilter {
                 "the step is predicted already and not yet updated (call update_step)",
             ));
         }
-        let ctx = self.context(time, platform)?;
+        let ctx = self.context(time, platform, data)?;
         let seed = rng.next_u64();
         self.predict(&ctx, seed)?;
         let summaries: Vec<TrackSummary> = if summaries {
@@ -653,9 +673,14 @@ impl LmbFilter {
         Ok(())
     }
 
-    /// The step context: time step from the previous frame, platform poses. Rejects a time or
-    /// pose that is not finite, or a time that goes backwards.
-    fn context(&self, time: f64, platform: Option<Isometry3<f64>>) -> Result<StepContext> {
+    /// The step context: time step from the previous frame, platform poses, the frame's data.
+    /// Rejects a time or pose that is not finite, or a time that goes backwards.
+    fn context(
+        &self,
+        time: f64,
+        platform: Option<Isometry3<f64>>,
+        data: StepData,
+    ) -> Result<StepContext> {
         let what = || format!("frame of step {}", self.step);
         if !time.is_finite() {
             return Err(Error::invalid(
@@ -685,6 +710,7 @@ impl LmbFilter {
             dt,
             platform,
             previous_platform,
+            data,
         })
     }
 

@@ -24,6 +24,7 @@ pub mod merge;
 pub mod model;
 pub mod particles;
 pub mod smoothing;
+pub mod step_data;
 pub mod survival;
 pub mod track;
 
@@ -46,5 +47,6 @@ pub use model::{
 };
 pub use particles::{Jitter, ParticleSet};
 pub use smoothing::FixedLagSmoother;
+pub use step_data::StepData;
 pub use survival::ConstantSurvival;
 pub use track::{Estimate, Track};

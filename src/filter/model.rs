@@ -23,7 +23,7 @@
 //! Not for: the built-in models (see [`crate::models`]) or the recursion that calls them (see
 //! [`super::lmb`]).
 
-use super::{Measurements, ParticleSet};
+use super::{Measurements, ParticleSet, StepData};
 use crate::error::{Error, Result};
 use crate::rng::FilterRng;
 use nalgebra::Isometry3;
@@ -32,8 +32,9 @@ use nalgebra::Isometry3;
 ///
 /// `platform` is the pose of the sensing platform (robot, vehicle) in the world frame at this
 /// step; `previous_platform` the pose at the previous step. Planar platforms use a rotation
-/// about z. Both are `None` for a static sensor at the world origin.
-#[derive(Copy, Clone, Debug, PartialEq)]
+/// about z. Both are `None` for a static sensor at the world origin. `data` holds what the
+/// frame brought for particular models, by type ([`StepData`]).
+#[derive(Clone, Debug, PartialEq)]
 pub struct StepContext {
     /// Filter step index (0 for the first frame).
     pub step: u32,
@@ -45,6 +46,8 @@ pub struct StepContext {
     pub platform: Option<Isometry3<f64>>,
     /// Platform pose at the previous step (world frame).
     pub previous_platform: Option<Isometry3<f64>>,
+    /// The frame's data for particular models ([`crate::filter::Frame::data`]).
+    pub data: StepData,
 }
 
 impl StepContext {
@@ -56,7 +59,14 @@ impl StepContext {
             dt,
             platform: None,
             previous_platform: None,
+            data: StepData::new(),
         }
+    }
+
+    /// The same context with `data` for the models.
+    pub fn with_data(mut self, data: StepData) -> Self {
+        self.data = data;
+        self
     }
 
     /// Planar platform pose (x, y, heading) at this step; the origin when none is set.

@@ -421,6 +421,7 @@ mod tests {
             dt,
             platform: Some(cur),
             previous_platform: Some(prev),
+            data: crate::filter::StepData::new(),
         }
     }
 

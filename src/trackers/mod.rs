@@ -133,6 +133,7 @@ impl StepClock {
             dt,
             platform,
             previous_platform,
+            data: crate::filter::StepData::new(),
         })
     }
 }
@@ -166,6 +167,7 @@ impl PointTracker for LmbTracker {
             time: ctx.time,
             measurements: z.clone(),
             platform: ctx.platform,
+            data: ctx.data.clone(),
         };
         self.filter.step(&frame, &mut self.rng)
     }

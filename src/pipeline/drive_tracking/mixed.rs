@@ -27,8 +27,8 @@
 //! # Models
 //!
 //! - [`MixedTransition`]: planes move by the ego motion with [`PlaneTransition`] (measured
-//!   poses, or a per-particle draw of a vehicle model through a [`VehicleStateHandle`] updated
-//!   every step);
+//!   poses, or a per-particle draw of a vehicle model from the previous frame's vehicle
+//!   state, [`VehicleStart`], which the frame brings in its step data);
 //!   clusters move by 3-D [`ConstantVelocity`].
 //! - [`MixedMeasurement`]: planes are scored by [`PlaneMeasurement`]; a cluster particle's
 //!   world position p is taken into the sensor frame, s = T⁻¹ p with T = `ctx.platform`, and
@@ -65,7 +65,7 @@ use crate::numerics::exp::exp_in_place;
 use crate::numerics::ln::ln_in_place;
 use crate::rng::FilterRng;
 use rand_distr::{Distribution, StandardNormal};
-use std::sync::{Arc, RwLock};
+use std::sync::Arc;
 
 /// Dimension of the mixed state.
 pub const STATE_DIM: usize = 7;
@@ -159,30 +159,17 @@ pub fn cluster_measurement(centroid: [f64; 3]) -> [f64; MEASUREMENT_DIM] {
     ]
 }
 
-/// A shared, updatable vehicle state (in the vehicle model's layout) for the predicted plane
-/// option: the caller writes the state of the previous step before each filter step.
-#[derive(Clone, Debug, Default)]
-pub struct VehicleStateHandle(Arc<RwLock<Vec<f64>>>);
-
-impl VehicleStateHandle {
-    /// Replaces the vehicle state.
-    pub fn set(&self, state: &[f64]) {
-        let mut guard = self.0.write().unwrap_or_else(|e| e.into_inner());
-        guard.clear();
-        guard.extend_from_slice(state);
-    }
-
-    /// The current vehicle state.
-    pub fn get(&self) -> Vec<f64> {
-        self.0.read().unwrap_or_else(|e| e.into_inner()).clone()
-    }
-}
+/// The vehicle state (in the vehicle model's layout) that a predicted ego's plane transition
+/// starts from, the previous frame's: handed with the step in [`crate::filter::Frame::data`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct VehicleStart(pub Vec<f64>);
 
 /// Plane transition or the road users' motion, chosen by the kind of the set.
 #[derive(Clone)]
 pub struct MixedTransition {
     plane: PlaneTransition,
-    vehicle: Option<VehicleStateHandle>,
+    /// Whether planes move by a vehicle model's draw from the step's [`VehicleStart`].
+    predicted: bool,
     cluster: ConstantVelocity,
     /// A user's road-user model, used instead of `cluster` when set.
     road_users: Option<Arc<dyn TransitionModel>>,
@@ -213,25 +200,24 @@ impl MixedTransition {
                 plane_sigma_angle,
                 plane_sigma_offset,
             )?,
-            vehicle: None,
+            predicted: false,
             cluster: ConstantVelocity::spatial(cluster_sigma_accel)?,
             road_users: None,
         })
     }
 
     /// As [`MixedTransition::measured`], but planes are moved by a per-particle draw of the
-    /// vehicle motion from `vehicle`, starting at the state in the returned handle, with the
-    /// vehicle → sensor transform `vehicle_to_sensor` (Gostar et al. 2019, Algorithm 1).
+    /// vehicle motion from `vehicle`, starting at the step's [`VehicleStart`] (an error when
+    /// the frame brings none), with the vehicle → sensor transform `vehicle_to_sensor`
+    /// (Gostar et al. 2019, Algorithm 1).
     pub fn predicted(
         vehicle: Arc<dyn VehicleModel>,
         vehicle_to_sensor: nalgebra::Isometry3<f64>,
         plane_sigma_angle: f64,
         plane_sigma_offset: f64,
         cluster_sigma_accel: f64,
-    ) -> Result<(Self, VehicleStateHandle)> {
-        let handle = VehicleStateHandle::default();
+    ) -> Result<Self> {
         let state = vec![0.0; vehicle.state_dim()];
-        handle.set(&state);
         let plane = PlaneTransition::new(
             EgoSource::Predicted {
                 vehicle,
@@ -241,15 +227,12 @@ impl MixedTransition {
             plane_sigma_angle,
             plane_sigma_offset,
         )?;
-        Ok((
-            MixedTransition {
-                plane,
-                vehicle: Some(handle.clone()),
-                cluster: ConstantVelocity::spatial(cluster_sigma_accel)?,
-                road_users: None,
-            },
-            handle,
-        ))
+        Ok(MixedTransition {
+            plane,
+            predicted: true,
+            cluster: ConstantVelocity::spatial(cluster_sigma_accel)?,
+            road_users: None,
+        })
     }
 }
 
@@ -294,13 +277,11 @@ impl TransitionModel for MixedTransition {
             return Ok(());
         }
         match kind_of_set(particles) {
-            Some(ObjectKind::Plane) => match &self.vehicle {
-                None => self.plane.predict(particles, ctx, rng),
-                Some(h) => {
-                    let state = h.0.read().unwrap_or_else(|e| e.into_inner());
-                    self.plane.predict_from(&state, particles, ctx, rng)
-                }
-            },
+            Some(ObjectKind::Plane) if self.predicted => {
+                let start = ctx.data.require::<VehicleStart>(&self.name())?;
+                self.plane.predict_from(&start.0, particles, ctx, rng)
+            }
+            Some(ObjectKind::Plane) => self.plane.predict(particles, ctx, rng),
             Some(ObjectKind::Cluster) => match &self.road_users {
                 None => self.cluster.predict(particles, ctx, rng),
                 Some(m) => {
@@ -1026,6 +1007,40 @@ mod tests {
         t.predict(&mut cluster, &c, &mut seeded(1)).unwrap();
         let s = cluster.state(0);
         assert!((s[0] - 0.2).abs() < 1e-12 && (s[2] + 0.1).abs() < 1e-12 && s[6] == 1.0);
+    }
+
+    /// A vehicle-model ego moves walls from the vehicle state the frame brings, and a step
+    /// whose frame brings none is an error naming the model and the missing type.
+    #[test]
+    fn a_predicted_ego_takes_the_vehicle_state_from_the_step() {
+        let ect = crate::models::ExtendedConstantTurn::new(0.5, 0.1).unwrap();
+        let t = MixedTransition::predicted(Arc::new(ect), Isometry3::identity(), 0.0, 0.0, 0.0)
+            .unwrap();
+        let wall = || {
+            ParticleSet::from_rows(&[vec![-1.0, 0.0, 0.0, 10.0, 0.0, 0.0, 0.0]], &[1.0]).unwrap()
+        };
+        let bare = StepContext::new(1, 0.1, 0.1);
+        let e = t
+            .predict(&mut wall(), &bare, &mut seeded(1))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("MixedTransition") && e.contains("VehicleStart"),
+            "{e}"
+        );
+        // clusters need no vehicle state
+        let mut cluster =
+            ParticleSet::from_rows(&[vec![0.0, 2.0, 0.0, -1.0, 0.0, 0.0, 1.0]], &[1.0]).unwrap();
+        t.predict(&mut cluster, &bare, &mut seeded(1)).unwrap();
+        // 10 m/s along x for 0.1 s: the wall 10 m ahead (normal −x) comes about 1 m nearer
+        let start = VehicleStart(vec![0.0, 10.0, 0.0, 0.0, 0.0, 0.0]);
+        let moving = bare
+            .clone()
+            .with_data(crate::filter::StepData::new().with(start));
+        let mut w = wall();
+        t.predict(&mut w, &moving, &mut seeded(1)).unwrap();
+        let d = w.state(0)[3];
+        assert!((d - 9.0).abs() < 0.05, "{d}");
     }
 
     #[test]

@@ -9,7 +9,7 @@
 //! takes the detection's box size. The matches also give every detection (and so every
 //! point) a track number for the labelled exports.
 //!
-//! Not for: reading drives or segmenting clouds (see [`super::detect`], [`super::track_drive`]).
+//! Not for: reading drives or segmenting clouds (see [`super::detect`], [`super::track_recording`]).
 
 use super::detect::{detect_here, FrameDetections};
 use super::output::{OrientedBox, StageTimes, TrackedCluster, TrackedFrame, TrackedPlane};
@@ -19,7 +19,7 @@ use crate::cloud::classes::speed_log_likelihoods;
 use crate::cloud::classes::ClassModel;
 use crate::cloud::PointCloud;
 use crate::error::Result;
-use crate::filter::{AdaptiveBirth, Estimate, Frame, Label, LmbFilter, Track};
+use crate::filter::{AdaptiveBirth, Estimate, Frame, Label, LmbFilter, StepData, Track};
 use crate::geometry::plane::canonical;
 use crate::geometry::wrap_angle;
 use crate::geometry::Plane;
@@ -27,7 +27,7 @@ use crate::models::plane::plane_residual;
 use crate::models::{PlaneMeasurement, VehicleModel, VehicleState};
 use crate::pipeline::drive_tracking::mixed::{
     MixedBirthSampler, MixedClutter, MixedDetection, MixedMeasurement, MixedMergeDistance,
-    MixedTransition, ObjectKind, VehicleStateHandle, KIND,
+    MixedTransition, ObjectKind, VehicleStart, KIND,
 };
 use crate::rng::{seeded, FilterRng};
 use nalgebra::{Isometry3, Point3, Vector3};
@@ -58,8 +58,9 @@ fn rectangle_gap(a: &[Point3<f64>; 4], b: &[Point3<f64>; 4]) -> f64 {
 /// The tracker of one drive: the filter, its random state and what the report remembers.
 pub struct DriveTracker {
     filter: LmbFilter,
-    /// The vehicle model of a predicted ego and where its state of each step goes.
-    vehicle: Option<(Arc<dyn VehicleModel>, VehicleStateHandle)>,
+    /// The vehicle model of a predicted ego and the last vehicle state handed to the tracker
+    /// (its layout; zeros before the first), which each step hands the plane transition.
+    vehicle: Option<(Arc<dyn VehicleModel>, Vec<f64>)>,
     rng: FilterRng,
     /// The report's id of each live label; a label the filter dropped never returns, and its
     /// entries here and in the maps below leave with it (see [`DriveTracker::forget_dropped`]).
@@ -145,14 +146,15 @@ impl DriveTracker {
                 None,
             ),
             Some(model) => {
-                let (t, h) = MixedTransition::predicted(
+                let t = MixedTransition::predicted(
                     model.clone(),
                     vehicle_to_sensor,
                     p.process_angle,
                     p.process_offset,
                     c.sigma_accel,
                 )?;
-                (t, Some((model, h)))
+                let start = vec![0.0; model.state_dim()];
+                (t, Some((model, start)))
             }
         };
         let mut transition =
@@ -287,8 +289,9 @@ impl DriveTracker {
         vehicle_state: Option<[f64; 6]>,
     ) -> Result<()> {
         rayon::scope(|_| {
-            self.set_vehicle_state(vehicle_state);
-            self.filter.predict_step(time, Some(pose), &mut self.rng)
+            let data = self.step_data(vehicle_state);
+            self.filter
+                .predict_step(time, Some(pose), data, &mut self.rng)
         })?;
         self.predicted = Some((time, pose));
         Ok(())
@@ -317,21 +320,24 @@ impl DriveTracker {
         })
     }
 
-    /// Hands a vehicle ego model the state of the previous frame, built from the measured
-    /// kinematics `[X, Ẋ, Y, Ẏ, φ, φ̇]` ([`VehicleModel::state_of`]).
-    fn set_vehicle_state(&self, measured: Option<[f64; 6]>) {
-        if let (Some((model, h)), Some([x, vx, y, vy, heading, yaw_rate])) =
-            (&self.vehicle, measured)
-        {
-            h.set(&model.state_of(&VehicleState {
+    /// The step's data for the models: for a vehicle ego model the state of the previous
+    /// frame ([`VehicleStart`]), built from the measured kinematics `[X, Ẋ, Y, Ẏ, φ, φ̇]`
+    /// ([`VehicleModel::state_of`]) or, without them, the last state handed over.
+    fn step_data(&mut self, measured: Option<[f64; 6]>) -> StepData {
+        let Some((model, last)) = &mut self.vehicle else {
+            return StepData::new();
+        };
+        if let Some([x, vx, y, vy, heading, yaw_rate]) = measured {
+            *last = model.state_of(&VehicleState {
                 x,
                 vx,
                 y,
                 vy,
                 heading,
                 yaw_rate,
-            }));
+            });
         }
+        StepData::new().with(VehicleStart(last.clone()))
     }
 
     fn step_here(
@@ -343,14 +349,10 @@ impl DriveTracker {
         detections: &FrameDetections,
     ) -> Result<TrackedFrame> {
         let start = Instant::now();
-        self.set_vehicle_state(vehicle_state);
+        let data = self.step_data(vehicle_state);
         let measurements = detections.measurements()?;
         let estimates = self.filter.step(
-            &Frame {
-                time,
-                measurements,
-                platform: Some(pose),
-            },
+            &Frame::new(time, measurements).at(pose).with_data(data),
             &mut self.rng,
         )?;
         self.finish(frame, time, pose, detections, &estimates, start)

@@ -14,9 +14,10 @@
 //!   breaks into two pieces yields one measurement the track takes and one it cannot; without
 //!   suppression the second piece starts a duplicate that the next split confirms.
 //!
-//! The tracks to suppress around are handed over by the tracker before each step through a
-//! shared list (see [`PeopleBirth::set_confirmed`]), and so are the measurements that may not
-//! propose at all, those the front end's classifier doubts ([`PeopleBirth::set_barren`]).
+//! The tracks to suppress around come with each step's frame, as [`ConfirmedPeople`] in its
+//! step data; the measurements that may not propose at all, those the front end's classifier
+//! doubts, come with the frame that holds them, as [`Doubted`] (births are proposed from the
+//! previous step's measurements, and so read its data).
 //! Not for: the filter's other birth models or deciding what a measurement is.
 
 use crate::error::{ensure_positive, ensure_probability, Result};
@@ -26,14 +27,32 @@ use crate::filter::{BirthModel, BirthTrack, ParticleSet};
 use crate::models::RangeBearing;
 use crate::rng::FilterRng;
 use rand_distr::{Distribution, StandardNormal};
-use std::sync::{Arc, RwLock};
 
-/// Confirmed tracks' positions, each with the squared radius around it in which no birth is
-/// proposed; shared by clones.
-type Suppressors = Arc<RwLock<Vec<([f64; 2], f64)>>>;
+/// The tracks around which [`PeopleBirth`] proposes nothing in a step: each track's world
+/// position at the previous scan, its existence and its position spread σ (m). Tracks below
+/// [`PeopleBirth::suppress_existence`] are ignored. Handed with the step
+/// ([`crate::filter::Frame::data`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ConfirmedPeople(pub Vec<ConfirmedPerson>);
+
+/// One track of [`ConfirmedPeople`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ConfirmedPerson {
+    /// World position (x, y) at the previous scan.
+    pub position: [f64; 2],
+    /// Existence probability.
+    pub existence: f64,
+    /// Position spread σ (m).
+    pub spread: f64,
+}
+
+/// Per measurement of the frame that brings it, whether it may not start a track (e.g. the
+/// front end's classifier doubts it); indexed like that frame's measurements; missing or
+/// shorter: the others may. Handed with the step ([`crate::filter::Frame::data`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Doubted(pub Vec<bool>);
 
 /// Measurement-driven birth with suppression near confirmed tracks (module documentation).
-/// Clones share the list of confirmed positions.
 #[derive(Clone, Debug)]
 pub struct PeopleBirth {
     sensor: RangeBearing,
@@ -60,10 +79,6 @@ pub struct PeopleBirth {
     /// Births carry a fifth state component, the detectability mode
     /// ([`super::models::detectability`]), set to detectable (the person was just detected).
     pub with_detectability: bool,
-    confirmed: Suppressors,
-    /// Per measurement of the last step, whether it may not start a track (see
-    /// [`PeopleBirth::set_barren`]); shared by clones.
-    barren: Arc<RwLock<Vec<bool>>>,
 }
 
 impl PeopleBirth {
@@ -97,41 +112,23 @@ impl PeopleBirth {
             suppress_existence: 0.5,
             suppress_spread: 0.0,
             with_detectability: false,
-            confirmed: Arc::new(RwLock::new(Vec::new())),
-            barren: Arc::new(RwLock::new(Vec::new())),
         })
     }
 
-    /// Replaces the list of tracks (world positions at the previous scan, with their existence)
-    /// around which no birth is proposed; tracks below `suppress_existence` are ignored.
-    pub fn set_confirmed(&self, tracks: impl IntoIterator<Item = ([f64; 2], f64)>) {
-        self.set_confirmed_with_spread(tracks.into_iter().map(|(p, r)| (p, r, 0.0)));
-    }
-
-    /// Marks the measurements of the step just made that may not start a track (births come
-    /// from the last step's measurements), e.g. those the front end's classifier doubts.
-    /// Indexed like that step's measurements; an empty list (the default) bars none.
-    pub fn set_barren(&self, barren: impl IntoIterator<Item = bool>) {
-        let mut b = self.barren.write().unwrap_or_else(|e| e.into_inner());
-        b.clear();
-        b.extend(barren);
-    }
-
-    /// [`PeopleBirth::set_confirmed`] with each track's position spread σ (m): no proposal
-    /// within max(`suppress_radius`, `spread_factor` · σ) of it.
-    pub fn set_confirmed_with_spread(
-        &self,
-        tracks: impl IntoIterator<Item = ([f64; 2], f64, f64)>,
-    ) {
-        let mut c = self.confirmed.write().unwrap_or_else(|e| e.into_inner());
-        c.clear();
+    /// The step's confirmed tracks (at least `suppress_existence`), each with the squared
+    /// radius max(`suppress_radius`, `suppress_spread` · σ)² around it in which no birth is
+    /// proposed.
+    fn suppressors(&self, ctx: &StepContext) -> Vec<([f64; 2], f64)> {
+        let Some(people) = ctx.data.get::<ConfirmedPeople>() else {
+            return Vec::new();
+        };
         let k = self.suppress_spread;
-        c.extend(
-            tracks
-                .into_iter()
-                .filter(|(_, r, _)| *r >= self.suppress_existence)
-                .map(|(p, _, s)| (p, self.suppress_radius.max(k * s).powi(2))),
-        );
+        people
+            .0
+            .iter()
+            .filter(|p| p.existence >= self.suppress_existence)
+            .map(|p| (p.position, self.suppress_radius.max(k * p.spread).powi(2)))
+            .collect()
     }
 
     /// r_B for an association probability `assigned` (before suppression).
@@ -169,15 +166,20 @@ impl PeopleBirth {
 impl BirthModel for PeopleBirth {
     fn birth(
         &self,
-        _: &StepContext,
+        ctx: &StepContext,
         evidence: Option<&BirthEvidence<'_>>,
         rng: &mut FilterRng,
     ) -> Vec<BirthTrack> {
         let Some(ev) = evidence else {
             return Vec::new();
         };
-        let confirmed = self.confirmed.read().unwrap_or_else(|e| e.into_inner());
-        let barren = self.barren.read().unwrap_or_else(|e| e.into_inner());
+        let confirmed = self.suppressors(ctx);
+        // the doubts came with the measurements' own frame
+        let barren = ev
+            .context
+            .data
+            .get::<Doubted>()
+            .map_or(&[][..], |d| &d.0[..]);
         ev.measurements
             .iter()
             .zip(ev.assigned)
@@ -207,7 +209,21 @@ impl BirthModel for PeopleBirth {
 mod tests {
     use super::*;
     use crate::filter::Measurements;
+    use crate::filter::StepData;
     use crate::rng::seeded;
+
+    /// A step context whose frame brings `people` as (position, existence, spread).
+    fn confirmed(people: &[([f64; 2], f64, f64)]) -> StepContext {
+        let people = people
+            .iter()
+            .map(|&(position, existence, spread)| ConfirmedPerson {
+                position,
+                existence,
+                spread,
+            })
+            .collect();
+        StepContext::new(1, 0.1, 0.1).with_data(StepData::new().with(ConfirmedPeople(people)))
+    }
 
     fn birth() -> PeopleBirth {
         let rb = RangeBearing::new(0.1, 0.01).unwrap();
@@ -237,14 +253,13 @@ mod tests {
             context: &ctx,
         };
         // the track stands 1.5 m from the measurement's (5, 0)
-        b.set_confirmed_with_spread([([6.5, 0.0], 0.9, 0.1)]);
-        assert_eq!(b.birth(&ctx, Some(&ev), &mut seeded(1)).len(), 1);
-        b.set_confirmed_with_spread([([6.5, 0.0], 0.9, 1.0)]);
-        assert!(b.birth(&ctx, Some(&ev), &mut seeded(1)).is_empty());
+        let tight = confirmed(&[([6.5, 0.0], 0.9, 0.1)]);
+        assert_eq!(b.birth(&tight, Some(&ev), &mut seeded(1)).len(), 1);
+        let spread = confirmed(&[([6.5, 0.0], 0.9, 1.0)]);
+        assert!(b.birth(&spread, Some(&ev), &mut seeded(1)).is_empty());
         // without the spread rule only the fixed radius counts
         b.suppress_spread = 0.0;
-        b.set_confirmed_with_spread([([6.5, 0.0], 0.9, 1.0)]);
-        assert_eq!(b.birth(&ctx, Some(&ev), &mut seeded(1)).len(), 1);
+        assert_eq!(b.birth(&spread, Some(&ev), &mut seeded(1)).len(), 1);
     }
 
     #[test]
@@ -267,21 +282,32 @@ mod tests {
             "{mean:?}"
         );
         // a confirmed track 0.5 m from (0, 4) suppresses that proposal; a weak one does not
-        b.set_confirmed([([0.3, 4.4], 0.9), ([5.0, 0.2], 0.1)]);
-        let some = b.birth(&ctx, Some(&ev), &mut seeded(1));
+        let now = confirmed(&[([0.3, 4.4], 0.9, 0.0), ([5.0, 0.2], 0.1, 0.0)]);
+        let some = b.birth(&now, Some(&ev), &mut seeded(1));
         assert_eq!(some.len(), 1);
         assert!((some[0].particles.mean()[0] - 5.0).abs() < 0.05);
-        // a barren measurement proposes nothing; an empty list bars none
-        b.set_confirmed([]);
-        b.set_barren([true, false]);
-        let one = b.birth(&ctx, Some(&ev), &mut seeded(1));
+        // a doubted measurement proposes nothing: the doubts come with the measurements'
+        // frame (the evidence's context), not with the step that proposes
+        let doubted = ctx
+            .clone()
+            .with_data(StepData::new().with(Doubted(vec![true, false])));
+        let ev_doubted = BirthEvidence {
+            context: &doubted,
+            ..ev
+        };
+        let one = b.birth(&ctx, Some(&ev_doubted), &mut seeded(1));
         assert_eq!(one.len(), 1);
         assert!(
             one[0].particles.mean()[2] > 3.9,
             "{:?}",
             one[0].particles.mean()
         );
-        b.set_barren([]);
-        assert_eq!(b.birth(&ctx, Some(&ev), &mut seeded(1)).len(), 2);
+        assert_eq!(b.birth(&doubted, Some(&ev), &mut seeded(1)).len(), 2);
+        let none = ctx.clone().with_data(StepData::new().with(Doubted(vec![])));
+        let ev_none = BirthEvidence {
+            context: &none,
+            ..ev
+        };
+        assert_eq!(b.birth(&ctx, Some(&ev_none), &mut seeded(1)).len(), 2);
     }
 }

@@ -25,7 +25,7 @@ pub mod run;
 pub mod score;
 pub mod tracker;
 
-pub use birth::PeopleBirth;
+pub use birth::{ConfirmedPeople, ConfirmedPerson, Doubted, PeopleBirth};
 pub use motion_state::{probability_moving, MotionClassifier, MotionConfig};
 #[cfg(feature = "plot")]
 pub use plot::{write_people_plot, PeoplePlotCounts, PeoplePlotOptions};

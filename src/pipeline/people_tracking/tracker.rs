@@ -11,11 +11,11 @@
 //! Not for: deciding which segments belong to moving objects on a cluttered map (background
 //! attenuation and shape learning), or the baseline trackers.
 
-use super::birth::PeopleBirth;
+use super::birth::{ConfirmedPeople, ConfirmedPerson, Doubted, PeopleBirth};
 use super::innovation::particle_innovation;
 use super::models::{
-    Detectability, DetectabilityDetection, DetectabilityTransition, FieldOfViewSurvival,
-    ManoeuvringVelocity, OcclusionDetection, ResolutionDetection, ResolutionLikelihood,
+    BeamView, Detectability, DetectabilityDetection, DetectabilityTransition, FieldOfViewSurvival,
+    ManoeuvringVelocity, Neighbours, OcclusionDetection, ResolutionDetection, ResolutionLikelihood,
 };
 use super::motion_state::{probability_moving, MotionClassifier, MotionConfig};
 use crate::config::{
@@ -23,7 +23,7 @@ use crate::config::{
 };
 use crate::error::{Error, Result};
 use crate::filter::{
-    AssociationMethod, Estimate, Frame, Label, LmbConfig, LmbFilter, Measurements,
+    AssociationMethod, Estimate, Frame, Label, LmbConfig, LmbFilter, Measurements, StepData,
 };
 use crate::filter::{DetectionModel, StepContext, TransitionModel};
 use crate::laser2d::person_groups::{person_groups, PersonGrouping};
@@ -273,6 +273,9 @@ pub struct PeopleTracker {
     sensor: RangeBearing,
     /// Innovations of the last step's reported people, when recorded.
     innovations: Option<Vec<Innovation>>,
+    /// The last scan seen ([`PeopleTracker::observe`]), which each step hands the occlusion
+    /// model.
+    view: BeamView,
 }
 
 impl PeopleTracker {
@@ -386,6 +389,7 @@ impl PeopleTracker {
             last_time: None,
             sensor,
             innovations: None,
+            view: BeamView::EMPTY,
         })
     }
 
@@ -478,10 +482,11 @@ impl PeopleTracker {
         self.step_measured(measurements, scan.time, platform)
     }
 
-    /// Hands the scan's ranges to the occlusion-aware detection model for the next step.
+    /// Keeps the scan's ranges, which the next steps hand the occlusion-aware detection
+    /// model.
     pub fn observe(&mut self, scan: &Scan) {
-        self.detection
-            .update_view(scan.angle_min, scan.angle_increment, scan.beam_ranges());
+        self.view
+            .reset(scan.angle_min, scan.angle_increment, scan.beam_ranges());
     }
 
     /// One step on measurements made elsewhere (range-bearing rows of the people's centres),
@@ -563,30 +568,34 @@ impl PeopleTracker {
             }
             other => (measurements, other),
         };
-        self.birth
-            .set_confirmed_with_spread(confirmed.iter().map(|&(at, _, r, s)| (at, r, s)));
+        // What the models need of this step: the scan, the tracks births keep away from and
+        // p_D is lowered near, and which of these measurements may not start a track (the
+        // next step's births come from them).
         let min_r = self.birth.suppress_existence;
-        self.resolution.set_neighbours(
-            confirmed
-                .iter()
-                .filter(|c| c.2 >= min_r)
-                .map(|&(_, next, _, _)| next),
-        );
+        let neighbours = confirmed
+            .iter()
+            .filter(|c| c.2 >= min_r)
+            .map(|&(_, next, _, _)| next)
+            .collect();
+        let people = confirmed
+            .iter()
+            .map(|&(position, _, existence, spread)| ConfirmedPerson {
+                position,
+                existence,
+                spread,
+            })
+            .collect();
+        let doubted = evidence.map_or_else(Vec::new, |e| e.iter().map(|&v| v <= 0.0).collect());
+        let data = StepData::new()
+            .with(self.view.clone())
+            .with(Neighbours(neighbours))
+            .with(ConfirmedPeople(people))
+            .with(Doubted(doubted));
         let recorded = self.innovations.is_some().then(|| measurements.clone());
-        let estimates = self.filter.step(
-            &Frame {
-                time,
-                measurements,
-                platform,
-            },
-            &mut self.rng,
-        )?;
-        // The next step's births come from these measurements: none from a doubted one.
-        match evidence {
-            Some(e) => self.birth.set_barren(e.iter().map(|&v| v <= 0.0)),
-            None => self.birth.set_barren(std::iter::empty()),
-        }
-        let mut ctx = StepContext::new(self.filter.steps(), time, 0.0);
+        let mut frame = Frame::new(time, measurements).with_data(data.clone());
+        frame.platform = platform;
+        let estimates = self.filter.step(&frame, &mut self.rng)?;
+        let mut ctx = StepContext::new(self.filter.steps(), time, 0.0).with_data(data);
         ctx.platform = platform;
         let p_max = self.detection.field_of_view().p_inside();
         let tracks = self.filter.tracks();
@@ -632,7 +641,7 @@ impl PeopleTracker {
                     pd_buffer.clear();
                     pd_buffer.extend_from_slice(known);
                     self.resolution
-                        .apply_factors(p, &mut pd_buffer, |o, f| *o /= f);
+                        .apply_factors(p, &ctx, &mut pd_buffer, |o, f| *o /= f);
                     if let Some(d) = &self.detectability {
                         d.remove_mode(p, &mut pd_buffer);
                     }
@@ -705,7 +714,7 @@ impl PointTracker for PeopleTracker {
     }
 
     fn observe_beams(&mut self, beams: BeamRanges<'_>) {
-        self.detection.update_view(
+        self.view.reset(
             beams.angle_min,
             beams.angle_increment,
             beams.ranges.iter().copied(),

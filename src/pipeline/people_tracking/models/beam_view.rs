@@ -33,6 +33,13 @@ pub(super) struct WindowExtremes {
 }
 
 impl WindowExtremes {
+    /// No beams.
+    const EMPTY: WindowExtremes = WindowExtremes {
+        offsets: Vec::new(),
+        min: Vec::new(),
+        max: Vec::new(),
+    };
+
     fn rebuild(&mut self, ranges: &[f64]) {
         let n = ranges.len();
         self.offsets.clear();
@@ -104,6 +111,14 @@ fn round_exact(x: f64) -> f64 {
 }
 
 impl BeamView {
+    /// A view of no beams (nothing blocks).
+    pub const EMPTY: BeamView = BeamView {
+        angle_min: 0.0,
+        angle_increment: 0.0,
+        ranges: Vec::new(),
+        extremes: WindowExtremes::EMPTY,
+    };
+
     /// A view from the scan header and its ranges; non-finite or non-positive ranges mean "no
     /// return" and never block.
     pub fn new(angle_min: f64, angle_increment: f64, ranges: &[f64]) -> Result<Self> {
@@ -135,6 +150,20 @@ impl BeamView {
             }
         }));
         self.extremes.rebuild(&self.ranges);
+    }
+
+    /// Replaces the header and the ranges in place (no allocation once the buffers are large
+    /// enough); unlike [`BeamView::new`] the header is not checked (a view whose increment is
+    /// not a positive finite number finds no window).
+    pub fn reset(
+        &mut self,
+        angle_min: f64,
+        angle_increment: f64,
+        ranges: impl IntoIterator<Item = f64>,
+    ) {
+        self.angle_min = angle_min;
+        self.angle_increment = angle_increment;
+        self.set_ranges(ranges);
     }
 
     /// Number of beams.

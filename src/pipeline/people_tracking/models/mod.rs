@@ -19,5 +19,5 @@ pub mod view_survival;
 pub use detectability::{Detectability, DetectabilityDetection, DetectabilityTransition};
 pub use manoeuvring::ManoeuvringVelocity;
 pub use occlusion::{BeamView, OcclusionDetection};
-pub use resolution::{ResolutionDetection, ResolutionLikelihood};
+pub use resolution::{Neighbours, ResolutionDetection, ResolutionLikelihood};
 pub use view_survival::FieldOfViewSurvival;

@@ -2,8 +2,8 @@
 //! the scanner's field of view and range, and inside it falls with the share of the object's
 //! beams that end clearly in front of it in the current scan.
 //!
-//! The model needs the scan the update is about to use; the caller hands it over before every
-//! filter step through a cloned [`OcclusionDetection`] (all clones share one [`BeamView`]).
+//! The model needs the scan the update is about to use: each step's frame brings it as a
+//! [`BeamView`] in its step data ([`crate::filter::Frame::data`]).
 //! Not for: appearance or shape-dependent detectability, or deciding which returns belong to
 //! which object.
 //!
@@ -29,7 +29,8 @@
 //!
 //! p_D(x) = p_inside · P(N ≥ m),  N ~ Poisson(μ),  P(N ≥ m) = 1 − Σ_{j<m} e^(−μ) μ^j / j!.
 //!
-//! Without a view set, no beam is blocked and the model equals the field-of-view model.
+//! In a step whose frame brings no view, no beam is blocked and the model equals the
+//! field-of-view model.
 
 pub use super::beam_view::BeamView;
 use crate::error::{ensure_positive, Error, Result};
@@ -38,19 +39,19 @@ use crate::filter::{DetectionModel, StepContext};
 use crate::models::cloud_bounds::{CloudBox, PolarBounds};
 use crate::models::detection::FieldOfViewDetection;
 use crate::numerics::exp::exp_in_place;
-use std::sync::{Arc, RwLock};
 
-/// p_D from the field of view and the occlusion by nearer returns of the current scan (see the
-/// module documentation). Clones share the view: keep one clone, call
-/// [`OcclusionDetection::set_view`] before each step, give the other to the filter.
+/// p_D from the field of view and the occlusion by nearer returns of the step's scan, the
+/// [`BeamView`] of the step data (see the module documentation).
 #[derive(Clone, Debug)]
 pub struct OcclusionDetection {
     fov: FieldOfViewDetection,
     object_radius: f64,
     margin: f64,
     min_returns: u32,
-    view: Arc<RwLock<BeamView>>,
 }
+
+/// The view of a step whose frame brings none: no beam, nothing blocked.
+static NO_VIEW: BeamView = BeamView::EMPTY;
 
 /// atan2(y, x) to within 2e-5 rad by an odd polynomial on [0, 1] and octant symmetry: the
 /// beam lookup needs a small fraction of a beam spacing, and the library function dominates
@@ -113,7 +114,6 @@ impl OcclusionDetection {
             object_radius,
             margin,
             min_returns: 0,
-            view: Arc::new(RwLock::new(BeamView::default())),
         })
     }
 
@@ -121,25 +121,6 @@ impl OcclusionDetection {
     pub fn with_min_returns(mut self, m: u32) -> Self {
         self.min_returns = m;
         self
-    }
-
-    /// Sets the scan that the next steps' p_D is computed against (shared by all clones).
-    pub fn set_view(&self, view: BeamView) {
-        *self.view.write().unwrap_or_else(|e| e.into_inner()) = view;
-    }
-
-    /// Replaces the shared view's header and ranges in place (no allocation once the buffer
-    /// is large enough).
-    pub fn update_view(
-        &self,
-        angle_min: f64,
-        angle_increment: f64,
-        ranges: impl IntoIterator<Item = f64>,
-    ) {
-        let mut v = self.view.write().unwrap_or_else(|e| e.into_inner());
-        v.angle_min = angle_min;
-        v.angle_increment = angle_increment;
-        v.set_ranges(ranges);
     }
 
     /// The field-of-view part.
@@ -313,7 +294,7 @@ impl OcclusionDetection {
             out.fill(0.0);
             return;
         }
-        let view = self.view.read().unwrap_or_else(|e| e.into_inner());
+        let view = ctx.data.get::<BeamView>().unwrap_or(&NO_VIEW);
         let sensor = self.fov.sensor(ctx);
         let (sx, sy, c, s) = sensor;
         let p_out = self.fov.p_outside();
@@ -327,7 +308,7 @@ impl OcclusionDetection {
             None
         };
         let reach = if whole_cloud_first {
-            self.reach(&view, bounds.as_ref())
+            self.reach(view, bounds.as_ref())
         } else {
             CloudReach::UNKNOWN
         };
@@ -453,17 +434,24 @@ mod tests {
     use std::f64::consts::{FRAC_PI_2, PI};
 
     use super::super::beam_view::tests::view;
+    use crate::filter::StepData;
 
     fn model() -> OcclusionDetection {
         let fov = FieldOfViewDetection::new(0.9, 0.0, 30.0, FRAC_PI_2).unwrap();
-        let m = OcclusionDetection::new(fov, 0.2, 0.3).unwrap();
-        m.set_view(view());
-        m
+        OcclusionDetection::new(fov, 0.2, 0.3).unwrap()
+    }
+
+    /// A step context of a static sensor whose frame brings `view`.
+    fn seeing(view: BeamView) -> StepContext {
+        StepContext::new(0, 0.0, 0.1).with_data(StepData::new().with(view))
     }
 
     /// The model (people of 0.2 m, margin 0.6 m) on a 361-beam half-circle scan of 30 m
     /// returns, with pieces of wall (first beam, beams, range) in front.
-    fn behind_walls(blockers: &[(usize, usize, f64)], min_returns: u32) -> OcclusionDetection {
+    fn behind_walls(
+        blockers: &[(usize, usize, f64)],
+        min_returns: u32,
+    ) -> (OcclusionDetection, BeamView) {
         let fov = FieldOfViewDetection::new(0.9, 0.1, 30.0, FRAC_PI_2).unwrap();
         let m = OcclusionDetection::new(fov, 0.2, 0.6)
             .unwrap()
@@ -474,8 +462,7 @@ mod tests {
                 .iter_mut()
                 .for_each(|v| *v = r);
         }
-        m.set_view(BeamView::new(-FRAC_PI_2, PI / 360.0, &ranges).unwrap());
-        m
+        (m, BeamView::new(-FRAC_PI_2, PI / 360.0, &ranges).unwrap())
     }
 
     proptest::proptest! {
@@ -491,8 +478,8 @@ mod tests {
             pose in (-1.0f64..1.0, -1.0f64..1.0, -0.3f64..0.3),
             min_returns in 0u32..3,
         ) {
-            let m = behind_walls(&blockers, min_returns);
-            let mut ctx = StepContext::new(0, 0.0, 0.1);
+            let (m, view) = behind_walls(&blockers, min_returns);
+            let mut ctx = seeing(view);
             ctx.platform = Some(Isometry3::new(
                 Vector3::new(pose.0, pose.1, 0.0),
                 Vector3::new(0.0, 0.0, pose.2),
@@ -521,9 +508,8 @@ mod tests {
             points in proptest::collection::vec((-2.0f64..32.0, -16.0f64..16.0), 1..150),
             min_returns in 0u32..3,
         ) {
-            let m = behind_walls(&blockers, min_returns);
-            let view = m.view.read().unwrap().clone();
-            let ctx = StepContext::new(0, 0.0, 0.1);
+            let (m, view) = behind_walls(&blockers, min_returns);
+            let ctx = seeing(view.clone());
             let rows: Vec<Vec<f64>> = points.iter().map(|p| vec![p.0, 0.0, p.1, 0.0]).collect();
             let set = ParticleSet::from_rows(&rows, &vec![1.0; rows.len()]).unwrap();
             let mut out = vec![0.0; rows.len()];
@@ -556,7 +542,7 @@ mod tests {
     #[test]
     fn occluded_visible_and_outside_particles() {
         let m = model();
-        let ctx = StepContext::new(0, 0.0, 0.1);
+        let ctx = seeing(view());
         // 10 m straight ahead, behind the 3 m wall: every beam of its ±1.15° window blocked
         assert_eq!(m.at(10.0, 0.0, &ctx), 0.0);
         // 2.5 m ahead, in front of the wall: the wall (3 m) is not nearer → fully visible
@@ -577,7 +563,7 @@ mod tests {
         // beams at 4°, 5° (blocked) and 6° (free) → p = 0.9 · 1/3
         let m = model();
         let (s, c) = 5f64.to_radians().sin_cos();
-        let p = m.at(10.0 * c, 10.0 * s, &StepContext::new(0, 0.0, 0.1));
+        let p = m.at(10.0 * c, 10.0 * s, &seeing(view()));
         assert!((p - 0.3).abs() < 1e-12, "{p}");
     }
 
@@ -585,17 +571,21 @@ mod tests {
     fn the_view_follows_the_platform() {
         // platform at (100, 50) facing +y; the wall piece is now 3 m north of it
         let m = model();
-        let mut ctx = StepContext::new(3, 1.0, 0.1);
+        let mut ctx = seeing(view());
+        ctx.step = 3;
         ctx.platform = Some(Isometry3::new(
             Vector3::new(100.0, 50.0, 0.0),
             Vector3::new(0.0, 0.0, FRAC_PI_2),
         ));
         assert_eq!(m.at(100.0, 60.0, &ctx), 0.0);
         assert_eq!(m.at(105.0, 55.0, &ctx), 0.9);
-        // a clone shares the view: clearing it through the clone unblocks the point
-        let other = m.clone();
-        other.update_view(-FRAC_PI_2, PI / 180.0, vec![f64::NAN; 181]);
-        assert_eq!(m.at(100.0, 60.0, &ctx), 0.9);
+        // the view is the step's: a step whose scan has no returns, or that brings no scan,
+        // leaves the point unblocked
+        let empty = BeamView::new(-FRAC_PI_2, PI / 180.0, &[f64::NAN; 181]).unwrap();
+        let mut clear = ctx.clone().with_data(StepData::new().with(empty));
+        assert_eq!(m.at(100.0, 60.0, &clear), 0.9);
+        clear.data = StepData::new();
+        assert_eq!(m.at(100.0, 60.0, &clear), 0.9);
     }
 
     #[test]
@@ -627,8 +617,7 @@ mod tests {
         // 1° beams, object radius 0.2 m, needs 2 returns. At 10 m: μ = 2 asin(0.02) / 1° =
         // 2.2920…; at 25 m: μ = 0.9167…
         let m = model().with_min_returns(2);
-        m.update_view(-FRAC_PI_2, PI / 180.0, vec![30.0; 181]);
-        let ctx = StepContext::new(0, 0.0, 0.1);
+        let ctx = seeing(BeamView::new(-FRAC_PI_2, PI / 180.0, &[30.0; 181]).unwrap());
         let mu = |d: f64| 2.0 * (0.2f64 / d).asin() / (PI / 180.0);
         let (s, c) = 20f64.to_radians().sin_cos();
         let near = m.at(10.0 * c, 10.0 * s, &ctx);
@@ -981,8 +970,7 @@ mod tests {
             .unwrap()
             .with_min_returns(people.min_returns);
         let ranges = scanner.scan(obstacles, 29.5);
-        m.update_view(angle_min, increment, ranges.iter().copied());
-        let mut ctx = StepContext::new(0, 0.0, 0.1);
+        let mut ctx = seeing(BeamView::new(angle_min, increment, &ranges).unwrap());
         ctx.platform = Some(Isometry3::new(
             Vector3::new(pose.0, pose.1, 0.0),
             Vector3::new(0.0, 0.0, pose.2),

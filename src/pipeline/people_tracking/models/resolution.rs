@@ -3,9 +3,9 @@
 //! measurement for both (or one between them), so each of them is missed as a separate
 //! measurement far more often than an object standing alone.
 //!
-//! [`ResolutionDetection`] wraps any [`DetectionModel`]. Before each step the caller hands it
-//! the predicted positions of the confirmed tracks ([`ResolutionDetection::set_neighbours`];
-//! clones share the list). For a particle whose nearest *other* neighbour lies at distance d,
+//! [`ResolutionDetection`] wraps any [`DetectionModel`]. Each step's frame brings the
+//! predicted positions of the confirmed tracks as [`Neighbours`] in its step data (none: no
+//! lowering). For a particle whose nearest *other* neighbour lies at distance d,
 //!
 //! p_D(x) = p_D,inner(x) · (1 − s · f(d)),  f = 1 for d ≤ d_res, falling linearly to 0 at
 //! d_res + fade,
@@ -34,7 +34,17 @@ use crate::filter::ParticleSet;
 use crate::filter::{DetectionModel, MeasurementModel, StepContext, TrackSummary};
 use crate::models::cloud_bounds::CloudBox;
 use crate::models::RangeBearing;
-use std::sync::{Arc, RwLock};
+
+/// The predicted world positions (x, y) at this step of the tracks that count as neighbours:
+/// handed to [`ResolutionDetection`] and [`ResolutionLikelihood`] with the step
+/// ([`crate::filter::Frame::data`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Neighbours(pub Vec<[f64; 2]>);
+
+/// The step's neighbours (none when the frame brings none).
+fn neighbours_of(ctx: &StepContext) -> &[[f64; 2]] {
+    ctx.data.get::<Neighbours>().map_or(&[], |n| &n.0)
+}
 
 /// p_D of an inner model, lowered near other tracks (module documentation).
 #[derive(Clone, Debug)]
@@ -44,7 +54,6 @@ pub struct ResolutionDetection<D> {
     fade: f64,
     share: f64,
     exclusion: f64,
-    neighbours: Arc<RwLock<Vec<[f64; 2]>>>,
 }
 
 impl<D: DetectionModel> ResolutionDetection<D> {
@@ -68,7 +77,6 @@ impl<D: DetectionModel> ResolutionDetection<D> {
             fade,
             share,
             exclusion,
-            neighbours: Arc::new(RwLock::new(Vec::new())),
         })
     }
 
@@ -76,51 +84,39 @@ impl<D: DetectionModel> ResolutionDetection<D> {
     pub fn inner(&self) -> &D {
         &self.inner
     }
-
-    /// Replaces the positions (world x, y at this step) of the tracks that count as
-    /// neighbours; shared by all clones.
-    pub fn set_neighbours(&self, positions: impl IntoIterator<Item = [f64; 2]>) {
-        let mut n = self.neighbours.write().unwrap_or_else(|e| e.into_inner());
-        n.clear();
-        n.extend(positions);
-    }
 }
 
 impl<D> ResolutionDetection<D> {
-    /// Whether some other track is near enough to lower the p_D of some particle of this set
-    /// (when false, the inner model's p_D stands unchanged).
-    pub fn lowers(&self, particles: &ParticleSet) -> bool {
-        self.share > 0.0 && particles.dim() >= 3 && !self.others_near(particles).is_empty()
+    /// Whether some other track of the step's [`Neighbours`] is near enough to lower the p_D
+    /// of some particle of this set (when false, the inner model's p_D stands unchanged).
+    pub fn lowers(&self, particles: &ParticleSet, ctx: &StepContext) -> bool {
+        self.share > 0.0
+            && particles.dim() >= 3
+            && !self.others_near(particles, neighbours_of(ctx)).is_empty()
     }
 
     /// The neighbours other than the set's own track that lie within reach of its weighted
     /// mean (reach: `distance` + `fade` + 2 m for the particles' spread) and near enough to
     /// some particle to lower its p_D: a neighbour farther than `distance` + `fade` from the
     /// box around every particle changes no particle's factor, so it is left out.
-    fn others_near(&self, particles: &ParticleSet) -> Vec<[f64; 2]> {
+    fn others_near(&self, particles: &ParticleSet, neighbours: &[[f64; 2]]) -> Vec<[f64; 2]> {
         let Some(cloud) = CloudBox::of(particles) else {
-            return self.others_near_mean(particles);
+            return self.others_near_mean(particles, neighbours);
         };
         let reach2 = (self.distance + self.fade).powi(2);
         let touches = |n: &[f64; 2]| cloud.min_distance_squared(n[0], n[1]) <= reach2;
-        {
-            let neighbours = self.neighbours.read().unwrap_or_else(|e| e.into_inner());
-            if !neighbours.iter().any(touches) {
-                return Vec::new();
-            }
+        if !neighbours.iter().any(touches) {
+            return Vec::new();
         }
-        let mut near = self.others_near_mean(particles);
+        let mut near = self.others_near_mean(particles, neighbours);
         near.retain(touches);
         near
     }
 
     /// The neighbours other than the set's own track within reach of its weighted mean.
-    fn others_near_mean(&self, particles: &ParticleSet) -> Vec<[f64; 2]> {
-        {
-            let neighbours = self.neighbours.read().unwrap_or_else(|e| e.into_inner());
-            if neighbours.is_empty() || particles.is_empty() {
-                return Vec::new();
-            }
+    fn others_near_mean(&self, particles: &ParticleSet, neighbours: &[[f64; 2]]) -> Vec<[f64; 2]> {
+        if neighbours.is_empty() || particles.is_empty() {
+            return Vec::new();
         }
         let (xs, ys, w) = (
             particles.component(0),
@@ -138,13 +134,12 @@ impl<D> ResolutionDetection<D> {
             return Vec::new();
         }
         let (mx, my) = (sx / total, sy / total);
-        self.others_near_point(mx, my)
+        self.others_near_point(mx, my, neighbours)
     }
 
     /// The neighbours farther than `exclusion` from (`mx`, `my`) (the track there) and within
     /// reach of it.
-    fn others_near_point(&self, mx: f64, my: f64) -> Vec<[f64; 2]> {
-        let neighbours = self.neighbours.read().unwrap_or_else(|e| e.into_inner());
+    fn others_near_point(&self, mx: f64, my: f64, neighbours: &[[f64; 2]]) -> Vec<[f64; 2]> {
         let reach = self.distance + self.fade + 2.0;
         let ex2 = self.exclusion * self.exclusion;
         neighbours
@@ -158,8 +153,7 @@ impl<D> ResolutionDetection<D> {
     }
 
     /// Whether [`Self::others_near_point`] would find any neighbour (without collecting them).
-    fn any_other_near_point(&self, mx: f64, my: f64) -> bool {
-        let neighbours = self.neighbours.read().unwrap_or_else(|e| e.into_inner());
+    fn any_other_near_point(&self, mx: f64, my: f64, neighbours: &[[f64; 2]]) -> bool {
         let reach = self.distance + self.fade + 2.0;
         let ex2 = self.exclusion * self.exclusion;
         neighbours.iter().any(|n| {
@@ -184,20 +178,21 @@ impl<D> ResolutionDetection<D> {
 impl<D: DetectionModel> DetectionModel for ResolutionDetection<D> {
     fn detection_probability(&self, particles: &ParticleSet, ctx: &StepContext, out: &mut [f64]) {
         self.inner.detection_probability(particles, ctx, out);
-        self.apply_factors(particles, out, |o, f| *o *= f);
+        self.apply_factors(particles, ctx, out, |o, f| *o *= f);
     }
 }
 
 impl<D> ResolutionDetection<D> {
-    /// Calls `apply(out[i], 1 − s·f(dᵢ))` for every particle i that some other track lowers;
-    /// particles out of every neighbour's reach are left alone.
+    /// Calls `apply(out[i], 1 − s·f(dᵢ))` for every particle i that some other track of the
+    /// step's [`Neighbours`] lowers; particles out of every neighbour's reach are left alone.
     pub fn apply_factors(
         &self,
         particles: &ParticleSet,
+        ctx: &StepContext,
         out: &mut [f64],
         apply: impl Fn(&mut f64, f64),
     ) {
-        self.for_each_lowered(particles, |i, f| {
+        self.for_each_lowered(particles, neighbours_of(ctx), |i, f| {
             if let Some(o) = out.get_mut(i) {
                 apply(o, f);
             }
@@ -205,12 +200,17 @@ impl<D> ResolutionDetection<D> {
     }
 
     /// Calls `visit(i, 1 − s·f(dᵢ))` for every particle i that some other track lowers, in
-    /// particle order; the neighbours are looked up once per call.
-    pub fn for_each_lowered(&self, particles: &ParticleSet, mut visit: impl FnMut(usize, f64)) {
+    /// particle order; the neighbours near the set are looked up once per call.
+    fn for_each_lowered(
+        &self,
+        particles: &ParticleSet,
+        neighbours: &[[f64; 2]],
+        mut visit: impl FnMut(usize, f64),
+    ) {
         if self.share == 0.0 || particles.dim() < 3 || particles.is_empty() {
             return;
         }
-        let others = self.others_near(particles);
+        let others = self.others_near(particles, neighbours);
         if others.is_empty() {
             return;
         }
@@ -299,7 +299,7 @@ impl<D: Send + Sync> MeasurementModel for ResolutionLikelihood<D> {
         out: &mut [f64],
     ) {
         self.narrow.log_likelihood(z, particles, ctx, out);
-        self.widen(particles, &mut [out]);
+        self.widen(particles, ctx, &mut [out]);
     }
 
     fn log_likelihood_batch(
@@ -310,11 +310,11 @@ impl<D: Send + Sync> MeasurementModel for ResolutionLikelihood<D> {
         out: &mut [Vec<f64>],
     ) {
         self.narrow.log_likelihood_batch(zs, particles, ctx, out);
-        self.widen(particles, out);
+        self.widen(particles, ctx, out);
     }
 
     fn gate(&self, z: &[f64], track: &TrackSummary, ctx: &StepContext) -> bool {
-        self.gating_model(track).gate(z, track, ctx)
+        self.gating_model(track, ctx).gate(z, track, ctx)
     }
 
     fn gate_all(
@@ -324,18 +324,20 @@ impl<D: Send + Sync> MeasurementModel for ResolutionLikelihood<D> {
         ctx: &StepContext,
         out: &mut Vec<usize>,
     ) {
-        self.gating_model(track).gate_all(zs, track, ctx, out)
+        self.gating_model(track, ctx).gate_all(zs, track, ctx, out)
     }
 }
 
 impl<D> ResolutionLikelihood<D> {
     /// The model whose gate applies to `track`: the wide one when the track's mean lies next
     /// to another track.
-    fn gating_model(&self, track: &TrackSummary) -> &RangeBearing {
+    fn gating_model(&self, track: &TrackSummary, ctx: &StepContext) -> &RangeBearing {
         let near = track.mean.len() >= 3
-            && self
-                .resolution
-                .any_other_near_point(track.mean[0], track.mean[2]);
+            && self.resolution.any_other_near_point(
+                track.mean[0],
+                track.mean[2],
+                neighbours_of(ctx),
+            );
         if near {
             &self.wide
         } else {
@@ -345,19 +347,20 @@ impl<D> ResolutionLikelihood<D> {
 
     /// Replaces, in every row, the narrow log-likelihood of each particle next to another
     /// track by the wide one (the neighbours are looked up once for all rows).
-    fn widen<R: AsMut<[f64]>>(&self, particles: &ParticleSet, rows: &mut [R]) {
+    fn widen<R: AsMut<[f64]>>(&self, particles: &ParticleSet, ctx: &StepContext, rows: &mut [R]) {
         if self.scale == 1.0 {
             return;
         }
         let c = self.narrow.log_normaliser();
         let (shift, inv_s2) = (2.0 * self.scale.ln(), 1.0 / (self.scale * self.scale));
-        self.resolution.for_each_lowered(particles, |i, _| {
-            for row in rows.iter_mut() {
-                if let Some(l) = row.as_mut().get_mut(i) {
-                    *l = c - shift - (c - *l) * inv_s2;
+        self.resolution
+            .for_each_lowered(particles, neighbours_of(ctx), |i, _| {
+                for row in rows.iter_mut() {
+                    if let Some(l) = row.as_mut().get_mut(i) {
+                        *l = c - shift - (c - *l) * inv_s2;
+                    }
                 }
-            }
-        });
+            });
     }
 }
 
@@ -370,6 +373,12 @@ mod tests {
         let rows: Vec<Vec<f64>> = points.iter().map(|p| vec![p[0], 0.0, p[1], 0.0]).collect();
         let w = vec![1.0 / points.len() as f64; points.len()];
         ParticleSet::from_rows(&rows, &w).unwrap()
+    }
+
+    /// A step context whose frame brings `neighbours`.
+    fn with(neighbours: &[[f64; 2]]) -> StepContext {
+        StepContext::new(0, 0.0, 0.1)
+            .with_data(crate::filter::StepData::new().with(Neighbours(neighbours.to_vec())))
     }
 
     fn model() -> ResolutionDetection<ConstantDetection> {
@@ -385,18 +394,18 @@ mod tests {
         let mut out = [0.0; 2];
         m.detection_probability(&s, &ctx, &mut out);
         assert_eq!(out, [0.9, 0.9]);
+        assert!(!m.lowers(&s, &ctx));
         // Its own position and a far track change nothing.
-        m.set_neighbours([[0.05, 0.0], [10.0, 0.0]]);
+        let ctx = with(&[[0.05, 0.0], [10.0, 0.0]]);
         m.detection_probability(&s, &ctx, &mut out);
         assert_eq!(out, [0.9, 0.9]);
-        assert!(!m.lowers(&s));
+        assert!(!m.lowers(&s, &ctx));
     }
 
     #[test]
     fn near_another_track_p_d_falls_by_the_share_and_fades_out() {
         let m = model();
-        let ctx = StepContext::new(0, 0.0, 0.1);
-        m.set_neighbours([[0.0, 0.0], [2.0, 0.0]]);
+        let ctx = with(&[[0.0, 0.0], [2.0, 0.0]]);
         // Particles 1.5 m (at d_res), 1.75 m (half-way through the fade), 2.5 m and 2.125 m
         // from the other track; the set's mean is its own track at the origin.
         let s = set(&[
@@ -409,10 +418,13 @@ mod tests {
         let mut out = [0.0; 5];
         m.detection_probability(&s, &ctx, &mut out);
         let want = [0.9 * 0.5, 0.9 * 0.75, 0.9, 0.9, 0.9];
-        assert!(m.lowers(&s));
+        assert!(m.lowers(&s, &ctx));
         for (o, w) in out.iter().zip(want) {
             assert!((o - w).abs() < 1e-12, "{out:?}");
         }
+        // The same model in a step whose frame brings no neighbours lowers nothing.
+        m.detection_probability(&s, &StepContext::new(0, 0.0, 0.1), &mut out);
+        assert_eq!(out, [0.9; 5]);
     }
 
     #[test]
@@ -432,11 +444,9 @@ mod tests {
         wide.log_likelihood(z, &s, &ctx, &mut w);
         l.log_likelihood(z, &s, &ctx, &mut a);
         assert_eq!(a, n); // no neighbours
-        m.set_neighbours([[5.0, 0.0], [5.0, 1.0]]);
-        l.log_likelihood(z, &s, &ctx, &mut a);
+        l.log_likelihood(z, &s, &with(&[[5.0, 0.0], [5.0, 1.0]]), &mut a);
         assert!((a[0] - w[0]).abs() < 1e-12, "{a:?} {w:?}"); // another track 1 m away
-        m.set_neighbours([[5.0, 0.0], [5.0, 5.0]]);
-        l.log_likelihood(z, &s, &ctx, &mut a);
+        l.log_likelihood(z, &s, &with(&[[5.0, 0.0], [5.0, 5.0]]), &mut a);
         assert_eq!(a, n); // far away
     }
 
@@ -454,10 +464,9 @@ mod tests {
                 .unwrap();
             let pts: Vec<[f64; 2]> = points.iter().map(|p| [p.0, p.1]).collect();
             let ns: Vec<[f64; 2]> = neighbours.iter().map(|n| [n.0, n.1]).collect();
-            m.set_neighbours(ns.iter().copied());
             let s = set(&pts);
             let mut out = vec![0.0; pts.len()];
-            m.detection_probability(&s, &StepContext::new(0, 0.0, 0.1), &mut out);
+            m.detection_probability(&s, &with(&ns), &mut out);
             let n = pts.len() as f64;
             let (mx, my) = (
                 pts.iter().map(|p| p[0] / n).sum::<f64>(),
