@@ -1,7 +1,7 @@
 //! Criterion benchmark of a whole recording as `track` runs it: eight frames of drive 0005
 //! (seed 001's drive, with its OXTS poses) from the shared data, tracked
 //!
-//! * `recording/overlapped`: by `track_drive`, which segments scan k while the filter updates
+//! * `recording/overlapped`: by `track_recording`, which segments scan k while the filter updates
 //!   frame k − 1, predicts to frame k and reads scan k + 1;
 //! * `recording/one_after_another`: by a plain loop that reads, segments and steps one frame
 //!   after the other (the same tracks).
@@ -11,7 +11,7 @@
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use smc_lmb::kitti::RawDrive;
 use smc_lmb::pipeline::drive_tracking::{
-    detect_objects, segment_rng, track_drive, DriveTracker, TrackingConfig,
+    detect_objects, segment_rng, track_recording, DriveTracker, TrackingConfig,
 };
 use std::path::Path;
 use std::time::Duration;
@@ -35,7 +35,7 @@ fn recording(c: &mut Criterion) {
         .warm_up_time(Duration::from_millis(500));
     g.throughput(Throughput::Elements(FRAMES as u64));
     g.bench_function("overlapped", |b| {
-        b.iter(|| track_drive(&drive, Some(0..FRAMES), &config, SEED, |_| Ok(())).unwrap())
+        b.iter(|| track_recording(&drive, Some(0..FRAMES), &config, SEED, |_| Ok(())).unwrap())
     });
     g.bench_function("one_after_another", |b| {
         b.iter(|| {

@@ -19,8 +19,10 @@ use smc_lmb::filter::{check_state_dim, ParticleSet, StepContext, TransitionModel
 use smc_lmb::kitti::RawDrive;
 use smc_lmb::metrics::plane_prediction::PlanePredictionSummary;
 use smc_lmb::models::{SharedVehicleModel, VehicleModel, VehicleState};
-use smc_lmb::pipeline::drive_tracking::{track_drive, DriveTracks, RoadUserMotion, TrackingConfig};
-use smc_lmb::pipeline::{predict_drive_pairs, PlanePredictionConfig};
+use smc_lmb::pipeline::drive_tracking::{
+    track_recording, DriveTracks, RoadUserMotion, TrackingConfig,
+};
+use smc_lmb::pipeline::{predict_pairs, PlanePredictionConfig};
 use smc_lmb::rng::seeded;
 use smc_lmb::FilterRng;
 use std::ops::Range;
@@ -105,7 +107,7 @@ fn plane_prediction(
         vehicle,
         ..PlanePredictionConfig::default()
     };
-    let results = predict_drive_pairs(drive, Some(frames), &config, 10, &mut seeded(1))?;
+    let results = predict_pairs(drive, Some(frames), &config, 10, &mut seeded(1))?;
     let pairs: Vec<_> = results.iter().flat_map(|r| r.pairs.clone()).collect();
     let ms: Vec<f64> = results
         .iter()
@@ -125,7 +127,7 @@ fn track(
 ) -> smc_lmb::Result<DriveTracks> {
     let mut config = TrackingConfig::default();
     config.cluster.motion = motion;
-    track_drive(drive, Some(frames), &config, 1, |_| Ok(()))
+    track_recording(drive, Some(frames), &config, 1, |_| Ok(()))
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -28,6 +28,8 @@ pub(crate) mod numerics;
 pub mod pipeline;
 #[cfg(feature = "plot")]
 pub mod plot;
+#[cfg(feature = "kitti")]
+pub mod recording;
 pub mod rng;
 pub mod sim;
 pub mod trackers;

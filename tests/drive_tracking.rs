@@ -10,7 +10,7 @@ use smc_lmb::cloud::{read_las, read_ply, write_las_labelled, write_ply_labelled,
 use smc_lmb::filter::Label;
 use smc_lmb::kitti::RawDrive;
 use smc_lmb::pipeline::drive_tracking::{
-    detect_objects, drive_plot, point_labels, segment_rng, track_drive, ClusterMethod,
+    detect_objects, drive_plot, point_labels, segment_rng, track_recording, ClusterMethod,
     DriveTracker, DriveTracks, TrackingConfig,
 };
 use std::collections::{BTreeMap, BTreeSet};
@@ -83,7 +83,7 @@ fn synthetic_street_walls_keep_labels_and_the_box_is_tracked() {
     let mut exported = 0;
     let export_dir = tmp.path().join("export");
     std::fs::create_dir_all(&export_dir).unwrap();
-    let tracks = track_drive(&drive, None, &config(), 3, |view| {
+    let tracks = track_recording(&drive, None, &config(), 3, |view| {
         let k = view.tracked.frame;
         if k == FRAMES - 1 {
             let labels = point_labels(view.cloud.len(), view.detections, view.tracked);
@@ -252,8 +252,8 @@ fn same_seed_same_tracks() {
     let drive = RawDrive::open(&dir).unwrap();
     let mut c = config();
     c.filter.particles = 200;
-    let a = track_drive(&drive, Some(0..4), &c, 5, |_| Ok(())).unwrap();
-    let b = track_drive(&drive, Some(0..4), &c, 5, |_| Ok(())).unwrap();
+    let a = track_recording(&drive, Some(0..4), &c, 5, |_| Ok(())).unwrap();
+    let b = track_recording(&drive, Some(0..4), &c, 5, |_| Ok(())).unwrap();
     let strip = |t: &DriveTracks| {
         t.frames
             .iter()
@@ -273,7 +273,7 @@ fn overlapped_frames_track_as_a_plain_loop_does() {
     let mut c = config();
     c.filter.particles = 300;
     let seed = 9;
-    let run = track_drive(&drive, None, &c, seed, |_| Ok(())).unwrap();
+    let run = track_recording(&drive, None, &c, seed, |_| Ok(())).unwrap();
     let poses = drive.poses().unwrap();
     let times = drive.timestamps().unwrap().seconds;
     let mut tracker = DriveTracker::new(&c, seed).unwrap();
@@ -342,7 +342,7 @@ fn dropped_scans_are_left_out_and_predicted_over() {
 
     let c = config();
     let seed = 4;
-    let run = track_drive(&drive, None, &c, seed, |_| Ok(())).unwrap();
+    let run = track_recording(&drive, None, &c, seed, |_| Ok(())).unwrap();
     let kept: Vec<usize> = (0..FRAMES).filter(|k| ![4, 5].contains(k)).collect();
     let numbers: Vec<usize> = run.frames.iter().map(|f| f.frame).collect();
     assert_eq!(numbers, kept);
@@ -385,7 +385,7 @@ fn dropped_scans_are_left_out_and_predicted_over() {
         .collect();
     std::fs::write(&stamps, wrong).unwrap();
     let drive = RawDrive::open(&dir).unwrap();
-    let err = track_drive(&drive, None, &c, seed, |_| Ok(()))
+    let err = track_recording(&drive, None, &c, seed, |_| Ok(()))
         .unwrap_err()
         .to_string();
     assert!(
@@ -403,7 +403,7 @@ fn bad_drives_give_clear_errors() {
 
     let dir = synthetic_drive(tmp.path());
     let drive = RawDrive::open(&dir).unwrap();
-    let err = track_drive(&drive, Some(5..20), &config(), 1, |_| Ok(()))
+    let err = track_recording(&drive, Some(5..20), &config(), 1, |_| Ok(()))
         .unwrap_err()
         .to_string();
     assert!(
@@ -416,7 +416,7 @@ fn bad_drives_give_clear_errors() {
     std::fs::write(&bin, &bytes[..bytes.len() - 5]).unwrap();
     let mut c = config();
     c.filter.particles = 100;
-    let err = track_drive(&drive, None, &c, 1, |_| Ok(()))
+    let err = track_recording(&drive, None, &c, 1, |_| Ok(()))
         .unwrap_err()
         .to_string();
     assert!(err.contains("0000000002.bin"), "{err}");
@@ -612,7 +612,7 @@ fn vendored_real_frame_static_sensor_keeps_labels() {
     let drive = RawDrive::open(&dir).unwrap();
     let tolerance = config().clusters.tolerance as f32;
     let mut first_clusters: Vec<Vec<u32>> = Vec::new();
-    let tracks = track_drive(&drive, None, &config(), 2, |view| {
+    let tracks = track_recording(&drive, None, &config(), 2, |view| {
         if view.tracked.frame == 0 {
             first_clusters = view
                 .detections
@@ -666,7 +666,7 @@ fn full_real_frames_when_present() {
     let drive = RawDrive::open(&dir).unwrap();
     let tolerance = config().clusters.tolerance as f32;
     let mut checked = 0;
-    let tracks = track_drive(&drive, None, &config(), 1, |view| {
+    let tracks = track_recording(&drive, None, &config(), 1, |view| {
         if view.tracked.frame == 0 {
             let clusters: Vec<Vec<u32>> = view
                 .detections
@@ -699,7 +699,7 @@ fn ect_ego_model_keeps_wall_labels_and_needs_oxts() {
         sigma_turn_accel: 0.1,
     };
     let drive = RawDrive::open(&dir).unwrap();
-    let tracks = track_drive(&drive, Some(0..6), &c, 9, |_| Ok(())).unwrap();
+    let tracks = track_recording(&drive, Some(0..6), &c, 9, |_| Ok(())).unwrap();
     assert_eq!(tracks.ego, "oxts+ect");
     let wall_labels: BTreeSet<Label> = tracks.frames[2..]
         .iter()
@@ -713,7 +713,7 @@ fn ect_ego_model_keeps_wall_labels_and_needs_oxts() {
         }
     }
     let no_oxts = static_real_drive(tmp.path(), 2);
-    let err = track_drive(&RawDrive::open(&no_oxts).unwrap(), None, &c, 1, |_| Ok(()))
+    let err = track_recording(&RawDrive::open(&no_oxts).unwrap(), None, &c, 1, |_| Ok(()))
         .unwrap_err()
         .to_string();
     assert!(err.contains("OXTS"), "{err}");

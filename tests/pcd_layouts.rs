@@ -4,7 +4,7 @@
 
 use smc_lmb::cloud::{read_kitti_bin, write_kitti_bin, write_pcd, PcdEncoding, PointCloud};
 use smc_lmb::kitti::{OdometrySequence, RawDrive, TrackingSequence};
-use smc_lmb::pipeline::drive_tracking::{track_drive, TrackingConfig};
+use smc_lmb::pipeline::drive_tracking::{track_recording, TrackingConfig};
 use std::path::{Path, PathBuf};
 
 /// The vendored real frame and a copy of it shifted 0.3 m forward (a second, different scan).
@@ -104,7 +104,7 @@ fn a_drive_tracked_from_pcd_matches_the_same_drive_from_bin() {
     };
     let run = |dir: PathBuf| {
         let drive = RawDrive::open(dir).unwrap();
-        let mut t = track_drive(&drive, None, &config, 3, |_| Ok(())).unwrap();
+        let mut t = track_recording(&drive, None, &config, 3, |_| Ok(())).unwrap();
         for f in &mut t.frames {
             f.times = Default::default();
         }

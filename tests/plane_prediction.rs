@@ -180,7 +180,7 @@ fn write_drive(root: &std::path::Path) -> std::path::PathBuf {
 #[test]
 fn synthetic_kitti_drive_round_trip() {
     use smc_lmb::kitti::RawDrive;
-    use smc_lmb::pipeline::predict_drive_pairs;
+    use smc_lmb::pipeline::predict_pairs;
     let tmp = tempfile::tempdir().unwrap();
     let dir = write_drive(tmp.path());
     let drive = RawDrive::open(&dir).unwrap();
@@ -191,7 +191,7 @@ fn synthetic_kitti_drive_round_trip() {
             use_vehicle_model,
             ..PlanePredictionConfig::default()
         };
-        let results = predict_drive_pairs(&drive, None, &config, 20, &mut rng).unwrap();
+        let results = predict_pairs(&drive, None, &config, 20, &mut rng).unwrap();
         assert_eq!(results.len(), 1);
         check(
             &results[0],
@@ -203,7 +203,7 @@ fn synthetic_kitti_drive_round_trip() {
         );
     }
     // A pair beyond the last frame is refused, naming the drive folder.
-    let err = predict_drive_pairs(
+    let err = predict_pairs(
         &drive,
         Some(1..2),
         &PlanePredictionConfig::default(),

@@ -166,7 +166,7 @@ const SEED_DRIVE: &str = "kitti_raw/2011_09_26/2011_09_26_drive_0005_sync";
 fn seed_drive_walls_repeat() {
     use smc_lmb::kitti::RawDrive;
     use smc_lmb::metrics::PlanePredictionSummary;
-    use smc_lmb::pipeline::{predict_drive_pairs, PlanePredictionConfig};
+    use smc_lmb::pipeline::{predict_pairs, PlanePredictionConfig};
     let Some(dir) = common::shared_data(SEED_DRIVE) else {
         return;
     };
@@ -177,8 +177,7 @@ fn seed_drive_walls_repeat() {
             use_vehicle_model: !measured,
             ..PlanePredictionConfig::default()
         };
-        let results =
-            predict_drive_pairs(&drive, Some(0..last), &config, runs, &mut seeded(1)).unwrap();
+        let results = predict_pairs(&drive, Some(0..last), &config, runs, &mut seeded(1)).unwrap();
         let pairs: Vec<_> = results.iter().flat_map(|r| r.pairs.clone()).collect();
         let s = PlanePredictionSummary::from_pairs(&pairs, &[]);
         println!(

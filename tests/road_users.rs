@@ -8,7 +8,7 @@ use smc_lmb::pipeline::kitti_results::result_labels;
 use smc_lmb::pipeline::kitti_tracking_eval::{
     evaluate_kitti_tracking, EvalClass, KittiEvalConfig, KittiTrackingEvaluation,
 };
-use smc_lmb::pipeline::{track_tracking_sequence, DriveTracks, TrackingConfig};
+use smc_lmb::pipeline::{track_recording, DriveTracks, TrackingConfig};
 use smc_lmb::sim::street::{write_tracking_sequence, StreetConfig};
 use smc_lmb::trackers::ab3dmot::Ab3dmotConfig;
 use std::cell::RefCell;
@@ -32,7 +32,7 @@ fn track_and_score(street: &StreetConfig, street_seed: u64) -> Scored {
     let truth = read_tracking_labels(seq.labels_path()).unwrap();
     let config = TrackingConfig::default();
     let baseline = RefCell::new(BaselineBoxes::new());
-    let tracks = track_tracking_sequence(&seq, None, &config, 1, |v| {
+    let tracks = track_recording(&seq, None, &config, 1, |v| {
         baseline.borrow_mut().add(v);
         Ok(())
     })

@@ -8,7 +8,7 @@ use nalgebra::Vector3;
 use smc_lmb::cloud::planes::{extract_planes, PlaneConfig};
 use smc_lmb::kitti::RawDrive;
 use smc_lmb::metrics::plane_prediction::{PlanePairError, PlanePredictionSummary};
-use smc_lmb::pipeline::plane_prediction::{predict_drive_pairs, PlanePredictionConfig};
+use smc_lmb::pipeline::plane_prediction::{predict_pairs, PlanePredictionConfig};
 use smc_lmb::sim::street::{generate, write_drive, StreetConfig, Surface};
 
 const FRAMES: usize = 12;
@@ -65,7 +65,7 @@ fn summary(config: &PlanePredictionConfig, runs: usize) -> PlanePredictionSummar
     let written = write_drive(dir.path(), &StreetConfig::default(), FRAMES, SEED, |_| {}).unwrap();
     let drive = RawDrive::open(&written.dir).unwrap();
     let mut rng = smc_lmb::rng::seeded(SEED);
-    let results = predict_drive_pairs(&drive, None, config, runs, &mut rng).unwrap();
+    let results = predict_pairs(&drive, None, config, runs, &mut rng).unwrap();
     assert_eq!(results.len(), FRAMES - 1);
     let pairs: Vec<PlanePairError> = results.iter().flat_map(|r| r.pairs.clone()).collect();
     let timings: Vec<f64> = results

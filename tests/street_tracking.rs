@@ -18,7 +18,7 @@ use smc_lmb::kitti::RawDrive;
 use smc_lmb::pipeline::drive_evaluation::{
     evaluate_clusters, evaluate_walls, street_object_truth, ClusterEvaluationConfig,
 };
-use smc_lmb::pipeline::{track_drive, TrackingConfig};
+use smc_lmb::pipeline::{track_recording, TrackingConfig};
 use smc_lmb::sim::street::{write_drive, StreetConfig};
 
 const FRAMES: usize = 16;
@@ -28,7 +28,7 @@ fn cluster_and_wall_tracks_of_a_simulated_street_meet_their_bounds() {
     let dir = tempfile::tempdir().unwrap();
     let written = write_drive(dir.path(), &StreetConfig::default(), FRAMES, 1, |_| {}).unwrap();
     let drive = RawDrive::open(&written.dir).unwrap();
-    let tracks = track_drive(&drive, None, &TrackingConfig::default(), 1, |_| Ok(())).unwrap();
+    let tracks = track_recording(&drive, None, &TrackingConfig::default(), 1, |_| Ok(())).unwrap();
     assert_eq!(tracks.frames.len(), FRAMES);
 
     // Walls: every confirmed wall with a rectangle lies on a truth wall.

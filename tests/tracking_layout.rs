@@ -284,8 +284,7 @@ fn broken_sequences_fail_naming_file_and_line() {
 #[test]
 fn pipelines_run_on_the_tracking_layout_as_on_the_raw_drive() {
     use smc_lmb::pipeline::{
-        predict_drive_pairs, predict_tracking_pairs, track_tracking_sequence,
-        PlanePredictionConfig, TrackingConfig,
+        predict_pairs, track_recording, PlanePredictionConfig, TrackingConfig,
     };
     let Some(s) = shared() else { return };
     let tmp = tempfile::tempdir().unwrap();
@@ -298,9 +297,9 @@ fn pipelines_run_on_the_tracking_layout_as_on_the_raw_drive() {
         ..PlanePredictionConfig::default()
     };
     let mut rng = smc_lmb::rng::seeded(3);
-    let a = predict_tracking_pairs(&seq, Some(11..12), &config, 2, &mut rng).unwrap();
+    let a = predict_pairs(&seq, Some(11..12), &config, 2, &mut rng).unwrap();
     let mut rng = smc_lmb::rng::seeded(3);
-    let b = predict_drive_pairs(&drive, Some(11..12), &config, 2, &mut rng).unwrap();
+    let b = predict_pairs(&drive, Some(11..12), &config, 2, &mut rng).unwrap();
     assert_eq!(a.len(), 1);
     assert_eq!(a[0].pairs, b[0].pairs);
     assert_eq!(
@@ -309,11 +308,11 @@ fn pipelines_run_on_the_tracking_layout_as_on_the_raw_drive() {
     );
     let mut c = TrackingConfig::default();
     c.filter.particles = 100;
-    let tracks = track_tracking_sequence(&seq, Some(0..3), &c, 1, |_| Ok(())).unwrap();
+    let tracks = track_recording(&seq, Some(0..3), &c, 1, |_| Ok(())).unwrap();
     assert_eq!(tracks.drive, "tracking_0000");
     assert_eq!(tracks.ego, "oxts");
     assert_eq!(tracks.frames.len(), 3);
-    let err = track_tracking_sequence(&seq, Some(90..110), &c, 1, |_| Ok(()))
+    let err = track_recording(&seq, Some(90..110), &c, 1, |_| Ok(()))
         .unwrap_err()
         .to_string();
     assert!(err.contains("beyond its 100 frames"), "{err}");

@@ -16,9 +16,9 @@ use smc_lmb::models::{
     VehicleState,
 };
 use smc_lmb::pipeline::drive_tracking::{
-    track_drive, DriveTracks, EgoModel, RoadUserMotion, TrackingConfig,
+    track_recording, DriveTracks, EgoModel, RoadUserMotion, TrackingConfig,
 };
-use smc_lmb::pipeline::{predict_drive_pairs, PlanePredictionConfig};
+use smc_lmb::pipeline::{predict_pairs, PlanePredictionConfig};
 use smc_lmb::rng::seeded;
 use smc_lmb::FilterRng;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -52,7 +52,7 @@ fn summary(drive: &RawDrive, vehicle: SharedVehicleModel) -> PlanePredictionSumm
         vehicle,
         ..PlanePredictionConfig::default()
     };
-    let results = predict_drive_pairs(drive, Some(0..12), &config, 5, &mut seeded(2)).unwrap();
+    let results = predict_pairs(drive, Some(0..12), &config, 5, &mut seeded(2)).unwrap();
     let pairs: Vec<_> = results.iter().flat_map(|r| r.pairs.clone()).collect();
     PlanePredictionSummary::from_pairs(&pairs, &[])
 }
@@ -111,7 +111,7 @@ impl TransitionModel for Counting {
 }
 
 fn track(drive: &RawDrive, config: &TrackingConfig) -> DriveTracks {
-    track_drive(drive, Some(0..6), config, 3, |_| Ok(())).unwrap()
+    track_recording(drive, Some(0..6), config, 3, |_| Ok(())).unwrap()
 }
 
 fn cluster_positions(t: &DriveTracks) -> Vec<[f64; 3]> {
@@ -183,7 +183,7 @@ fn a_vehicle_model_named_in_a_configuration_moves_the_walls() {
     assert_eq!(track(&drive, &own).ego, "oxts+StandsStill");
     let bad = r#"{"ego": {"kind": "vehicle", "model": "hovercraft"}}"#;
     let config: TrackingConfig = serde_json::from_str(bad).unwrap();
-    let e = track_drive(&drive, Some(0..2), &config, 1, |_| Ok(()))
+    let e = track_recording(&drive, Some(0..2), &config, 1, |_| Ok(()))
         .unwrap_err()
         .to_string();
     assert!(e.contains("hovercraft") && e.contains("bicycle"), "{e}");

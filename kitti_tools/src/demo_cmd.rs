@@ -11,7 +11,7 @@ use smc_lmb::pipeline::drive_evaluation::{
     evaluate_clusters, evaluate_walls, street_object_truth, ClusterEvaluationConfig,
 };
 use smc_lmb::pipeline::drive_tracking::drive_plot;
-use smc_lmb::pipeline::{predict_drive_pairs, track_drive, PlanePredictionConfig, TrackingConfig};
+use smc_lmb::pipeline::{predict_pairs, track_recording, PlanePredictionConfig, TrackingConfig};
 use smc_lmb::sim::street::{write_drive, StreetConfig, StreetTruth, TRUTH_FILE};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -95,7 +95,7 @@ pub fn run(args: Args) -> Result<()> {
         args.runs
     );
     let mut rng = smc_lmb::rng::seeded(args.seed);
-    let results = predict_drive_pairs(
+    let results = predict_pairs(
         &drive,
         None,
         &PlanePredictionConfig::default(),
@@ -112,7 +112,7 @@ pub fn run(args: Args) -> Result<()> {
     // Tracking: walls and clusters as labelled objects of one filter run.
     println!("\ntracking walls and clusters (one LMB filter, up to 1000 particles per track):");
     let b = bar(args.quiet, drive.frame_count(), "frames tracked");
-    let tracks = track_drive(
+    let tracks = track_recording(
         &drive,
         None,
         &TrackingConfig::default(),

@@ -12,9 +12,7 @@ use smc_lmb::pipeline::drive_evaluation::{
     tracklet_truth, ClusterEvaluation, ClusterEvaluationConfig, FrameScore, TruthFrames,
     WallEvaluation,
 };
-use smc_lmb::pipeline::{
-    predict_drive_pairs, predict_tracking_pairs, DriveTracks, PlanePredictionConfig,
-};
+use smc_lmb::pipeline::{predict_pairs, DriveTracks, PlanePredictionConfig};
 use smc_lmb::sim::street::StreetTruth;
 use std::path::{Path, PathBuf};
 
@@ -173,7 +171,7 @@ fn plane_statistics(args: &Args) -> Result<Option<PlanePredictionSummary>> {
     }
     let mut rng = smc_lmb::rng::seeded(1);
     if let Some((seq, what)) = tracking_sequence(args)? {
-        let results = predict_tracking_pairs(
+        let results = predict_pairs(
             &seq,
             None,
             &PlanePredictionConfig::default(),
@@ -187,7 +185,7 @@ fn plane_statistics(args: &Args) -> Result<Option<PlanePredictionSummary>> {
         bail!("--planes needs --drive or --tracking");
     };
     let drive = RawDrive::open(dir).with_context(|| format!("opening drive {}", dir.display()))?;
-    let results = predict_drive_pairs(
+    let results = predict_pairs(
         &drive,
         None,
         &PlanePredictionConfig::default(),

@@ -7,18 +7,25 @@ use anyhow::{bail, Context, Result};
 use smc_lmb::cloud::planes::PlaneConfig;
 use smc_lmb::kitti::{OdometrySequence, RawDrive, TrackingSequence};
 use smc_lmb::metrics::{PlanePairError, PlanePredictionSummary};
-use smc_lmb::pipeline::{
-    predict_drive_pairs, predict_odometry_pairs, predict_tracking_pairs, PairPrediction,
-    PlanePredictionConfig,
-};
+use smc_lmb::pipeline::{predict_pairs, PairPrediction, PlanePredictionConfig};
+use smc_lmb::recording::{Recording, ScanDirectory};
 use std::path::PathBuf;
 
 /// Flags of `planes`.
 #[derive(clap::Args)]
 pub struct Args {
     /// A KITTI raw drive folder (`.../2011_09_26/2011_09_26_drive_0001_sync`).
-    #[arg(long, conflicts_with_all = ["odometry", "tracking"])]
+    #[arg(long, conflicts_with_all = ["odometry", "tracking", "scans"])]
     drive: Option<PathBuf>,
+    /// A folder of `.bin` or `.pcd` scans from any lidar, one frame per file in file-name
+    /// order; the ego motion from `--poses` or lidar odometry (measured motion: a folder has
+    /// no vehicle states).
+    #[arg(long, conflicts_with_all = ["odometry", "tracking"])]
+    scans: Option<PathBuf>,
+    /// With `--scans`: a pose file, one row-major 3 × 4 sensor pose per line, at least one per
+    /// scan.
+    #[arg(long, requires = "scans")]
+    poses: Option<PathBuf>,
     /// A KITTI odometry root (holding `sequences/` and `poses/`); needs `--sequence`.
     #[arg(long, requires = "sequence", conflicts_with = "tracking")]
     odometry: Option<PathBuf>,
@@ -38,8 +45,9 @@ pub struct Args {
     /// Every consecutive frame pair instead of one, with the error distribution.
     #[arg(long)]
     all: bool,
-    /// Use the measured poses instead of the vehicle motion model (raw drives and tracking
-    /// sequences).
+    /// Use the measured poses instead of the vehicle motion model (the model needs the
+    /// vehicle's measured motion: raw drives and tracking sequences; other recordings are
+    /// predicted with the measured poses anyway).
     #[arg(long)]
     measured: bool,
     /// Random seed.
@@ -92,49 +100,6 @@ pub enum Ego {
     Lidar,
 }
 
-/// The recording `planes` reads.
-enum Input {
-    Drive(RawDrive),
-    Odometry(OdometrySequence),
-    Tracking(TrackingSequence),
-}
-
-impl Input {
-    fn has_poses(&self) -> bool {
-        match self {
-            Input::Drive(d) => d.has_oxts(),
-            Input::Odometry(s) => s.poses_path().is_file(),
-            Input::Tracking(s) => s.has_oxts(),
-        }
-    }
-
-    /// Frames, dropped scans included.
-    fn frame_count(&self) -> usize {
-        match self {
-            Input::Drive(d) => d.frame_count(),
-            Input::Odometry(s) => s.frame_count(),
-            Input::Tracking(s) => s.frame_count(),
-        }
-    }
-
-    /// Whether frame `k` has a scan.
-    fn has_scan(&self, k: usize) -> bool {
-        match self {
-            Input::Drive(d) => d.has_scan(k),
-            Input::Odometry(_) => true,
-            Input::Tracking(s) => s.has_scan(k),
-        }
-    }
-
-    fn load(&self, k: usize) -> smc_lmb::error::Result<smc_lmb::cloud::PointCloud> {
-        match self {
-            Input::Drive(d) => d.velodyne(k),
-            Input::Odometry(s) => s.velodyne(k),
-            Input::Tracking(s) => s.velodyne(k),
-        }
-    }
-}
-
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
     let mut planes: PlaneConfig = match &args.planes_config {
@@ -150,7 +115,7 @@ pub fn run(args: Args) -> Result<()> {
     let params = crate::config_file::vehicle_params(&args.vehicle_param)?;
     let vehicle = smc_lmb::models::vehicle_model_by_name(&args.vehicle_model, &params)
         .context("--vehicle-model")?;
-    let config = PlanePredictionConfig {
+    let mut config = PlanePredictionConfig {
         planes,
         use_vehicle_model: !args.measured,
         vehicle: smc_lmb::models::SharedVehicleModel(vehicle),
@@ -173,17 +138,20 @@ pub fn run(args: Args) -> Result<()> {
         (None, None, Some(root), Some(n)) => {
             format!("{} tracking sequence {n:04}", root.display())
         }
-        _ => String::new(),
+        _ => args
+            .scans
+            .as_ref()
+            .map_or_else(String::new, |d| d.display().to_string()),
     };
-    let input = match (&args.drive, &args.odometry, &args.tracking) {
-        (Some(dir), _, _) => Input::Drive(
+    let input: Box<dyn Recording> = match (&args.drive, &args.odometry, &args.tracking) {
+        (Some(dir), _, _) => Box::new(
             RawDrive::open(dir).with_context(|| format!("opening drive {}", dir.display()))?,
         ),
         (None, Some(root), _) => {
             let Some(number) = args.sequence else {
                 bail!("--odometry needs --sequence");
             };
-            Input::Odometry(OdometrySequence::open(root, number).with_context(|| {
+            Box::new(OdometrySequence::open(root, number).with_context(|| {
                 format!(
                     "opening odometry sequence {number:02} of {}",
                     root.display()
@@ -194,17 +162,29 @@ pub fn run(args: Args) -> Result<()> {
             let Some(number) = args.sequence else {
                 bail!("--tracking needs --sequence");
             };
-            Input::Tracking(TrackingSequence::open(root, number).with_context(|| {
+            Box::new(TrackingSequence::open(root, number).with_context(|| {
                 format!(
                     "opening tracking sequence {number:04} of {}",
                     root.display()
                 )
             })?)
         }
-        (None, None, None) => bail!(
-            "give --drive DIR, --odometry ROOT --sequence NN or --tracking ROOT --sequence NNNN"
-        ),
+        (None, None, None) => match &args.scans {
+            Some(dir) => {
+                let mut scans = ScanDirectory::open(dir)?;
+                if let Some(p) = &args.poses {
+                    scans = scans.with_poses(p)?;
+                }
+                Box::new(scans)
+            }
+            None => bail!(
+                "give --drive DIR, --odometry ROOT --sequence NN, --tracking ROOT --sequence \
+                 NNNN or --scans DIR"
+            ),
+        },
     };
+    // Algorithm 1 needs the vehicle's measured motion; other recordings use the poses.
+    config.use_vehicle_model &= input.has_vehicle();
     let lidar = match args.ego {
         Ego::Lidar => true,
         Ego::Recorded => false,
@@ -212,7 +192,7 @@ pub fn run(args: Args) -> Result<()> {
     };
     let ego_line = if lidar {
         "ego motion: lidar odometry on the scans (measured motion)".to_string()
-    } else if args.measured || matches!(input, Input::Odometry(_)) {
+    } else if !config.use_vehicle_model {
         "ego motion: recorded poses (measured motion)".to_string()
     } else {
         let model = match args.vehicle_model.as_str() {
@@ -232,7 +212,7 @@ pub fn run(args: Args) -> Result<()> {
         let poses = smc_lmb::cloud::odometry::odometry_of_frames_with(
             end,
             &|k| input.has_scan(k),
-            &|k| input.load(k),
+            &|k| input.scan(k),
             &smc_lmb::cloud::odometry::OdometryConfig::default(),
         )
         .with_context(|| format!("lidar odometry on {source}"))?;
@@ -240,7 +220,7 @@ pub fn run(args: Args) -> Result<()> {
         smc_lmb::pipeline::plane_prediction::predict_pairs_with_poses(
             frames,
             &|k| input.has_scan(k),
-            &|k| input.load(k),
+            &|k| input.scan(k),
             &poses,
             &source,
             &config,
@@ -249,18 +229,8 @@ pub fn run(args: Args) -> Result<()> {
         )
         .with_context(|| format!("predicting planes of {source}"))?
     } else {
-        match &input {
-            Input::Drive(drive) => predict_drive_pairs(drive, frames, &config, args.runs, &mut rng)
-                .with_context(|| format!("predicting planes of drive {source}"))?,
-            Input::Odometry(seq) => {
-                predict_odometry_pairs(seq, frames, &config, args.runs, &mut rng)
-                    .with_context(|| format!("predicting planes of {source}"))?
-            }
-            Input::Tracking(seq) => {
-                predict_tracking_pairs(seq, frames, &config, args.runs, &mut rng)
-                    .with_context(|| format!("predicting planes of {source}"))?
-            }
-        }
+        predict_pairs(&*input, frames, &config, args.runs, &mut rng)
+            .with_context(|| format!("predicting planes of {}", input.describe()))?
     };
     if args.paper {
         println!("{ego_line}");

@@ -1,5 +1,5 @@
-//! `kitti-tools track`: one LMB run over a KITTI raw drive, tracking sequence or odometry
-//! sequence in which building walls and point clusters are labelled objects; writes the per-frame tracks as JSON and, on request,
+//! `kitti-tools track`: one LMB run over a KITTI raw drive, tracking sequence, odometry
+//! sequence or folder of scans in which building walls and point clusters are labelled objects; writes the per-frame tracks as JSON and, on request,
 //! labelled LAS/PLY clouds of chosen frames and a bird's-eye plot; prints a summary.
 
 use crate::config_file::tracking_config;
@@ -22,8 +22,20 @@ use std::path::PathBuf;
 #[derive(clap::Args)]
 pub struct Args {
     /// A KITTI raw drive folder (`.../2011_09_26/2011_09_26_drive_0001_sync`).
-    #[arg(long, conflicts_with_all = ["odometry", "tracking"])]
+    #[arg(long, conflicts_with_all = ["odometry", "tracking", "scans"])]
     drive: Option<PathBuf>,
+    /// A folder of `.bin` or `.pcd` scans from any lidar, one frame per file in file-name
+    /// order; poses from `--poses` or lidar odometry, times from `--times` or the config's
+    /// `dt`.
+    #[arg(long, conflicts_with_all = ["odometry", "tracking"])]
+    scans: Option<PathBuf>,
+    /// With `--scans`: a pose file, one row-major 3 × 4 sensor pose per line (KITTI's
+    /// odometry layout), at least one per scan.
+    #[arg(long, requires = "scans")]
+    poses: Option<PathBuf>,
+    /// With `--scans`: a time file, one time in seconds per line, at least one per scan.
+    #[arg(long, requires = "scans")]
+    times: Option<PathBuf>,
     /// A KITTI odometry root (holding `sequences/` and `poses/`); needs `--sequence`. Walls
     /// move by the ground-truth poses (sequences 00–10).
     #[arg(long, requires = "sequence", conflicts_with = "tracking")]
@@ -199,9 +211,17 @@ pub fn run(args: Args) -> Result<()> {
         (Some(dir), _, _, _) => Recording::Raw(dir.clone()),
         (None, Some(root), _, Some(n)) => Recording::Odometry(root.clone(), n),
         (None, None, Some(root), Some(n)) => Recording::Tracking(root.clone(), n),
-        _ => bail!(
-            "give --drive DIR, --odometry ROOT --sequence NN or --tracking ROOT --sequence NNNN"
-        ),
+        _ => match &args.scans {
+            Some(dir) => Recording::Scans {
+                dir: dir.clone(),
+                poses: args.poses.clone(),
+                times: args.times.clone(),
+            },
+            None => bail!(
+                "give --drive DIR, --odometry ROOT --sequence NN, --tracking ROOT --sequence NNNN \
+                 or --scans DIR"
+            ),
+        },
     };
     let frame_plotted = std::cell::RefCell::new(false);
     let plot_at = args

@@ -101,6 +101,22 @@ def test_plane_prediction_over_the_real_drive():
         smc_lmb.predict_plane_pairs("tracking", root)
 
 
+def test_plane_prediction_over_a_folder_of_scans(tmp_path):
+    root = shared_data("kitti_raw/2011_09_26/2011_09_26_drive_0005_sync")
+    scans = tmp_path / "scans"
+    scans.mkdir()
+    for k in range(10, 13):
+        (scans / f"{k}.bin").write_bytes((root / "velodyne_points" / "data" / f"{k:010d}.bin").read_bytes())
+    with pytest.raises(ValueError, match="no pose file"):
+        smc_lmb.predict_plane_pairs("scans", scans, runs=2)
+    # poses.txt beside the scans: a sensor standing still (the folder has no vehicle states,
+    # so the measured motion is used)
+    (scans / "poses.txt").write_text("1 0 0 0 0 1 0 0 0 0 1 0\n" * 3)
+    r = smc_lmb.predict_plane_pairs("scans", scans, runs=2, seed=1)
+    assert [f["frame"] for f in r["frames"]] == [1, 2]
+    assert r["summary"]["pairs"] > 0
+
+
 DRIVE = "kitti_raw/2011_09_26/2011_09_26_drive_0005_sync"
 
 

@@ -11,17 +11,14 @@ pub mod plane_prediction;
 
 #[cfg(feature = "kitti")]
 pub use plane_prediction::{
-    predict_drive_pairs, predict_odometry_pairs, predict_planes_between, predict_tracking_pairs,
-    predict_walls, segment_walls, EgoMotion, PairPrediction, PlanePredictionConfig,
+    predict_pairs, predict_planes_between, predict_walls, segment_walls, EgoMotion, PairPrediction,
+    PlanePredictionConfig,
 };
 
 #[cfg(feature = "kitti")]
 pub mod drive_tracking;
 #[cfg(feature = "kitti")]
-pub use drive_tracking::{
-    track_drive, track_odometry_sequence, track_tracking_sequence, DriveTracker, DriveTracks,
-    TrackingConfig,
-};
+pub use drive_tracking::{track_recording, DriveTracker, DriveTracks, TrackingConfig};
 
 #[cfg(feature = "kitti")]
 pub mod drive_evaluation;

@@ -26,10 +26,10 @@ use crate::cloud::planes::{extract_planes, PlaneConfig};
 use crate::cloud::PointCloud;
 use crate::error::{Error, Result};
 use crate::geometry::{FrameChange, PlanePatch};
-use crate::kitti::{OdometrySequence, RawDrive, TrackingSequence};
 use crate::metrics::plane_prediction::{associate_planes, PlanePairError};
 use crate::models::vehicle::check_vehicle_state;
 use crate::models::{ExtendedConstantTurn, SharedVehicleModel, VehicleState};
+use crate::recording::Recording;
 use crate::rng::FilterRng;
 use nalgebra::Isometry3;
 use std::collections::BTreeMap;
@@ -352,90 +352,37 @@ fn check_range(frames: &std::ops::Range<usize>, count: usize, source: &str) -> R
     Ok(())
 }
 
-/// Plane prediction over the consecutive frame pairs `(k, k + 1)`, `k ∈ frames`, of a KITTI
-/// raw drive. `None` means every pair. Uses the Velodyne poses from OXTS; with
-/// `config.use_vehicle_model` the prediction follows Algorithm 1 from the OXTS vehicle
-/// states, the OXTS step lengths and the drive's IMU → Velodyne calibration (overriding
-/// `config.vehicle_to_sensor`).
-pub fn predict_drive_pairs(
-    drive: &RawDrive,
+/// Plane prediction over the consecutive frame pairs `(k, k + 1)`, `k ∈ frames`, of a
+/// recording (a KITTI raw drive, tracking or odometry sequence, a folder of scans with a pose
+/// file, a user's own [`Recording`]); `None` means every pair. Uses the recording's sensor
+/// poses. With `config.use_vehicle_model` the prediction follows Algorithm 1 from the
+/// recording's measured vehicle motion ([`Recording::vehicle`]: the OXTS states, their step
+/// lengths and the vehicle → sensor calibration, which overrides `config.vehicle_to_sensor`);
+/// a recording without it is an error then. Pairs with a frame that has no scan are left out.
+pub fn predict_pairs(
+    rec: &dyn Recording,
     frames: Option<std::ops::Range<usize>>,
     config: &PlanePredictionConfig,
     runs: usize,
     rng: &mut FilterRng,
 ) -> Result<Vec<PairPrediction>> {
-    let poses = drive.poses()?;
-    let count = drive.frame_count().min(poses.len());
+    let poses = rec.poses()?;
+    let count = rec.frame_count().min(poses.len());
     let frames = frames.unwrap_or(0..count.saturating_sub(1));
-    check_range(&frames, count, &drive.dir().display().to_string())?;
+    check_range(&frames, count, &rec.describe())?;
     let mut config = config.clone();
     let (states, dts) = if config.use_vehicle_model {
-        let states: Vec<[f64; 6]> = drive
-            .vehicle_states()?
-            .iter()
-            .map(|s| s.to_array())
-            .collect();
-        config.vehicle_to_sensor = drive.calib_imu_to_velo()?.isometry;
-        let dts = drive.oxts_timestamps()?.intervals();
-        (Some(states), dts)
+        let vehicle = rec.vehicle()?;
+        let states: Vec<[f64; 6]> = vehicle.states.iter().map(|s| s.to_array()).collect();
+        config.vehicle_to_sensor = vehicle.vehicle_to_sensor;
+        (Some(states), vehicle.intervals)
     } else {
         (None, Vec::new())
     };
     predict_sequence(
         frames,
-        &|k| drive.has_scan(k),
-        &|k| drive.velodyne(k),
-        &poses,
-        states.as_deref(),
-        &dts,
-        &config,
-        runs,
-        rng,
-    )
-}
-
-/// Plane prediction over the consecutive frame pairs `(k, k + 1)`, `k ∈ frames`, of a KITTI
-/// tracking sequence, as [`predict_drive_pairs`] does a raw drive: Velodyne poses from the
-/// sequence's OXTS file and `Tr_imu_velo`; with `config.use_vehicle_model` Algorithm 1 from
-/// the OXTS vehicle states with `Tr_imu_velo` as the vehicle → sensor transform and steps of
-/// [`FRAME_PERIOD`](crate::kitti::tracking::FRAME_PERIOD) (the layout has no time stamps).
-/// `None` means every pair.
-pub fn predict_tracking_pairs(
-    sequence: &TrackingSequence,
-    frames: Option<std::ops::Range<usize>>,
-    config: &PlanePredictionConfig,
-    runs: usize,
-    rng: &mut FilterRng,
-) -> Result<Vec<PairPrediction>> {
-    let poses = sequence.poses()?;
-    let count = sequence.frame_count().min(poses.len());
-    let frames = frames.unwrap_or(0..count.saturating_sub(1));
-    check_range(
-        &frames,
-        count,
-        &format!(
-            "tracking sequence {} of {}",
-            sequence.name(),
-            sequence.root().display()
-        ),
-    )?;
-    let mut config = config.clone();
-    let (states, dts) = if config.use_vehicle_model {
-        let states: Vec<[f64; 6]> = sequence
-            .vehicle_states()?
-            .iter()
-            .map(|s| s.to_array())
-            .collect();
-        config.vehicle_to_sensor = sequence.calib()?.imu_to_velo;
-        let dts = vec![crate::kitti::tracking::FRAME_PERIOD; count.saturating_sub(1)];
-        (Some(states), dts)
-    } else {
-        (None, Vec::new())
-    };
-    predict_sequence(
-        frames,
-        &|k| sequence.has_scan(k),
-        &|k| sequence.velodyne(k),
+        &|k| rec.has_scan(k),
+        &|k| rec.scan(k),
         &poses,
         states.as_deref(),
         &dts,
@@ -463,34 +410,4 @@ pub fn predict_pairs_with_poses(
 ) -> Result<Vec<PairPrediction>> {
     check_range(&frames, poses.len(), source)?;
     predict_sequence(frames, has_scan, load, poses, None, &[], config, runs, rng)
-}
-
-/// Plane prediction over the consecutive frame pairs of a KITTI odometry sequence (ground-truth
-/// poses, so sequences 00–10 only), always with the measured poses. `None` means every pair.
-pub fn predict_odometry_pairs(
-    sequence: &OdometrySequence,
-    frames: Option<std::ops::Range<usize>>,
-    config: &PlanePredictionConfig,
-    runs: usize,
-    rng: &mut FilterRng,
-) -> Result<Vec<PairPrediction>> {
-    let poses = sequence.velodyne_poses()?;
-    let count = sequence.frame_count().min(poses.len());
-    let frames = frames.unwrap_or(0..count.saturating_sub(1));
-    check_range(
-        &frames,
-        count,
-        &format!("odometry sequence {}", sequence.dir().display()),
-    )?;
-    predict_sequence(
-        frames,
-        &|_| true,
-        &|k| sequence.velodyne(k),
-        &poses,
-        None,
-        &[],
-        config,
-        runs,
-        rng,
-    )
 }

@@ -11,7 +11,7 @@
 //! frame with constant velocity. The ground is not tracked (see [`detect`]).
 //!
 //! [`DriveTracker::step`] is the per-frame step on ready-made detections (for benchmarks);
-//! [`track_drive`] ([`track_tracking_sequence`], [`track_odometry_sequence`]) runs a whole
+//! [`track_recording`] runs a whole
 //! recording and hands every frame (cloud, detections, report) to a callback, which is where a
 //! caller draws progress or writes labelled point clouds ([`export`]).
 //!
@@ -46,10 +46,10 @@ use crate::cloud::planes::PlaneConfig;
 use crate::cloud::PointCloud;
 use crate::error::{ensure_positive, ensure_probability, Error, Result};
 use crate::filter::{Jitter, LmbConfig, SharedTransitionModel, TransitionModel};
-use crate::kitti::{OdometrySequence, RawDrive, TrackingSequence};
 use crate::models::{
     vehicle_model_by_name, ExtendedConstantTurn, SharedVehicleModel, VehicleModel,
 };
+use crate::recording::Recording;
 use crate::rng::stream;
 use nalgebra::Isometry3;
 use std::ops::Range;
@@ -425,7 +425,7 @@ pub const DUPLICATE_MERGE_THRESHOLD: f64 = 9.0;
 /// estimate, or only those at 0.99, both scored lower.
 pub const REPORT_MIN_EXISTENCE: f64 = 0.9;
 
-/// Everything [`track_drive`] needs besides the drive and the seed. Every field has a default;
+/// Everything [`track_recording`] needs besides the recording and the seed. Every field has a default;
 /// a JSON or TOML file may set any subset (in `planes` too: the fields it leaves out keep
 /// [`PlaneConfig::default`]'s values).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -571,7 +571,7 @@ impl TrackingConfig {
     }
 }
 
-/// What [`track_drive`] hands its callback for every frame.
+/// What [`track_recording`] hands its callback for every frame.
 #[derive(Debug)]
 pub struct FrameView<'a> {
     /// The frame's cloud (sensor frame).
@@ -588,33 +588,10 @@ pub struct FrameView<'a> {
 const KEY_SEGMENT: u64 = 0x5E6 << 48;
 
 /// The random stream the segmentation of frame `frame` draws from in a run seeded `seed`
-/// ([`track_drive`] and its siblings): [`detect_objects`] with it gives that frame's
+/// ([`track_recording`]): [`detect_objects`] with it gives that frame's
 /// detections again.
 pub fn segment_rng(seed: u64, frame: usize) -> crate::rng::FilterRng {
     stream(seed, KEY_SEGMENT ^ frame as u64)
-}
-
-/// What the tracking loop needs from a recording, whatever its layout.
-struct Recording<'a> {
-    /// Name in errors and in the output.
-    name: String,
-    /// Number of frames, a dropped scan's included.
-    frames: usize,
-    /// Whether frame k has a scan (KITTI drops one now and then: see
-    /// [`RawDrive::has_scan`]); a frame without one is left out of the run and the next
-    /// frame is predicted to over the longer step.
-    has_scan: &'a dyn Fn(usize) -> bool,
-    /// Reads scan k.
-    read: &'a (dyn Fn(usize) -> Result<PointCloud> + Sync),
-    /// Velodyne poses (frame k → frame 0), one per frame; `None`: lidar odometry on the scans.
-    poses: Option<Vec<Isometry3<f64>>>,
-    /// Where the poses come from, e.g. `oxts` (`none` when every pose is the identity).
-    ego: String,
-    /// Measured vehicle kinematics [X, Ẋ, Y, Ẏ, φ, φ̇] for a vehicle ego model, one per
-    /// frame, and the recording's vehicle → sensor calibration.
-    vehicle: Option<(Vec<[f64; 6]>, Isometry3<f64>)>,
-    /// Frame times, s, one per frame.
-    times: Vec<f64>,
 }
 
 /// The pose source's name with `+ect` when the ECT ego model moves the walls.
@@ -622,234 +599,79 @@ fn ego_name(source: &str, config: &TrackingConfig) -> String {
     format!("{source}{}", config.ego.suffix())
 }
 
-/// The poses of a recording (`None`: lidar odometry) and their source's name, given whether
-/// it has poses of its own and how to read them.
+/// The poses of a recording (`None`: lidar odometry) and their source's name.
 fn choose_poses(
     config: &TrackingConfig,
-    what: &str,
-    n: usize,
-    recorded: Option<&dyn Fn() -> Result<Vec<Isometry3<f64>>>>,
-    recorded_name: &str,
+    rec: &dyn Recording,
 ) -> Result<(Option<Vec<Isometry3<f64>>>, String)> {
-    match (config.poses, recorded) {
+    let n = rec.frame_count();
+    match (config.poses, rec.has_poses()) {
         (PoseSource::Static, _) => Ok((Some(vec![Isometry3::identity(); n]), "none".into())),
-        (PoseSource::Lidar, _) | (PoseSource::Auto, None) => Ok((None, ego_name("lidar", config))),
-        (PoseSource::Recorded, None) => Err(Error::invalid(
-            what.to_string(),
+        (PoseSource::Lidar, _) | (PoseSource::Auto, false) => Ok((None, ego_name("lidar", config))),
+        (PoseSource::Recorded, false) => Err(Error::invalid(
+            rec.describe(),
             "has no recorded poses (OXTS or a poses file); use lidar odometry or a static sensor",
         )),
-        (_, Some(read)) => Ok((Some(read()?), ego_name(recorded_name, config))),
+        (_, true) => Ok((Some(rec.poses()?), ego_name(rec.pose_source(), config))),
     }
 }
 
-/// The measured vehicle kinematics and the vehicle → sensor calibration a vehicle ego model
-/// needs (`None` for measured poses).
-fn ect_states(
-    config: &TrackingConfig,
-    states: impl FnOnce() -> Result<Vec<crate::kitti::VehicleState>>,
-    vehicle_to_sensor: impl FnOnce() -> Result<Isometry3<f64>>,
-) -> Result<Option<(Vec<[f64; 6]>, Isometry3<f64>)>> {
-    if config.ego.is_predicted() {
-        let measured = states()?.iter().map(|s| s.to_array()).collect();
-        Ok(Some((measured, vehicle_to_sensor()?)))
-    } else {
-        Ok(None)
-    }
-}
-
-/// Tracks walls and clusters over `frames` (default: all) of `drive`.
+/// Tracks walls and clusters over `frames` (default: all) of a recording: a KITTI raw drive,
+/// tracking or odometry sequence, a folder of scans ([`crate::recording::ScanDirectory`]) or
+/// a user's own [`Recording`].
 ///
-/// Poses come from OXTS when the drive has it; otherwise every frame is taken at the world
-/// origin (`ego = "none"`: only a static sensor is then tracked correctly). The ECT ego model
-/// needs OXTS. Time stamps come from `velodyne_points/timestamps.txt` when present, else frame
-/// k is at k·`config.dt`. `on_frame` sees every frame as it is done; its error stops the run.
-pub fn track_drive(
-    drive: &RawDrive,
+/// Poses come from the recording when it has them (`config.poses` decides: recorded, lidar
+/// odometry on the scans, or a static sensor); a vehicle ego model (`config.ego`) needs the
+/// recording's measured vehicle motion ([`Recording::vehicle`]: OXTS). Frame times come from
+/// the recording when it has them, else frame k is at k·`config.dt`. Frames without a scan
+/// are left out and the next is predicted to over the longer step. `on_frame` sees every
+/// frame as it is done; its error stops the run. The output is named [`Recording::name`].
+pub fn track_recording(
+    rec: &dyn Recording,
     frames: Option<Range<usize>>,
     config: &TrackingConfig,
     seed: u64,
     on_frame: impl FnMut(&FrameView<'_>) -> Result<()>,
 ) -> Result<DriveTracks> {
     config.validate()?;
-    let name = drive.dir().display().to_string();
-    if !drive.has_velodyne() {
-        return Err(Error::invalid(
-            format!("drive {name}"),
-            "has no velodyne_points/data folder",
-        ));
-    }
-    let n = drive.frame_count();
-    check_frame_range(frames.as_ref(), n, &format!("drive {name}"))?;
-    if !drive.has_oxts() {
-        if config.ego.is_predicted() {
-            return Err(Error::invalid(
-                format!("drive {name}"),
-                "the vehicle ego model needs OXTS packets (oxts/data)",
-            ));
-        }
-    }
-    let oxts_poses = || drive.poses();
-    let (poses, ego) = choose_poses(
-        config,
-        &format!("drive {name}"),
-        n,
-        drive
-            .has_oxts()
-            .then_some(&oxts_poses as &dyn Fn() -> Result<Vec<Isometry3<f64>>>),
-        "oxts",
-    )?;
-    let vehicle = ect_states(
-        config,
-        || drive.vehicle_states(),
-        || Ok(drive.calib_imu_to_velo()?.isometry),
-    )?;
-    let times: Vec<f64> = if drive.velodyne_timestamps_path().is_file() {
-        drive.scan_times()?
-    } else {
-        (0..n).map(|k| k as f64 * config.dt).collect()
-    };
-    let read = |k: usize| drive.velodyne(k);
-    let has_scan = |k: usize| drive.has_scan(k);
-    let recording = Recording {
-        name: drive.name(),
-        frames: n,
-        has_scan: &has_scan,
-        read: &read,
-        poses,
-        ego,
-        vehicle,
-        times,
-    };
-    track_recording(&recording, frames, config, seed, on_frame)
-}
-
-/// Tracks walls and clusters over `frames` (default: all) of a KITTI tracking sequence, as
-/// [`track_drive`] does a raw drive: poses from the sequence's OXTS file and `Tr_imu_velo`
-/// (required: the tracking layout always has them), frame k at k·0.1 s (the layout has no
-/// time stamps, see [`crate::kitti::tracking::FRAME_PERIOD`]). The output is named
-/// `tracking_NNNN`.
-pub fn track_tracking_sequence(
-    sequence: &TrackingSequence,
-    frames: Option<Range<usize>>,
-    config: &TrackingConfig,
-    seed: u64,
-    on_frame: impl FnMut(&FrameView<'_>) -> Result<()>,
-) -> Result<DriveTracks> {
-    config.validate()?;
-    let name = format!(
-        "tracking sequence {} of {}",
-        sequence.name(),
-        sequence.root().display()
-    );
-    if !sequence.has_velodyne() {
-        return Err(Error::invalid(
-            name,
-            format!("has no scan folder {}", sequence.velodyne_dir().display()),
-        ));
-    }
-    let n = sequence.frame_count();
-    check_frame_range(frames.as_ref(), n, &name)?;
-    let oxts_poses = || sequence.poses();
-    let (poses, ego) = choose_poses(
-        config,
-        &name,
-        n,
-        sequence
-            .has_oxts()
-            .then_some(&oxts_poses as &dyn Fn() -> Result<Vec<Isometry3<f64>>>),
-        "oxts",
-    )?;
-    let read = |k: usize| sequence.velodyne(k);
-    let has_scan = |k: usize| sequence.has_scan(k);
-    let recording = Recording {
-        name: format!("tracking_{}", sequence.name()),
-        frames: n,
-        has_scan: &has_scan,
-        read: &read,
-        poses,
-        ego,
-        vehicle: ect_states(
-            config,
-            || sequence.vehicle_states(),
-            || Ok(sequence.calib()?.imu_to_velo),
-        )?,
-        times: sequence.times(),
-    };
-    track_recording(&recording, frames, config, seed, on_frame)
-}
-
-/// Tracks walls and clusters over `frames` (default: all) of a KITTI odometry sequence, with
-/// the ground-truth poses of `poses/NN.txt` (sequences 00–10) moved to the Velodyne frame with
-/// `calib.txt`'s `Tr` (`ego = "odometry"`), and the times of `times.txt` (k·`config.dt` when it
-/// is absent). The ECT ego model needs vehicle states, which the layout has not: an error. The
-/// output is named `odometry_NN`.
-pub fn track_odometry_sequence(
-    sequence: &OdometrySequence,
-    frames: Option<Range<usize>>,
-    config: &TrackingConfig,
-    seed: u64,
-    on_frame: impl FnMut(&FrameView<'_>) -> Result<()>,
-) -> Result<DriveTracks> {
-    config.validate()?;
-    let name = format!("odometry sequence {}", sequence.dir().display());
-    if config.ego.is_predicted() {
-        return Err(Error::invalid(
-            name,
-            "the vehicle ego model needs OXTS vehicle states, which the odometry layout has not",
-        ));
-    }
-    let n = sequence.frame_count();
+    let what = rec.describe();
+    let n = rec.frame_count();
     if n == 0 {
-        return Err(Error::invalid(
-            name,
-            format!("has no scans in {}", sequence.velodyne_dir().display()),
-        ));
+        let reason = match rec.scan_dir() {
+            Some(dir) => format!("has no scans in {}", dir.display()),
+            None => "has no scans".to_string(),
+        };
+        return Err(Error::invalid(what, reason));
     }
-    check_frame_range(frames.as_ref(), n, &name)?;
-    let file_poses = || -> Result<Vec<Isometry3<f64>>> {
-        let poses = sequence.velodyne_poses()?;
-        if poses.len() < n {
-            return Err(Error::invalid(
-                format!("{}", sequence.poses_path().display()),
-                format!("has {} poses for {n} scans", poses.len()),
-            ));
-        }
-        Ok(poses)
-    };
-    let (poses, ego) = choose_poses(
-        config,
-        &name,
-        n,
-        sequence
-            .poses_path()
-            .is_file()
-            .then_some(&file_poses as &dyn Fn() -> Result<Vec<Isometry3<f64>>>),
-        "odometry",
-    )?;
-    let times = if sequence.times_path().is_file() {
-        let t = sequence.times()?;
-        if t.len() < n {
-            return Err(Error::invalid(
-                format!("{}", sequence.times_path().display()),
-                format!("has {} times for {n} scans", t.len()),
-            ));
-        }
-        t
+    check_frame_range(frames.as_ref(), n, &what)?;
+    if config.ego.is_predicted() && !rec.has_vehicle() {
+        // the recording's own words for what is missing
+        rec.vehicle()?;
+    }
+    let (poses, ego) = choose_poses(config, rec)?;
+    let vehicle = if config.ego.is_predicted() {
+        let v = rec.vehicle()?;
+        let measured: Vec<[f64; 6]> = v.states.iter().map(|s| s.to_array()).collect();
+        Some((measured, v.vehicle_to_sensor))
     } else {
-        (0..n).map(|k| k as f64 * config.dt).collect()
+        None
     };
-    let read = |k: usize| sequence.velodyne(k);
-    let recording = Recording {
-        name: format!("odometry_{}", sequence.name()),
-        frames: n,
-        has_scan: &|_| true,
-        read: &read,
+    let times = match rec.times()? {
+        Some(t) => t,
+        None => (0..n).map(|k| k as f64 * config.dt).collect(),
+    };
+    track_frames(
+        rec,
+        &rec.name(),
+        &ego,
         poses,
-        ego,
-        vehicle: None,
-        times,
-    };
-    track_recording(&recording, frames, config, seed, on_frame)
+        vehicle,
+        &times,
+        frames,
+        config,
+        seed,
+        on_frame,
+    )
 }
 
 /// Where the tracking loop takes each frame's sensor pose from.
@@ -953,33 +775,40 @@ fn check_frame_range(frames: Option<&Range<usize>>, n: usize, what: &str) -> Res
     Ok(())
 }
 
-/// The tracking loop over a recording's frames.
-fn track_recording(
-    rec: &Recording<'_>,
+/// The tracking loop over a recording's frames: `poses` one per frame (`None`: lidar
+/// odometry), `vehicle` the measured kinematics of every frame and the vehicle → sensor
+/// transform for a vehicle ego model, `times` one per frame.
+#[allow(clippy::too_many_arguments)]
+fn track_frames(
+    rec: &dyn Recording,
+    name: &str,
+    ego_name: &str,
+    poses: Option<Vec<Isometry3<f64>>>,
+    vehicle_motion: Option<(Vec<[f64; 6]>, Isometry3<f64>)>,
+    times: &[f64],
     frames: Option<Range<usize>>,
     config: &TrackingConfig,
     seed: u64,
     mut on_frame: impl FnMut(&FrameView<'_>) -> Result<()>,
 ) -> Result<DriveTracks> {
-    let range = frames.unwrap_or(0..rec.frames);
+    let range = frames.unwrap_or(0..rec.frame_count());
     // The frames of the range that have a scan.
-    let scans: Vec<usize> = range.clone().filter(|&k| (rec.has_scan)(k)).collect();
+    let scans: Vec<usize> = range.clone().filter(|&k| rec.has_scan(k)).collect();
     if scans.is_empty() {
         return Err(Error::invalid(
-            format!("frames {}..{} of {}", range.start, range.end, rec.name),
+            format!("frames {}..{} of {name}", range.start, range.end),
             "hold no scan",
         ));
     }
-    let times = &rec.times;
-    let vehicle = rec.vehicle.as_ref().map(|(states, _)| states);
+    let vehicle = vehicle_motion.as_ref().map(|(states, _)| states);
     let mut tracker = DriveTracker::builder(config)
         .vehicle_to_sensor(
-            rec.vehicle
+            vehicle_motion
                 .as_ref()
                 .map_or_else(Isometry3::identity, |v| v.1),
         )
         .build(seed)?;
-    let mut ego = match &rec.poses {
+    let mut ego = match &poses {
         Some(p) => Ego::Recorded(p),
         None => Ego::Lidar(Box::new(LidarOdometry::new(OdometryConfig::default())?)),
     };
@@ -994,7 +823,7 @@ fn track_recording(
     // Scan k + 1 is read beside the segmentation of scan k too.
     let read = |k: usize| -> Result<(PointCloud, f64)> {
         let start = Instant::now();
-        let cloud = (rec.read)(k)?;
+        let cloud = rec.scan(k)?;
         Ok((cloud, start.elapsed().as_secs_f64() * 1e3))
     };
     let mut next = Some(read(scans[0])?);
@@ -1003,7 +832,7 @@ fn track_recording(
         let previous_state = vehicle.map(|v| v[scans[i.saturating_sub(1)]]);
         let following = scans.get(i + 1).copied();
         let steps = if i == 0 { 1 } else { k - scans[i - 1] };
-        let (pose, ego_ms) = ego.pose(k, steps, &cloud, &rec.name)?;
+        let (pose, ego_ms) = ego.pose(k, steps, &cloud, name)?;
         let start = Instant::now();
         let earlier = held.take();
         type Earlier = Option<(Held, FrameDetections, TrackedFrame, f64)>;
@@ -1065,10 +894,10 @@ fn track_recording(
         Ego::Lidar(o) => o.fallbacks().values().sum(),
     };
     Ok(DriveTracks {
-        drive: rec.name.clone(),
+        drive: name.to_string(),
         seed,
         particles: config.filter.particles,
-        ego: rec.ego.clone(),
+        ego: ego_name.to_string(),
         frames: out,
         summary,
     })

@@ -1,15 +1,13 @@
 //! [`RecordingSource`]: which recording a tracking run reads — a KITTI raw drive, a tracking
-//! sequence or an odometry sequence, by where it lives — opened and tracked the same way
+//! sequence, an odometry sequence or a folder of scans, by where it lives — opened and tracked the same way
 //! whatever its layout, for the command line and the Python package alike.
 //!
-//! Not for: the tracking loop itself (see [`super::track_drive`] and its siblings).
+//! Not for: the tracking loop itself (see [`super::track_recording`]).
 
-use super::{
-    track_drive, track_odometry_sequence, track_tracking_sequence, DriveTracks, FrameView,
-    TrackingConfig,
-};
+use super::{track_recording, DriveTracks, FrameView, TrackingConfig};
 use crate::error::Result;
 use crate::kitti::{OdometrySequence, RawDrive, TrackingSequence};
+use crate::recording::{Recording, ScanDirectory};
 use std::ops::Range;
 use std::path::PathBuf;
 
@@ -22,6 +20,16 @@ pub enum RecordingSource {
     Tracking(PathBuf, u32),
     /// An odometry root (holding `sequences/` and `poses/`) and a sequence number.
     Odometry(PathBuf, u32),
+    /// A folder of `.bin` or `.pcd` scans ([`ScanDirectory`]) with an optional pose file and
+    /// an optional time file.
+    Scans {
+        /// The folder.
+        dir: PathBuf,
+        /// One row-major 3 × 4 sensor pose per line (KITTI's odometry layout).
+        poses: Option<PathBuf>,
+        /// One time (s) per line.
+        times: Option<PathBuf>,
+    },
 }
 
 impl RecordingSource {
@@ -34,6 +42,10 @@ impl RecordingSource {
                 .unwrap_or_else(|| dir.display().to_string()),
             RecordingSource::Tracking(_, n) => format!("tracking_{n:04}"),
             RecordingSource::Odometry(_, n) => format!("odometry_{n:02}"),
+            RecordingSource::Scans { dir, .. } => dir
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_else(|| dir.display().to_string()),
         }
     }
 
@@ -47,6 +59,7 @@ impl RecordingSource {
             RecordingSource::Odometry(root, n) => {
                 format!("odometry sequence {n:02} of {}", root.display())
             }
+            RecordingSource::Scans { dir, .. } => format!("scan folder {}", dir.display()),
         }
     }
 
@@ -58,18 +71,25 @@ impl RecordingSource {
         seed: u64,
         on_frame: impl FnMut(&FrameView<'_>) -> Result<()>,
     ) -> Result<DriveTracks> {
-        match self {
-            RecordingSource::Raw(dir) => {
-                track_drive(&RawDrive::open(dir)?, frames, config, seed, on_frame)
+        track_recording(&*self.open()?, frames, config, seed, on_frame)
+    }
+
+    /// Opens the recording.
+    pub fn open(&self) -> Result<Box<dyn Recording>> {
+        Ok(match self {
+            RecordingSource::Raw(dir) => Box::new(RawDrive::open(dir)?),
+            RecordingSource::Tracking(root, n) => Box::new(TrackingSequence::open(root, *n)?),
+            RecordingSource::Odometry(root, n) => Box::new(OdometrySequence::open(root, *n)?),
+            RecordingSource::Scans { dir, poses, times } => {
+                let mut scans = ScanDirectory::open(dir)?;
+                if let Some(p) = poses {
+                    scans = scans.with_poses(p)?;
+                }
+                if let Some(t) = times {
+                    scans = scans.with_times(t)?;
+                }
+                Box::new(scans)
             }
-            RecordingSource::Tracking(root, n) => {
-                let seq = TrackingSequence::open(root, *n)?;
-                track_tracking_sequence(&seq, frames, config, seed, on_frame)
-            }
-            RecordingSource::Odometry(root, n) => {
-                let seq = OdometrySequence::open(root, *n)?;
-                track_odometry_sequence(&seq, frames, config, seed, on_frame)
-            }
-        }
+        })
     }
 }
