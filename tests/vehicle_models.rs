@@ -3,7 +3,8 @@
 //! transition, and a road-user motion model of one's own moves the tracker's clusters. On the
 //! shared frames of drive 0005 a deliberately poor vehicle model (the car stands still) predicts
 //! the walls worse than the extended constant turn, and the tracker calls the user's road-user
-//! model and its tracks change with it.
+//! model and its tracks change with it; so are its own detection and clutter models, each asked
+//! only about its kind of object.
 
 mod common;
 
@@ -16,7 +17,7 @@ use smc_lmb::models::{
     VehicleState,
 };
 use smc_lmb::pipeline::drive_tracking::{
-    track_recording, DriveTracks, EgoModel, RoadUserMotion, TrackingConfig,
+    track_recording, DriveTracks, EgoModel, OwnModels, RoadUserMotion, TrackingConfig,
 };
 use smc_lmb::pipeline::{predict_pairs, PlanePredictionConfig};
 use smc_lmb::rng::seeded;
@@ -187,4 +188,80 @@ fn a_vehicle_model_named_in_a_configuration_moves_the_walls() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("hovercraft") && e.contains("bicycle"), "{e}");
+}
+
+/// A constant p_D that counts the particle sets it is asked about.
+struct CountedDetection {
+    p: f64,
+    calls: Arc<AtomicUsize>,
+}
+
+impl smc_lmb::filter::DetectionModel for CountedDetection {
+    fn detection_probability(&self, p: &ParticleSet, _: &StepContext, out: &mut [f64]) {
+        self.calls.fetch_add(1, Ordering::Relaxed);
+        out[..p.len()].fill(self.p);
+    }
+}
+
+/// A uniform clutter density that checks it is only asked about walls.
+struct WallClutter {
+    log_density: f64,
+    calls: Arc<AtomicUsize>,
+}
+
+impl smc_lmb::filter::ClutterModel for WallClutter {
+    fn log_intensity(&self, z: &[f64], _: &StepContext) -> f64 {
+        assert_eq!(z.len(), 5);
+        assert_eq!(
+            z[4], 0.0,
+            "a cluster measurement reached the wall clutter model"
+        );
+        self.calls.fetch_add(1, Ordering::Relaxed);
+        self.log_density
+    }
+}
+
+#[test]
+fn the_tracker_takes_the_users_detection_and_clutter_models() {
+    let Some(dir) = common::shared_data(DRIVE) else {
+        return;
+    };
+    let drive = RawDrive::open(&dir).unwrap();
+    let default = track(&drive, &TrackingConfig::default());
+    let (detections, clutter) = (Arc::new(AtomicUsize::new(0)), Arc::new(AtomicUsize::new(0)));
+    let mut config = TrackingConfig::default();
+    // clusters seen half as often as the default 0.8 says; false walls as likely as the
+    // default's (0.5 per frame over π/2 · 50 rad·m)
+    config.cluster.own_models = OwnModels::default().detection(CountedDetection {
+        p: 0.4,
+        calls: detections.clone(),
+    });
+    config.plane.own_models = OwnModels::default().clutter(WallClutter {
+        log_density: (0.5 / (std::f64::consts::FRAC_PI_2 * 50.0)).ln(),
+        calls: clutter.clone(),
+    });
+    let own = track(&drive, &config);
+    let (d, c) = (
+        detections.load(Ordering::Relaxed),
+        clutter.load(Ordering::Relaxed),
+    );
+    assert!(d > 100 && c > 10, "detection {d} calls, clutter {c} calls");
+    assert_ne!(cluster_positions(&own), cluster_positions(&default));
+}
+
+#[test]
+fn a_measurement_model_of_the_wrong_dimension_is_refused_naming_it() {
+    let mut config = TrackingConfig::default();
+    // a 2-D position model measures 2 components, not the tracker's 5
+    config.cluster.own_models = OwnModels::default()
+        .measurement(smc_lmb::models::PositionMeasurement::new(2, 0.3).unwrap());
+    let e = smc_lmb::pipeline::DriveTracker::new(&config, 1)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("cluster measurement model")
+            && e.contains("PositionMeasurement")
+            && e.contains("2"),
+        "{e}"
+    );
 }

@@ -21,8 +21,9 @@ use std::path::{Path, PathBuf};
 /// Flags of `batch`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The recordings: a text file with one per line (a raw drive folder, `tracking ROOT NNNN`
-    /// or `odometry ROOT NN`; relative paths from the file's folder; `#` comments), or a
+    /// The recordings: a text file with one per line (a raw drive folder, `tracking ROOT NNNN`,
+    /// `odometry ROOT NN` or `scans DIR [POSES [TIMES]]`; relative paths from the file's
+    /// folder; `#` comments), or a
     /// folder whose raw drives (subfolders with `velodyne_points/`) are all taken.
     #[arg(long)]
     drives: PathBuf,

@@ -143,6 +143,9 @@ pub fn run(args: Args) -> Result<()> {
             .as_ref()
             .map_or_else(String::new, |d| d.display().to_string()),
     };
+    if args.scans.is_none() && args.poses.is_some() {
+        bail!("--poses goes with --scans DIR (the KITTI layouts bring their own)");
+    }
     let input: Box<dyn Recording> = match (&args.drive, &args.odometry, &args.tracking) {
         (Some(dir), _, _) => Box::new(
             RawDrive::open(dir).with_context(|| format!("opening drive {}", dir.display()))?,

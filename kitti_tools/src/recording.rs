@@ -24,9 +24,10 @@ pub fn track(
 
 /// The recordings `path` names: every raw drive in it when it is a folder (its subfolders
 /// holding `velodyne_points/`, by name), else its lines. A line is a raw drive folder,
-/// `tracking ROOT NNNN` or `odometry ROOT NN`; relative paths are taken from the list's own
-/// folder, blank lines and text after `#` are ignored. Errors name the file and line. Two
-/// recordings with the same [`Recording::name`] are an error (their outputs would collide).
+/// `tracking ROOT NNNN`, `odometry ROOT NN` or `scans DIR [POSES [TIMES]]`; relative paths
+/// are taken from the list's own folder, blank lines and text after `#` are ignored. Errors
+/// name the file and line. Two recordings with the same [`Recording::name`] are an error
+/// (their outputs would collide).
 pub fn read_list(path: &Path) -> Result<Vec<Recording>> {
     let list = if path.is_dir() {
         drives_in(path)?
@@ -95,8 +96,17 @@ fn parse_line(line: &str, base: &Path) -> Result<Recording> {
         [kind @ ("tracking" | "odometry"), ..] => {
             bail!("expected `{kind} ROOT NUMBER`")
         }
+        ["scans", dir, rest @ ..] if rest.len() <= 2 => Ok(Recording::Scans {
+            dir: at(dir),
+            poses: rest.first().map(|p| at(p)),
+            times: rest.get(1).map(|t| at(t)),
+        }),
+        ["scans", ..] => bail!("expected `scans DIR [POSES [TIMES]]`"),
         [dir] => Ok(Recording::Raw(at(dir))),
-        _ => bail!("expected a drive folder, `tracking ROOT NNNN` or `odometry ROOT NN`"),
+        _ => bail!(
+            "expected a drive folder, `tracking ROOT NNNN`, `odometry ROOT NN` or `scans DIR \
+             [POSES [TIMES]]`"
+        ),
     }
 }
 
@@ -115,7 +125,8 @@ mod tests {
              a/2011_09_26_drive_0001_sync\n\n\
              /abs/2011_09_26_drive_0002_sync   # absolute\n\
              tracking kitti/training 7\n\
-             odometry odo 3\n",
+             odometry odo 3\n\
+             scans lidar/run1 lidar/run1_poses.txt\n",
         )
         .unwrap();
         let got = read_list(&list).unwrap();
@@ -126,14 +137,21 @@ mod tests {
                 Recording::Raw(PathBuf::from("/abs/2011_09_26_drive_0002_sync")),
                 Recording::Tracking(tmp.path().join("kitti/training"), 7),
                 Recording::Odometry(tmp.path().join("odo"), 3),
+                Recording::Scans {
+                    dir: tmp.path().join("lidar/run1"),
+                    poses: Some(tmp.path().join("lidar/run1_poses.txt")),
+                    times: None,
+                },
             ]
         );
+        assert_eq!(got[4].name(), "run1");
         assert_eq!(got[2].name(), "tracking_0007");
         assert_eq!(got[3].name(), "odometry_03");
         for (text, needle) in [
             ("x\ntracking root\n", "line 2"),
             ("tracking root seven\n", "not a sequence number"),
             ("a b\n", "expected a drive folder"),
+            ("scans a b c d\n", "expected `scans DIR [POSES [TIMES]]`"),
             ("# nothing\n", "names no recording"),
             ("x/d_sync\ny/d_sync\n", "would both write"),
         ] {

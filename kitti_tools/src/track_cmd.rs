@@ -207,6 +207,9 @@ pub fn run(args: Args) -> Result<()> {
         ProgressStyle::with_template("{bar:40} {pos}/{len} frames {elapsed} {msg}")
             .expect("valid template"),
     );
+    if args.scans.is_none() && (args.poses.is_some() || args.times.is_some()) {
+        bail!("--poses and --times go with --scans DIR (the KITTI layouts bring their own)");
+    }
     let recording = match (&args.drive, &args.odometry, &args.tracking, args.sequence) {
         (Some(dir), _, _, _) => Recording::Raw(dir.clone()),
         (None, Some(root), _, Some(n)) => Recording::Odometry(root.clone(), n),

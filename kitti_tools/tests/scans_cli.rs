@@ -97,10 +97,40 @@ fn a_scan_folder_tracks_as_the_drive_it_came_from() {
     );
 }
 
+/// `../shared/data/REL` when present. Under `CI=true` a missing folder fails the test;
+/// elsewhere the test is skipped with a note on the terminal.
+fn shared_data(rel: &str) -> Option<PathBuf> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/data")
+        .join(rel);
+    if dir.exists() {
+        return Some(dir);
+    }
+    if std::env::var("CI").is_ok_and(|v| v == "true") {
+        panic!(
+            "CI=true but the shared data folder {} is missing",
+            dir.display()
+        );
+    }
+    eprintln!("SKIPPED: {} is missing", dir.display());
+    None
+}
+
 #[test]
 fn a_scan_folder_predicts_planes_as_the_drive_it_came_from() {
+    let Some(real) = shared_data("kitti_raw/2011_09_26/2011_09_26_drive_0005_sync") else {
+        return;
+    };
+    // frames 10–12 of drive 0005 (facades on both sides) as a drive without OXTS and as a
+    // folder of scans
     let tmp = tempfile::tempdir().unwrap();
-    let (drive, data) = static_drive(tmp.path(), 3);
+    let drive = tmp.path().join("2011_09_26/2011_09_26_drive_0001_sync");
+    let data = drive.join("velodyne_points/data");
+    std::fs::create_dir_all(&data).unwrap();
+    for k in 0..3 {
+        let from = real.join(format!("velodyne_points/data/{:010}.bin", k + 10));
+        std::fs::copy(from, data.join(format!("{k:010}.bin"))).unwrap();
+    }
     let planes = |flag: &str, path: &Path, extra: &[&str]| {
         let mut args = vec![
             "planes",
@@ -119,7 +149,13 @@ fn a_scan_folder_predicts_planes_as_the_drive_it_came_from() {
     let a = planes("--drive", &drive, &[]);
     let b = planes("--scans", &data, &[]);
     assert_eq!(a["pairs"], b["pairs"]);
-    assert!(!b["pairs"].as_array().unwrap().is_empty());
+    assert!(!b["pairs"].as_array().unwrap().is_empty(), "{b}");
+    assert!(
+        b["ego"].as_str().unwrap().contains("lidar odometry"),
+        "{}",
+        b["ego"]
+    );
+    // a pose file: a sensor standing still, the measured motion
     let poses = tmp.path().join("poses.txt");
     std::fs::write(&poses, "1 0 0 0 0 1 0 0 0 0 1 0\n".repeat(3)).unwrap();
     let c = planes("--scans", &data, &["--poses", poses.to_str().unwrap()]);
@@ -128,7 +164,7 @@ fn a_scan_folder_predicts_planes_as_the_drive_it_came_from() {
         "{}",
         c["ego"]
     );
-    assert_eq!(c["pairs"].as_array().unwrap().len(), 2);
+    assert!(!c["pairs"].as_array().unwrap().is_empty(), "{c}");
 }
 
 #[test]
@@ -202,6 +238,14 @@ fn broken_scan_folders_and_files_are_named_and_nothing_is_written() {
         short.to_str().unwrap(),
         "--out",
         out.to_str().unwrap(),
+    ]);
+    assert!(!ok && stderr.contains("--scans"), "{stderr}");
+    let (ok, _, stderr) = run(&[
+        "planes",
+        "--drive",
+        data.to_str().unwrap(),
+        "--poses",
+        short.to_str().unwrap(),
     ]);
     assert!(!ok && stderr.contains("--scans"), "{stderr}");
 }

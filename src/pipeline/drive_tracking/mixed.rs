@@ -303,15 +303,132 @@ impl TransitionModel for MixedTransition {
     }
 }
 
+/// A user's own measurement, detection and clutter models for one kind of object (walls or
+/// clusters), used by the drive tracker instead of its built-in ones (code only: a
+/// configuration file tunes the built-in ones). Each gets the mixed layout of the module
+/// documentation: the 7-component state (the kind in component 6) and the 5-component
+/// measurement (the kind in component 4), and is only ever asked about its own kind: a
+/// measurement of the other kind never reaches it.
+#[derive(Clone, Default)]
+pub struct OwnModels {
+    /// The measurement model (its `measurement_dim` must be 5).
+    pub measurement: Option<Arc<dyn MeasurementModel>>,
+    /// The detection model.
+    pub detection: Option<Arc<dyn DetectionModel>>,
+    /// The clutter model (asked about measurements of its kind).
+    pub clutter: Option<Arc<dyn ClutterModel>>,
+}
+
+impl OwnModels {
+    /// The same with `m` as the measurement model.
+    pub fn measurement(mut self, m: impl MeasurementModel + 'static) -> Self {
+        self.measurement = Some(Arc::new(m));
+        self
+    }
+
+    /// The same with `d` as the detection model.
+    pub fn detection(mut self, d: impl DetectionModel + 'static) -> Self {
+        self.detection = Some(Arc::new(d));
+        self
+    }
+
+    /// The same with `c` as the clutter model.
+    pub fn clutter(mut self, c: impl ClutterModel + 'static) -> Self {
+        self.clutter = Some(Arc::new(c));
+        self
+    }
+
+    /// Whether no model is set.
+    pub fn is_empty(&self) -> bool {
+        self.measurement.is_none() && self.detection.is_none() && self.clutter.is_none()
+    }
+
+    /// Checks the measurement model's dimensions against the mixed layout; `what` names the
+    /// kind (`wall`, `cluster`) in the error.
+    pub fn check(&self, what: &str) -> Result<()> {
+        if let Some(m) = &self.measurement {
+            if m.measurement_dim() != MEASUREMENT_DIM {
+                return Err(Error::invalid(
+                    format!("{what} measurement model {}", m.name()),
+                    format!(
+                        "measures {} components; the drive tracker's measurements have \
+                         {MEASUREMENT_DIM} (the kind last)",
+                        m.measurement_dim()
+                    ),
+                ));
+            }
+            if let Some(d) = m.state_dim().filter(|&d| d > STATE_DIM) {
+                return Err(Error::invalid(
+                    format!("{what} measurement model {}", m.name()),
+                    format!("reads states of {d} components; the drive tracker's have {STATE_DIM}"),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl std::fmt::Debug for OwnModels {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("OwnModels")
+            .field("measurement", &self.measurement.as_ref().map(|m| m.name()))
+            .field("detection", &self.detection.is_some())
+            .field("clutter", &self.clutter.is_some())
+            .finish()
+    }
+}
+
+/// Equal when they share the same models (compared by identity).
+impl PartialEq for OwnModels {
+    fn eq(&self, other: &Self) -> bool {
+        fn same<T: ?Sized>(a: &Option<Arc<T>>, b: &Option<Arc<T>>) -> bool {
+            match (a, b) {
+                (None, None) => true,
+                (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+                _ => false,
+            }
+        }
+        same(&self.measurement, &other.measurement)
+            && same(&self.detection, &other.detection)
+            && same(&self.clutter, &other.clutter)
+    }
+}
+
+/// The index of a kind in the per-kind arrays of the mixed models.
+fn slot(kind: ObjectKind) -> usize {
+    match kind {
+        ObjectKind::Plane => 0,
+        ObjectKind::Cluster => 1,
+    }
+}
+
 /// Plane likelihood or sensor-frame position likelihood, chosen by the kind of the set; −∞
-/// for a measurement of the other kind.
-#[derive(Clone, Debug)]
+/// for a measurement of the other kind. A user's model replaces either
+/// ([`MixedMeasurement::with_own`]).
+#[derive(Clone)]
 pub struct MixedMeasurement {
     plane: PlaneMeasurement,
     cluster_sigma: f64,
     cluster_gate: f64,
     /// Weight ε and scale k of the wide component of the cluster likelihood (ε = 0: none).
     cluster_outliers: (f64, f64),
+    /// A user's models for walls and clusters ([`slot`]).
+    own: [Option<Arc<dyn MeasurementModel>>; 2],
+}
+
+impl std::fmt::Debug for MixedMeasurement {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("MixedMeasurement")
+            .field("plane", &self.plane)
+            .field("cluster_sigma", &self.cluster_sigma)
+            .field("cluster_gate", &self.cluster_gate)
+            .field("cluster_outliers", &self.cluster_outliers)
+            .field(
+                "own",
+                &self.own.each_ref().map(|m| m.as_ref().map(|m| m.name())),
+            )
+            .finish()
+    }
 }
 
 impl MixedMeasurement {
@@ -325,7 +442,19 @@ impl MixedMeasurement {
             cluster_sigma,
             cluster_gate,
             cluster_outliers: (0.0, 1.0),
+            own: [None, None],
         })
+    }
+
+    /// The same with a user's model for walls (`planes`) and for clusters (`clusters`) where
+    /// given, each asked only about measurements of its kind.
+    pub fn with_own(
+        mut self,
+        planes: Option<Arc<dyn MeasurementModel>>,
+        clusters: Option<Arc<dyn MeasurementModel>>,
+    ) -> Self {
+        self.own = [planes, clusters];
+        self
     }
 
     /// Scores cluster centres by a contaminated Gaussian instead: (1 − `weight`) of the
@@ -483,6 +612,10 @@ impl MeasurementModel for MixedMeasurement {
             out[..n].fill(f64::NEG_INFINITY);
             return;
         }
+        if let Some(m) = kind.and_then(|k| self.own[slot(k)].as_ref()) {
+            m.log_likelihood(z, particles, ctx, out);
+            return;
+        }
         if kind == Some(ObjectKind::Plane) {
             self.plane.log_likelihood(&z[..4], particles, ctx, out);
             return;
@@ -543,7 +676,8 @@ impl MeasurementModel for MixedMeasurement {
     ) -> std::result::Result<(), LikelihoodFault> {
         let n = particles.len();
         let kind = kind_of_set(particles);
-        if kind != Some(ObjectKind::Cluster) || self.cluster_outliers.0 == 0.0 {
+        let own = kind.is_some_and(|k| self.own[slot(k)].is_some());
+        if own || kind != Some(ObjectKind::Cluster) || self.cluster_outliers.0 == 0.0 {
             self.log_likelihood_batch(zs, particles, ctx, out);
             return relative_from_logs(out, tops);
         }
@@ -593,6 +727,9 @@ impl MeasurementModel for MixedMeasurement {
         if track_kind.is_none() || track_kind != z_kind {
             return false;
         }
+        if let Some(m) = track_kind.and_then(|k| self.own[slot(k)].as_ref()) {
+            return m.gate(z, track, ctx);
+        }
         if track_kind == Some(ObjectKind::Plane) {
             let summary = TrackSummary {
                 mean: track.mean[..4].to_vec(),
@@ -609,11 +746,23 @@ impl MeasurementModel for MixedMeasurement {
     }
 }
 
-/// A constant detection probability per kind.
-#[derive(Copy, Clone, Debug, PartialEq)]
+/// A constant detection probability per kind, or a user's model for a kind
+/// ([`MixedDetection::with_own`]).
+#[derive(Clone)]
 pub struct MixedDetection {
     plane: f64,
     cluster: f64,
+    own: [Option<Arc<dyn DetectionModel>>; 2],
+}
+
+impl std::fmt::Debug for MixedDetection {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("MixedDetection")
+            .field("plane", &self.plane)
+            .field("cluster", &self.cluster)
+            .field("own", &self.own.each_ref().map(|m| m.is_some()))
+            .finish()
+    }
 }
 
 impl MixedDetection {
@@ -621,12 +770,30 @@ impl MixedDetection {
     pub fn new(plane: f64, cluster: f64) -> Result<Self> {
         ensure_probability("plane detection probability", plane)?;
         ensure_probability("cluster detection probability", cluster)?;
-        Ok(MixedDetection { plane, cluster })
+        Ok(MixedDetection {
+            plane,
+            cluster,
+            own: [None, None],
+        })
+    }
+
+    /// The same with a user's model for walls and for clusters where given.
+    pub fn with_own(
+        mut self,
+        planes: Option<Arc<dyn DetectionModel>>,
+        clusters: Option<Arc<dyn DetectionModel>>,
+    ) -> Self {
+        self.own = [planes, clusters];
+        self
     }
 }
 
 impl DetectionModel for MixedDetection {
-    fn detection_probability(&self, particles: &ParticleSet, _: &StepContext, out: &mut [f64]) {
+    fn detection_probability(&self, particles: &ParticleSet, ctx: &StepContext, out: &mut [f64]) {
+        if let Some(m) = kind_of_set(particles).and_then(|k| self.own[slot(k)].as_ref()) {
+            m.detection_probability(particles, ctx, out);
+            return;
+        }
         let p = match kind_of_set(particles) {
             Some(ObjectKind::Plane) => self.plane,
             Some(ObjectKind::Cluster) => self.cluster,
@@ -636,11 +803,23 @@ impl DetectionModel for MixedDetection {
     }
 }
 
-/// A uniform clutter intensity per kind: κ = rate / volume.
-#[derive(Copy, Clone, Debug, PartialEq)]
+/// A uniform clutter intensity per kind: κ = rate / volume; or a user's model for a kind
+/// ([`MixedClutter::with_own`]).
+#[derive(Clone)]
 pub struct MixedClutter {
     log_plane: f64,
     log_cluster: f64,
+    own: [Option<Arc<dyn ClutterModel>>; 2],
+}
+
+impl std::fmt::Debug for MixedClutter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("MixedClutter")
+            .field("log_plane", &self.log_plane)
+            .field("log_cluster", &self.log_cluster)
+            .field("own", &self.own.each_ref().map(|m| m.is_some()))
+            .finish()
+    }
 }
 
 impl MixedClutter {
@@ -663,12 +842,29 @@ impl MixedClutter {
         Ok(MixedClutter {
             log_plane: (plane_rate / plane_volume).ln(),
             log_cluster: (cluster_rate / cluster_volume).ln(),
+            own: [None, None],
         })
     }
 }
 
+impl MixedClutter {
+    /// The same with a user's model for false walls and for false clusters where given.
+    pub fn with_own(
+        mut self,
+        planes: Option<Arc<dyn ClutterModel>>,
+        clusters: Option<Arc<dyn ClutterModel>>,
+    ) -> Self {
+        self.own = [planes, clusters];
+        self
+    }
+}
+
 impl ClutterModel for MixedClutter {
-    fn log_intensity(&self, z: &[f64], _: &StepContext) -> f64 {
+    fn log_intensity(&self, z: &[f64], ctx: &StepContext) -> f64 {
+        let kind = kind_of_measurement(z).unwrap_or(ObjectKind::Plane);
+        if let Some(m) = &self.own[slot(kind)] {
+            return m.log_intensity(z, ctx);
+        }
         match kind_of_measurement(z) {
             Some(ObjectKind::Cluster) => self.log_cluster,
             _ => self.log_plane,
@@ -846,6 +1042,58 @@ mod tests {
         assert!(!m.gate(&plane_z, &summary(&clusters), &c));
         assert!(m.gate(&plane_z, &summary(&planes), &c));
         assert!(m.gate(&cluster_z, &summary(&clusters), &c));
+    }
+
+    /// A user's cluster measurement model: a constant log-likelihood of −1 that refuses every
+    /// gate. It scores cluster sets only; walls keep the built-in model.
+    #[derive(Debug)]
+    struct Flat;
+
+    impl MeasurementModel for Flat {
+        fn measurement_dim(&self) -> usize {
+            MEASUREMENT_DIM
+        }
+        fn log_likelihood(&self, _: &[f64], p: &ParticleSet, _: &StepContext, out: &mut [f64]) {
+            out[..p.len()].fill(-1.0);
+        }
+        fn gate(&self, _: &[f64], _: &TrackSummary, _: &StepContext) -> bool {
+            false
+        }
+    }
+
+    #[test]
+    fn a_users_model_scores_its_own_kind_only() {
+        let c = ctx(Isometry3::identity());
+        let built_in =
+            MixedMeasurement::new(PlaneMeasurement::new(0.05, 0.2).unwrap(), 0.3, 4.0).unwrap();
+        let m = built_in.clone().with_own(None, Some(Arc::new(Flat)));
+        let plane_z = plane_measurement([-1.0, 0.0, 0.0, 10.0]);
+        let cluster_z = cluster_measurement([5.0, 1.0, 0.0]);
+        let planes = sampler().sample(&plane_z, &c, 3, &mut seeded(1));
+        let clusters = sampler().sample(&cluster_z, &c, 3, &mut seeded(1));
+        let (mut out, mut want) = ([0.0; 3], [0.0; 3]);
+        m.log_likelihood(&cluster_z, &clusters, &c, &mut out);
+        assert_eq!(out, [-1.0; 3]);
+        m.log_likelihood(&plane_z, &clusters, &c, &mut out);
+        assert_eq!(out, [f64::NEG_INFINITY; 3]);
+        m.log_likelihood(&plane_z, &planes, &c, &mut out);
+        built_in.log_likelihood(&plane_z, &planes, &c, &mut want);
+        assert_eq!(out, want);
+        let summary = |s: &ParticleSet| TrackSummary {
+            mean: s.mean(),
+            std: s.std_dev(),
+        };
+        assert!(!m.gate(&cluster_z, &summary(&clusters), &c));
+        assert!(m.gate(&plane_z, &summary(&planes), &c));
+        // the relative likelihoods of a cluster set: every particle as likely as the best
+        let zs: Vec<&[f64]> = vec![&cluster_z, &plane_z];
+        let (mut rows, mut tops) = (vec![vec![0.0; 3]; 2], [0.0; 2]);
+        m.relative_likelihood_batch(&zs, &clusters, &c, &mut rows, &mut tops)
+            .unwrap();
+        assert_eq!((rows[0].clone(), tops[0]), (vec![1.0; 3], -1.0));
+        assert_eq!(tops[1], f64::NEG_INFINITY);
+        let own = OwnModels::default().measurement(Flat);
+        assert!(own.check("cluster").is_ok());
     }
 
     #[test]

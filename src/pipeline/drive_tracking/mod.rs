@@ -33,6 +33,7 @@ use detect::{segment_here, Segmented};
 pub use export::point_labels;
 #[cfg(feature = "plot")]
 pub use export::{drive_plot, frame_plot};
+pub use mixed::OwnModels;
 pub use output::{
     DriveTracks, StageTimes, TrackedCluster, TrackedFrame, TrackedPlane, TrackingSummary,
 };
@@ -174,6 +175,10 @@ pub struct PlaneTuning {
     pub birth_angle: f64,
     /// Offset spread of a new wall (m). Default 0.15.
     pub birth_offset: f64,
+    /// A user's own wall measurement, detection or clutter model, used instead of the one the
+    /// fields above tune (code only; see [`OwnModels`]). Default none.
+    #[serde(skip)]
+    pub own_models: OwnModels,
 }
 
 impl Default for PlaneTuning {
@@ -189,6 +194,7 @@ impl Default for PlaneTuning {
             clutter_volume: std::f64::consts::FRAC_PI_2 * 50.0,
             birth_angle: 2f64.to_radians(),
             birth_offset: 0.15,
+            own_models: OwnModels::default(),
         }
     }
 }
@@ -242,6 +248,10 @@ pub struct ClusterTuning {
     /// manoeuvre fringe.
     #[serde(skip_serializing_if = "RoadUserMotion::is_default")]
     pub motion: RoadUserMotion,
+    /// A user's own cluster measurement, detection or clutter model, used instead of the one
+    /// the fields above tune (code only; see [`OwnModels`]). Default none.
+    #[serde(skip)]
+    pub own_models: OwnModels,
 }
 
 /// How the drive tracker's road users (clusters) move. A cluster's state is
@@ -307,6 +317,7 @@ impl Default for ClusterTuning {
             birth_vertical: 0.3,
             clutter_particles: Some(400),
             motion: RoadUserMotion::ConstantVelocity,
+            own_models: OwnModels::default(),
         }
     }
 }

@@ -163,6 +163,9 @@ impl DriveTracker {
             transition = transition.with_road_users(m.0.clone())?;
         }
         let plane_meas = PlaneMeasurement::new(p.sigma_angle, p.sigma_offset)?.with_gate(p.gate)?;
+        p.own_models.check("wall")?;
+        c.own_models.check("cluster")?;
+        let (po, co) = (&p.own_models, &c.own_models);
         let sampler = MixedBirthSampler {
             plane_sigma_angle: p.birth_angle,
             plane_sigma_offset: p.birth_offset,
@@ -187,15 +190,22 @@ impl DriveTracker {
             .transition(transition)
             .measurement(
                 MixedMeasurement::new(plane_meas, c.sigma, c.gate)?
-                    .with_cluster_outliers(c.outlier_weight, c.outlier_scale)?,
+                    .with_cluster_outliers(c.outlier_weight, c.outlier_scale)?
+                    .with_own(po.measurement.clone(), co.measurement.clone()),
             )
-            .detection(MixedDetection::new(p.detection, c.detection)?)
-            .clutter(MixedClutter::new(
-                p.clutter_rate,
-                p.clutter_volume,
-                c.clutter_rate,
-                c.clutter_volume,
-            )?)
+            .detection(
+                MixedDetection::new(p.detection, c.detection)?
+                    .with_own(po.detection.clone(), co.detection.clone()),
+            )
+            .clutter(
+                MixedClutter::new(
+                    p.clutter_rate,
+                    p.clutter_volume,
+                    c.clutter_rate,
+                    c.clutter_volume,
+                )?
+                .with_own(po.clutter.clone(), co.clutter.clone()),
+            )
             .survival(crate::filter::ConstantSurvival(config.birth.survival))
             .birth(birth)
             .merge_distance(MixedMergeDistance)
