@@ -5,25 +5,6 @@ mod common;
 use common::{ok, output as run};
 use std::path::PathBuf;
 
-/// `../shared/data/REL` when present. Under `CI=true` a missing folder fails the test;
-/// elsewhere the test is skipped with a note on the terminal.
-fn shared_data(rel: &str) -> Option<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/data")
-        .join(rel);
-    if dir.exists() {
-        return Some(dir);
-    }
-    if std::env::var("CI").is_ok_and(|v| v == "true") {
-        panic!(
-            "CI=true but the shared data folder {} is missing",
-            dir.display()
-        );
-    }
-    eprintln!("SKIPPED: {} is missing", dir.display());
-    None
-}
-
 #[test]
 fn paper_tables_on_a_simulated_drive() {
     let dir = tempfile::tempdir().unwrap();
@@ -76,7 +57,7 @@ fn paper_tables_on_a_simulated_drive() {
 
 #[test]
 fn paper_tables_on_the_papers_drive_find_its_three_walls() {
-    let Some(drive) = shared_data("kitti_raw/2011_09_26/2011_09_26_drive_0005_sync") else {
+    let Some(drive) = common::shared_data("kitti_raw/2011_09_26/2011_09_26_drive_0005_sync") else {
         return;
     };
     let text = ok(&run(&[
@@ -234,7 +215,7 @@ fn segmentation_settings_come_from_a_file_and_a_flag() {
 /// keeps their vertical pieces (vegetation) and pairs them from scan to scan.
 #[test]
 fn any_vertical_keeps_what_the_facade_test_rejects() {
-    let Some(drive) = shared_data("kitti_raw/2011_09_26/2011_09_26_drive_UNKNOWN_sync") else {
+    let Some(drive) = common::shared_data("kitti_raw/2011_09_26/2011_09_26_drive_UNKNOWN_sync") else {
         return;
     };
     let d = drive.to_str().unwrap();

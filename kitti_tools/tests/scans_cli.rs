@@ -97,28 +97,9 @@ fn a_scan_folder_tracks_as_the_drive_it_came_from() {
     );
 }
 
-/// `../shared/data/REL` when present. Under `CI=true` a missing folder fails the test;
-/// elsewhere the test is skipped with a note on the terminal.
-fn shared_data(rel: &str) -> Option<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/data")
-        .join(rel);
-    if dir.exists() {
-        return Some(dir);
-    }
-    if std::env::var("CI").is_ok_and(|v| v == "true") {
-        panic!(
-            "CI=true but the shared data folder {} is missing",
-            dir.display()
-        );
-    }
-    eprintln!("SKIPPED: {} is missing", dir.display());
-    None
-}
-
 #[test]
 fn a_scan_folder_predicts_planes_as_the_drive_it_came_from() {
-    let Some(real) = shared_data("kitti_raw/2011_09_26/2011_09_26_drive_0005_sync") else {
+    let Some(real) = common::shared_data("kitti_raw/2011_09_26/2011_09_26_drive_0005_sync") else {
         return;
     };
     // frames 10–12 of drive 0005 (facades on both sides) as a drive without OXTS and as a
