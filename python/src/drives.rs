@@ -40,10 +40,46 @@ fn summary<'py>(py: Python<'py>, t: &DriveTracks) -> PyResult<Bound<'py, PyDict>
     Ok(d)
 }
 
+/// The recording `layout` names at `path`: `"raw"` (a raw drive folder), `"tracking"` (a
+/// tracking split folder, with `sequence`), `"odometry"` (an odometry root, with `sequence`)
+/// or `"scans"` (a folder of `.bin` or `.pcd` scans, with its `poses.txt` and `times.txt`
+/// when they are in it).
+pub fn recording_source(
+    layout: &str,
+    path: PathBuf,
+    sequence: Option<u32>,
+) -> PyResult<RecordingSource> {
+    let need_sequence = || {
+        sequence.ok_or_else(|| {
+            PyValueError::new_err(format!("layout \"{layout}\" needs a sequence number"))
+        })
+    };
+    Ok(match layout {
+        "raw" => RecordingSource::Raw(path),
+        "tracking" => RecordingSource::Tracking(path, need_sequence()?),
+        "odometry" => RecordingSource::Odometry(path, need_sequence()?),
+        "scans" => {
+            let beside = |name: &str| Some(path.join(name)).filter(|p| p.is_file());
+            RecordingSource::Scans {
+                poses: beside("poses.txt"),
+                times: beside("times.txt"),
+                dir: path,
+            }
+        }
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "layout \"{other}\": expected \"raw\", \"tracking\", \"odometry\" or \"scans\""
+            )))
+        }
+    })
+}
+
 /// Tracks walls and clusters over a whole recording with one LMB filter and returns the run's
-/// summary (see `tracks_summary`). `layout` is `"raw"` (`path` a raw drive folder),
-/// `"tracking"` (`path` a tracking split folder, with `sequence`) or `"odometry"` (`path` an
-/// odometry root, with `sequence`). `config` is the tracking configuration (`TrackingConfig`:
+/// summary (see `tracks_summary`). `layout` and `path` name the recording as
+/// `predict_plane_pairs` takes them: `"raw"` (`path` a raw drive folder), `"tracking"` (`path`
+/// a tracking split folder, with `sequence`), `"odometry"` (`path` an odometry root, with
+/// `sequence`) or `"scans"` (`path` a folder of scans, its `poses.txt` and `times.txt` used
+/// when present). `config` is the tracking configuration (`TrackingConfig`:
 /// a dict or TOML text; default: the library's); `particles` overrides its particles per
 /// track. With `out`, the per-frame tracks are written there as JSON (atomically), as
 /// `kitti-tools track --out` writes them. The GIL is released while it runs.
@@ -103,21 +139,7 @@ fn track<'py>(
         }
     };
     lib(cfg.validate())?;
-    let need_sequence = || {
-        sequence.ok_or_else(|| {
-            PyValueError::new_err(format!("layout \"{layout}\" needs a sequence number"))
-        })
-    };
-    let source = match layout {
-        "raw" => RecordingSource::Raw(path),
-        "tracking" => RecordingSource::Tracking(path, need_sequence()?),
-        "odometry" => RecordingSource::Odometry(path, need_sequence()?),
-        other => {
-            return Err(PyValueError::new_err(format!(
-                "layout \"{other}\": expected \"raw\", \"tracking\" or \"odometry\""
-            )))
-        }
-    };
+    let source = recording_source(layout, path, sequence)?;
     let tracks = py.detach(|| source.track(None, &cfg, seed, |_| Ok(())));
     let user_error = road_users
         .as_ref()

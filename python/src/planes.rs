@@ -20,11 +20,10 @@ use pyo3::types::{PyDict, PyList};
 use smc_lmb::cloud::planes::{self, PlaneConfig, PlaneDetection, WallQuality};
 use smc_lmb::cloud::PointCloud;
 use smc_lmb::geometry::PlanePatch;
-use smc_lmb::kitti::{OdometrySequence, RawDrive, TrackingSequence};
-use smc_lmb::recording::{Recording, ScanDirectory};
 use smc_lmb::metrics::{PlanePairError, PlanePredictionSummary};
 use smc_lmb::models::{vehicle_model_by_name, ExtendedConstantTurn, SharedVehicleModel};
 use smc_lmb::pipeline::plane_prediction::{self as pp, PairPrediction, PlanePredictionConfig};
+use smc_lmb::recording::Recording;
 use smc_lmb::rng::seeded;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -324,8 +323,8 @@ fn predict_planes_between<'py>(
 
 /// Plane prediction over consecutive frame pairs of a recording: `layout` is `"raw"` (`path` =
 /// the drive folder), `"tracking"` or `"odometry"` (`path` = the benchmark root, with
-/// `sequence`) or `"scans"` (`path` = a folder of `.bin` or `.pcd` scans with a `poses.txt`
-/// beside them). `frames = (start, end)` limits the pairs (k from start to end − 1). The
+/// `sequence`) or `"scans"` (`path` = a folder of `.bin` or `.pcd` scans with its `poses.txt`
+/// in it). `frames = (start, end)` limits the pairs (k from start to end − 1). The
 /// vehicle model (Algorithm 1) needs the vehicle's measured motion (OXTS: raw drives and
 /// tracking sequences); other recordings are predicted with their poses.
 /// Returns `{"frames": [per pair as predict_planes_between], "summary": {medians and 90th
@@ -346,11 +345,6 @@ fn predict_plane_pairs<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let (config, user) = prediction_config(py, options)?;
     let range = frames.map(|(a, b)| a..b);
-    let need_seq = || {
-        sequence.ok_or_else(|| {
-            PyValueError::new_err(format!("layout `{layout}` needs a sequence number"))
-        })
-    };
     let mut rng = seeded(seed);
     // A Python vehicle model's exception replaces the library's error about its draw.
     let lib = |r: smc_lmb::Result<Vec<pp::PairPrediction>>| match (
@@ -361,31 +355,13 @@ fn predict_plane_pairs<'py>(
         (_, Some(e)) => Err(e),
         (Err(e), None) => lib(Err(e)),
     };
-    let recording: Box<dyn Recording> = match layout {
-        "raw" => Box::new(crate::convert::lib(RawDrive::open(&path))?),
-        "tracking" => Box::new(crate::convert::lib(TrackingSequence::open(&path, need_seq()?))?),
-        "odometry" => Box::new(crate::convert::lib(OdometrySequence::open(&path, need_seq()?))?),
-        "scans" => {
-            let mut scans = crate::convert::lib(ScanDirectory::open(&path))?;
-            let poses = path.join("poses.txt");
-            if poses.is_file() {
-                scans = crate::convert::lib(scans.with_poses(poses))?;
-            }
-            Box::new(scans)
-        }
-        other => {
-            return Err(PyValueError::new_err(format!(
-                "layout `{other}`: expected \"raw\", \"tracking\", \"odometry\" or \"scans\""
-            )))
-        }
-    };
+    let source = crate::drives::recording_source(layout, path, sequence)?;
+    let recording: Box<dyn Recording> = crate::convert::lib(source.open())?;
     // Algorithm 1 needs the vehicle's measured motion (OXTS); other recordings are predicted
     // with their poses.
     let mut config = config;
     config.use_vehicle_model &= recording.has_vehicle();
-    let preds = lib(py.detach(|| {
-        pp::predict_pairs(&*recording, range, &config, runs, &mut rng)
-    }))?;
+    let preds = lib(py.detach(|| pp::predict_pairs(&*recording, range, &config, runs, &mut rng)))?;
     let d = PyDict::new(py);
     d.set_item("summary", summary_dict(py, &preds)?)?;
     let list = PyList::empty(py);

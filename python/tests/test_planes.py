@@ -115,6 +115,13 @@ def test_plane_prediction_over_a_folder_of_scans(tmp_path):
     r = smc_lmb.predict_plane_pairs("scans", scans, runs=2, seed=1)
     assert [f["frame"] for f in r["frames"]] == [1, 2]
     assert r["summary"]["pairs"] > 0
+    # the same folder tracked, with its poses and its times
+    (scans / "times.txt").write_text("0.0\n0.1\n0.2\n")
+    t = smc_lmb.track(scans, layout="scans", config={"filter": {"particles": 150}})
+    assert (t["name"], t["frames"], t["ego"]) == ("scans", 3, "poses")
+    assert t["walls_per_frame"] > 0
+    with pytest.raises(ValueError, match="scans"):
+        smc_lmb.track(scans, layout="folder")
 
 
 DRIVE = "kitti_raw/2011_09_26/2011_09_26_drive_0005_sync"
