@@ -13,6 +13,7 @@ use smc_lmb::kitti::RawDrive;
 use smc_lmb::pipeline::drive_tracking::{
     detect_objects, segment_rng, track_recording, DriveTracker, TrackingConfig,
 };
+use smc_lmb::recording::Recording;
 use std::path::Path;
 use std::time::Duration;
 
@@ -42,7 +43,7 @@ fn recording(c: &mut Criterion) {
             let mut tracker = DriveTracker::new(&config, SEED).unwrap();
             (0..FRAMES)
                 .map(|k| {
-                    let cloud = drive.velodyne(k).unwrap();
+                    let cloud = drive.scan(k).unwrap();
                     let det = detect_objects(&cloud, &config, &mut segment_rng(SEED, k)).unwrap();
                     tracker.step(k, times[k], poses[k], None, &det).unwrap()
                 })

@@ -13,6 +13,7 @@ use smc_lmb::pipeline::drive_tracking::{
     detect_objects, drive_plot, point_labels, segment_rng, track_recording, ClusterMethod,
     DriveTracker, DriveTracks, TrackingConfig,
 };
+use smc_lmb::recording::Recording;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
@@ -279,7 +280,7 @@ fn overlapped_frames_track_as_a_plain_loop_does() {
     let mut tracker = DriveTracker::new(&c, seed).unwrap();
     assert_eq!(run.frames.len(), FRAMES);
     for (k, got) in run.frames.iter().enumerate() {
-        let cloud = drive.velodyne(k).unwrap();
+        let cloud = drive.scan(k).unwrap();
         let det = detect_objects(&cloud, &c, &mut segment_rng(seed, k)).unwrap();
         let mut want = tracker.step(k, times[k], poses[k], None, &det).unwrap();
         let mut got = got.clone();
@@ -321,7 +322,7 @@ fn dropped_scans_are_left_out_and_predicted_over() {
         (drive.frame_count(), drive.velodyne_count()),
         (FRAMES, FRAMES - 2)
     );
-    assert_eq!(drive.dropped_scans(), vec![(4, 5)]);
+    assert_eq!(drive.scans().dropped(), vec![(4, 5)]);
     assert_eq!(
         drive.check(),
         vec![smc_lmb::kitti::Issue::DroppedScans {
@@ -349,7 +350,7 @@ fn dropped_scans_are_left_out_and_predicted_over() {
     let poses = drive.poses().unwrap();
     let mut tracker = DriveTracker::new(&c, seed).unwrap();
     for (got, &k) in run.frames.iter().zip(&kept) {
-        let cloud = drive.velodyne(k).unwrap();
+        let cloud = drive.scan(k).unwrap();
         let det = detect_objects(&cloud, &c, &mut segment_rng(seed, k)).unwrap();
         let mut want = tracker.step(k, times[k], poses[k], None, &det).unwrap();
         let mut got = got.clone();
@@ -411,7 +412,7 @@ fn bad_drives_give_clear_errors() {
         "{err}"
     );
     // Truncate frame 2 to a size that is not a whole number of points.
-    let bin = drive.velodyne_path(2);
+    let bin = drive.scans().path(2);
     let bytes = std::fs::read(&bin).unwrap();
     std::fs::write(&bin, &bytes[..bytes.len() - 5]).unwrap();
     let mut c = config();

@@ -14,6 +14,7 @@ use smc_lmb::kitti::{
     read_oxts_dir, read_timestamps, read_tracklets, write_oxts_dir, Issue, OdometrySequence,
     OxtsPacket, RawDrive,
 };
+use smc_lmb::recording::Recording;
 use std::path::{Path, PathBuf};
 
 fn vendored() -> PathBuf {
@@ -93,8 +94,8 @@ fn vendored_oxts_drive_gives_poses_starting_at_identity() {
 fn vendored_scan_is_a_point_cloud_without_poses() {
     let drive = RawDrive::open(vendored_day().join("2011_09_26_drive_UNKNOWN_sync")).unwrap();
     assert_eq!(drive.frame_count(), 1);
-    let size = std::fs::metadata(drive.velodyne_path(0)).unwrap().len();
-    let cloud = drive.velodyne(0).unwrap();
+    let size = std::fs::metadata(drive.scans().path(0)).unwrap().len();
+    let cloud = drive.scan(0).unwrap();
     assert_eq!(cloud.len() as u64, size / 16);
     assert_eq!(cloud.len(), 14_714);
     assert!(cloud.first_non_finite().is_none());
@@ -228,7 +229,7 @@ fn synthetic_drive_written_with_the_writers_reads_back() {
     // Pure forward motion of the rig moves the Velodyne forward by the same 10 m (up to the
     // tiny calibration rotation).
     assert!((velo[2].translation.vector.norm() - 10.0).abs() < 1e-6);
-    assert_eq!(drive.velodyne(1).unwrap(), cloud);
+    assert_eq!(drive.scan(1).unwrap(), cloud);
 }
 
 // ---------------------------------------------------------------- full shared data (if present)
@@ -340,8 +341,8 @@ fn full_unknown_drive_frames_have_the_expected_points() {
     assert_eq!(drive.frame_count(), 4);
     assert_eq!(drive.timestamps().unwrap().len(), 4);
     for k in 0..4 {
-        let size = std::fs::metadata(drive.velodyne_path(k)).unwrap().len();
-        let cloud = drive.velodyne(k).unwrap();
+        let size = std::fs::metadata(drive.scans().path(k)).unwrap().len();
+        let cloud = drive.scan(k).unwrap();
         assert_eq!(cloud.len() as u64, size / 16);
         assert!((117_000..118_500).contains(&cloud.len()));
         assert!(cloud.first_non_finite().is_none());
@@ -360,7 +361,7 @@ fn full_unknown_drive_frames_have_the_expected_points() {
         assert!((far as f64) < 0.01 * cloud.len() as f64);
     }
     // The vendored excerpt is every 8th point of frame 0, bytes unchanged.
-    let full = drive.velodyne(0).unwrap();
+    let full = drive.scan(0).unwrap();
     let excerpt = read_kitti_bin(
         vendored_day().join("2011_09_26_drive_UNKNOWN_sync/velodyne_points/data/0000000000.bin"),
     )
@@ -388,7 +389,7 @@ fn odometry_fixture_gives_hand_computed_velodyne_poses() {
     assert!((v[1].translation.vector - Vector3::new(1.5, -0.2, 0.0)).norm() < 1e-12);
     assert!(v[1].rotation.angle() < 1e-12);
     // The static points of scan 1 map onto those of scan 0.
-    let (s0, s1) = (seq.velodyne(0).unwrap(), seq.velodyne(1).unwrap());
+    let (s0, s1) = (seq.scan(0).unwrap(), seq.scan(1).unwrap());
     let moved = s1.transformed(&v[1]);
     for (a, b) in moved.iter().zip(s0.iter()) {
         assert!((a.x - b.x).abs() < 1e-5 && (a.y - b.y).abs() < 1e-5 && (a.z - b.z).abs() < 1e-5);
@@ -515,7 +516,7 @@ fn broken_inputs_are_errors_naming_the_file() {
     let msg = drive.poses().unwrap_err().to_string();
     println!("missing oxts: {msg}");
     assert!(msg.contains("oxts/data") && msg.contains("folder missing"));
-    assert!(drive.velodyne(1).is_ok());
+    assert!(drive.scan(1).is_ok());
 
     // Velodyne and OXTS counts that disagree.
     let uneven = make_drive(&root.join("b"), 3, 2);

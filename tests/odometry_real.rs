@@ -22,7 +22,7 @@ fn follows_oxts(frames: usize) {
     };
     let drive = RawDrive::open(&dir).expect("drive 0005");
     let reference = drive.poses().expect("OXTS Velodyne poses");
-    let scans: Vec<_> = (0..frames).map(|k| drive.velodyne_path(k)).collect();
+    let scans: Vec<_> = (0..frames).map(|k| drive.scans().path(k)).collect();
     let start = std::time::Instant::now();
     let estimate = odometry_of_files(&scans, &OdometryConfig::default(), |_, _| {}).unwrap();
     let ms = start.elapsed().as_secs_f64() * 1e3 / scans.len() as f64;

@@ -5,6 +5,7 @@
 use smc_lmb::cloud::{read_kitti_bin, write_kitti_bin, write_pcd, PcdEncoding, PointCloud};
 use smc_lmb::kitti::{OdometrySequence, RawDrive, TrackingSequence};
 use smc_lmb::pipeline::drive_tracking::{track_recording, TrackingConfig};
+use smc_lmb::recording::Recording;
 use std::path::{Path, PathBuf};
 
 /// The vendored real frame and a copy of it shifted 0.3 m forward (a second, different scan).
@@ -49,9 +50,9 @@ fn every_layout_reads_pcd_scan_folders() {
 
     let drive = RawDrive::open(raw_drive(tmp.path(), &clouds, true)).unwrap();
     assert_eq!(drive.frame_count(), 2);
-    assert!(drive.velodyne_path(1).ends_with("0000000001.pcd"));
+    assert!(drive.scans().path(1).ends_with("0000000001.pcd"));
     for (k, c) in clouds.iter().enumerate() {
-        assert_eq!(&drive.velodyne(k).unwrap(), c, "raw drive frame {k}");
+        assert_eq!(&drive.scan(k).unwrap(), c, "raw drive frame {k}");
     }
 
     let tracking = tmp.path().join("tracking/training");
@@ -60,7 +61,7 @@ fn every_layout_reads_pcd_scan_folders() {
     });
     let seq = TrackingSequence::open(&tracking, 4).unwrap();
     assert_eq!(seq.frame_count(), 2);
-    assert_eq!(&seq.velodyne(1).unwrap(), &clouds[1]);
+    assert_eq!(&seq.scan(1).unwrap(), &clouds[1]);
 
     let odometry = tmp.path().join("odometry");
     write_scans(
@@ -71,7 +72,7 @@ fn every_layout_reads_pcd_scan_folders() {
     );
     let seq = OdometrySequence::open(&odometry, 7).unwrap();
     assert_eq!(seq.frame_count(), 2);
-    assert_eq!(&seq.velodyne(0).unwrap(), &clouds[0]);
+    assert_eq!(&seq.scan(0).unwrap(), &clouds[0]);
 }
 
 #[test]

@@ -12,6 +12,7 @@ use smc_lmb::cloud::planes::{
     extract_planes, PlaneConfig, PlaneDetection, PlaneSegmentation, RejectReason,
 };
 use smc_lmb::cloud::read_kitti_bin;
+use smc_lmb::recording::Recording;
 use smc_lmb::rng::seeded;
 use std::path::Path;
 use std::time::Instant;
@@ -205,7 +206,7 @@ fn seed_drive_walls_repeat_with_lidar_odometry() {
     };
     let drive = RawDrive::open(&dir).expect("drive");
     let count = drive.velodyne_count();
-    let load = |k: usize| drive.velodyne(k);
+    let load = |k: usize| drive.scan(k);
     let poses = odometry_of_frames(count, &load, &OdometryConfig::default()).unwrap();
     let config = PlanePredictionConfig::default();
     let results = predict_pairs_with_poses(
@@ -318,7 +319,7 @@ fn seed_drive_walls_are_segmented_again() {
     };
     let drive = RawDrive::open(&dir).expect("drive");
     let count = drive.velodyne_count();
-    let clouds: Vec<_> = (0..count).map(|k| drive.velodyne(k).unwrap()).collect();
+    let clouds: Vec<_> = (0..count).map(|k| drive.scan(k).unwrap()).collect();
     let load = |k: usize| Ok(clouds[k].clone());
     let poses = odometry_of_frames(count, &load, &OdometryConfig::default()).unwrap();
     let walls = walls_again(&clouds, &poses, 20.0);

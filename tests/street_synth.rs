@@ -6,6 +6,7 @@ use nalgebra::{Isometry3, Point3, Vector3};
 use smc_lmb::cloud::planes::{extract_planes, PlaneConfig};
 use smc_lmb::cloud::{read_kitti_bin, PointCloud};
 use smc_lmb::kitti::RawDrive;
+use smc_lmb::recording::Recording;
 use smc_lmb::sim::street::{
     generate, write_drive, LegSpec, StreetConfig, StreetSimulator, StreetTruth, Surface,
     WrittenDrive,
@@ -60,7 +61,7 @@ fn small_drive_opens_checks_clean_and_round_trips_the_poses() {
     let stamps = drive.timestamps().unwrap();
     assert!(stamps.intervals().iter().all(|d| (d - 0.1).abs() < 1e-9));
     for k in 0..frames {
-        let cloud = drive.velodyne(k).unwrap(); // errors on any non-finite value
+        let cloud = drive.scan(k).unwrap(); // errors on any non-finite value
         assert!(cloud.len() > 1000, "frame {k}: {} points", cloud.len());
         assert!(cloud.intensities().iter().all(|r| (0.0..=1.0).contains(r)));
     }

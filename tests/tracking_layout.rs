@@ -10,6 +10,7 @@ use nalgebra::Point3;
 use smc_lmb::kitti::labels::label_frame_count;
 use smc_lmb::kitti::tracking::FRAME_PERIOD;
 use smc_lmb::kitti::{Issue, ObjectType, RawDrive, TrackingSequence};
+use smc_lmb::recording::Recording;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
@@ -88,7 +89,7 @@ fn sequence_0000_gives_the_poses_of_raw_drive_0005() {
     // The drive moves ~3.5 m/s: about 17 m in 49 frames.
     let travelled = seq.poses().unwrap()[49].translation.vector.norm();
     assert!((10.0..25.0).contains(&travelled), "{travelled}");
-    let a = seq.velodyne(11).unwrap();
+    let a = seq.scan(11).unwrap();
     assert_eq!(a.len(), 123_334);
 }
 
@@ -125,7 +126,7 @@ fn labels_of_sequence_0000_hold_lidar_points() {
     let rect_from_velo = calib.rect_from_velo();
     let mut checked = BTreeMap::<ObjectType, usize>::new();
     for k in [0, 12, 25, 37, 49] {
-        let cloud = seq.velodyne(k).unwrap();
+        let cloud = seq.scan(k).unwrap();
         let points: Vec<Point3<f64>> = cloud
             .positions()
             .map(|p| Point3::new(p.x as f64, p.y as f64, p.z as f64))

@@ -11,8 +11,10 @@ use smc_lmb::kitti::{OdometrySequence, RawDrive};
 use smc_lmb::metrics::{
     path_length, relative_pose_errors, segment_errors, Spread, KITTI_SEGMENT_LENGTHS,
 };
+use smc_lmb::recording::Recording;
+use smc_lmb::recording::ScanDirectory;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// Flags of `odometry`.
@@ -127,7 +129,7 @@ fn input(args: &Args) -> Result<Input> {
             let frames: Vec<usize> = (0..drive.frame_count())
                 .filter(|&k| drive.has_scan(k))
                 .collect();
-            let scans = frames.iter().map(|&k| drive.velodyne_path(k)).collect();
+            let scans = frames.iter().map(|&k| drive.scans().path(k)).collect();
             let reference = drive.has_oxts().then_some(Reference::Drive(drive));
             Ok(Input {
                 scans,
@@ -146,7 +148,7 @@ fn input(args: &Args) -> Result<Input> {
                 )
             })?;
             let scans: Vec<PathBuf> = (0..seq.frame_count())
-                .map(|k| seq.velodyne_path(k))
+                .map(|k| seq.scans().path(k))
                 .collect();
             let poses = seq.poses_path();
             let reference = poses
@@ -159,7 +161,7 @@ fn input(args: &Args) -> Result<Input> {
             })
         }
         (None, None, Some(dir)) => {
-            let scans = scan_files(dir)?;
+            let scans = ScanDirectory::open(dir)?.scan_paths().to_vec();
             Ok(Input {
                 frames: (0..scans.len()).collect(),
                 scans,
@@ -170,41 +172,6 @@ fn input(args: &Args) -> Result<Input> {
             bail!("give --drive DIR, --odometry ROOT --sequence NN or --scans DIR")
         }
     }
-}
-
-/// The `.bin` or the `.pcd` files of `dir` in file-name order; an error naming the folder when
-/// there is none, or when it holds both kinds.
-fn scan_files(dir: &Path) -> Result<Vec<PathBuf>> {
-    let (mut bin, mut pcd) = (Vec::new(), Vec::new());
-    for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
-        let path = entry
-            .with_context(|| format!("reading {}", dir.display()))?
-            .path();
-        if !path.is_file() {
-            continue;
-        }
-        if path.extension().is_some_and(|e| e == "bin") {
-            bin.push(path);
-        } else if path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("pcd"))
-        {
-            pcd.push(path);
-        }
-    }
-    let mut files = match (bin.is_empty(), pcd.is_empty()) {
-        (true, true) => bail!("{}: no .bin or .pcd scans in this folder", dir.display()),
-        (false, false) => bail!(
-            "{}: holds both .bin ({}) and .pcd ({}) scans; keep one kind",
-            dir.display(),
-            bin.len(),
-            pcd.len()
-        ),
-        (false, true) => bin,
-        (true, false) => pcd,
-    };
-    files.sort();
-    Ok(files)
 }
 
 fn estimate(args: &Args, scans: &[PathBuf], frames: &[usize]) -> Result<Vec<Isometry3<f64>>> {

@@ -215,7 +215,8 @@ fn segmentation_settings_come_from_a_file_and_a_flag() {
 /// keeps their vertical pieces (vegetation) and pairs them from scan to scan.
 #[test]
 fn any_vertical_keeps_what_the_facade_test_rejects() {
-    let Some(drive) = common::shared_data("kitti_raw/2011_09_26/2011_09_26_drive_UNKNOWN_sync") else {
+    let Some(drive) = common::shared_data("kitti_raw/2011_09_26/2011_09_26_drive_UNKNOWN_sync")
+    else {
         return;
     };
     let d = drive.to_str().unwrap();

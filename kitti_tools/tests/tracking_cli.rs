@@ -172,7 +172,7 @@ fn track_reads_the_odometry_layout() {
     let (mut poses, mut times) = (String::new(), String::new());
     for (k, v) in seq.poses().unwrap().iter().enumerate() {
         std::fs::copy(
-            seq.velodyne_path(k),
+            seq.scans().path(k),
             sdir.join(format!("velodyne/{k:06}.bin")),
         )
         .unwrap();

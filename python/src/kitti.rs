@@ -14,6 +14,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use smc_lmb::cloud::{read_kitti_bin as read_bin, PointCloud};
 use smc_lmb::kitti::{self, OdometrySequence, RawDrive, TrackingLabel, TrackingSequence};
+use smc_lmb::recording::Recording;
 use std::path::PathBuf;
 
 /// A cloud as an `N × 4` float32 array (x, y, z, reflectance), columns copied once.
@@ -112,7 +113,7 @@ impl PyRawDrive {
     }
     /// Velodyne scan `k` as an `N × 4` float32 array.
     fn velodyne<'py>(&self, py: Python<'py>, k: usize) -> PyResult<Bound<'py, PyArray2<f32>>> {
-        let cloud = lib(py.detach(|| self.0.velodyne(k)))?;
+        let cloud = lib(py.detach(|| self.0.scan(k)))?;
         Ok(cloud_array(py, cloud))
     }
     /// Velodyne poses (`K × 4 × 4`): pose k maps frame-k Velodyne coordinates to frame 0.
@@ -163,7 +164,7 @@ impl PyOdometrySequence {
     }
     /// Velodyne scan `k` as an `N × 4` float32 array.
     fn velodyne<'py>(&self, py: Python<'py>, k: usize) -> PyResult<Bound<'py, PyArray2<f32>>> {
-        let cloud = lib(py.detach(|| self.0.velodyne(k)))?;
+        let cloud = lib(py.detach(|| self.0.scan(k)))?;
         Ok(cloud_array(py, cloud))
     }
     /// Ground-truth Velodyne poses (`K × 4 × 4`, frame k → frame 0; sequences 00–10).
@@ -207,7 +208,7 @@ impl PyTrackingSequence {
     }
     /// Velodyne scan `k` as an `N × 4` float32 array.
     fn velodyne<'py>(&self, py: Python<'py>, k: usize) -> PyResult<Bound<'py, PyArray2<f32>>> {
-        let cloud = lib(py.detach(|| self.0.velodyne(k)))?;
+        let cloud = lib(py.detach(|| self.0.scan(k)))?;
         Ok(cloud_array(py, cloud))
     }
     /// Velodyne poses from OXTS (`K × 4 × 4`, frame k → frame 0).

@@ -15,7 +15,7 @@
 //! and asking it for poses is an error naming the missing folder. [`RawDrive::check`] reports
 //! every inconsistency at once. A scan missing inside the numbering is a dropped scan (drive
 //! 0009 lacks 177–180; their OXTS packets are there and their stamp lines blank): the drive's
-//! frames are those the scans span, and [`RawDrive::has_scan`] tells which have one.
+//! frames are those the scans span, and [`RawDrive::scans`] tells which have one.
 //!
 //! Not for: camera images, the odometry benchmark layout (see [`super::odometry`]) or the
 //! tracking benchmark layout (see [`super::tracking`]).
@@ -28,7 +28,6 @@ use super::issue::Issue;
 use super::oxts::{read_oxts_file, OxtsPacket};
 use super::poses::{self, VehicleState};
 use super::timestamps::{read_timestamps, Timestamps};
-use crate::cloud::{BinScan, NonFinite, PointCloud};
 use crate::error::{Error, Result};
 use nalgebra::Isometry3;
 use std::path::{Path, PathBuf};
@@ -91,7 +90,11 @@ impl RawDrive {
             Some(_) => PathBuf::from("."),
             None => dir.clone(),
         };
-        let velodyne = ScanFolder::open(dir.join("velodyne_points").join("data"), 10)?;
+        let velodyne = ScanFolder::open(
+            dir.join("velodyne_points").join("data"),
+            10,
+            "this drive has no Velodyne point clouds",
+        )?;
         let oxts = list_if_present(&dir.join("oxts").join("data"), "txt")?;
         Ok(RawDrive {
             dir,
@@ -162,43 +165,17 @@ impl RawDrive {
 
     /// Number of frames: the frames the Velodyne scans span when `velodyne_points/data` exists
     /// (the last scan's number + 1, dropped scans inside the numbering included; see
-    /// [`has_scan`](Self::has_scan)), otherwise the OXTS packets.
+    /// [`ScanFolder::has_scan`]), otherwise the OXTS packets.
     pub fn frame_count(&self) -> usize {
-        if self.has_velodyne() {
-            self.velodyne.extent()
-        } else {
-            self.oxts_count()
-        }
+        self.velodyne.extent_or(|| self.oxts_count())
     }
 
-    /// Whether frame `k` has a Velodyne scan. KITTI drops a scan now and then (drive 0009 has
-    /// none for frames 177–180) and keeps the other files' numbers, its OXTS packet and a
-    /// blank line in `velodyne_points/timestamps.txt`.
-    pub fn has_scan(&self, k: usize) -> bool {
-        self.velodyne.has_scan(k)
-    }
-
-    /// The frames below [`frame_count`](Self::frame_count) without a scan, as inclusive ranges.
-    pub fn dropped_scans(&self) -> Vec<(u64, u64)> {
-        self.velodyne.dropped()
-    }
-
-    /// Path of Velodyne frame `k`: the listed `.bin` or `.pcd` file, else (whether or not it
-    /// exists) the `.bin` name.
-    pub fn velodyne_path(&self, k: usize) -> PathBuf {
-        self.velodyne.path(k)
-    }
-
-    /// Reads Velodyne frame `k`; a non-finite value is an error naming the file and point.
-    pub fn velodyne(&self, k: usize) -> Result<PointCloud> {
-        self.velodyne_with(k, NonFinite::Error).map(|s| s.cloud)
-    }
-
-    /// Reads Velodyne frame `k` with a choice for non-finite points.
-    pub fn velodyne_with(&self, k: usize, policy: NonFinite) -> Result<BinScan> {
-        self.velodyne.read(k, policy, |dir| {
-            missing_folder(dir, "this drive has no Velodyne point clouds")
-        })
+    /// The Velodyne scans (`velodyne_points/data`): which frames have one
+    /// ([`ScanFolder::has_scan`]; KITTI drops a scan now and then, drive 0009 has none for
+    /// frames 177–180, and keeps the other files' numbers, its OXTS packet and a blank line in
+    /// `velodyne_points/timestamps.txt`), their paths, reading them.
+    pub fn scans(&self) -> &ScanFolder {
+        &self.velodyne
     }
 
     /// Reads every OXTS packet, in frame order.
@@ -236,7 +213,7 @@ impl RawDrive {
                 format!("has {} stamps for {n} Velodyne frames", t.len()),
             ));
         }
-        if let Some(&k) = t.blank.iter().find(|&&k| self.has_scan(k)) {
+        if let Some(&k) = t.blank.iter().find(|&&k| self.velodyne.has_scan(k)) {
             return Err(Error::parse(
                 path,
                 k + 1,
@@ -413,19 +390,7 @@ impl RawDrive {
                 });
             }
         }
-        for (_, path) in self.velodyne.files().into_iter().flatten() {
-            match std::fs::metadata(path) {
-                Err(e) => issues.push(Issue::Unreadable {
-                    path: path.clone(),
-                    error: e.to_string(),
-                }),
-                Ok(m) if m.len() % 16 != 0 => issues.push(Issue::Unreadable {
-                    path: path.clone(),
-                    error: format!("{} bytes is not a multiple of 16", m.len()),
-                }),
-                Ok(_) => {}
-            }
-        }
+        self.velodyne.check_sizes(&mut issues);
         let calib = [
             (CALIB_IMU_TO_VELO, "no Velodyne poses"),
             (CALIB_VELO_TO_CAM, "no Velodyne→camera transform"),
@@ -445,9 +410,6 @@ impl RawDrive {
 
     /// [`check`](Self::check), stopping with the first issue as an error.
     pub fn ensure_consistent(&self) -> Result<()> {
-        match self.check().first() {
-            None => Ok(()),
-            Some(issue) => Err(issue.to_error()),
-        }
+        Issue::first_as_error(&self.check())
     }
 }

@@ -73,53 +73,78 @@ pub fn list_scan_files(dir: &Path) -> Result<Vec<(u64, PathBuf)>> {
     }
 }
 
-/// A recording's scan folder as listed when the recording was opened: its numbered scan
+/// A KITTI layout's scan folder as listed when the recording was opened: its numbered scan
 /// files ([`list_scan_files`]), or none when the folder does not exist. Scan `k` is the listed
 /// file numbered `k`, else the `.bin` name with `digits` digits (whether or not it exists).
+/// The raw drive, tracking and odometry layouts each hand theirs out (`scans()`).
 #[derive(Clone, Debug)]
-pub(crate) struct ScanFolder {
+pub struct ScanFolder {
     dir: PathBuf,
     files: Option<Vec<(u64, PathBuf)>>,
     digits: usize,
+    /// What a missing folder means, for the error of a read.
+    missing: &'static str,
 }
 
 impl ScanFolder {
-    /// Lists `dir` when it is a folder; names scans with `digits` digits when not listed.
-    pub(crate) fn open(dir: PathBuf, digits: usize) -> Result<Self> {
+    /// Lists `dir` when it is a folder; names scans with `digits` digits when not listed;
+    /// `missing` says what a missing folder means in the error of a read.
+    pub(crate) fn open(dir: PathBuf, digits: usize, missing: &'static str) -> Result<Self> {
         let files = if dir.is_dir() {
             Some(list_scan_files(&dir)?)
         } else {
             None
         };
-        Ok(ScanFolder { dir, files, digits })
+        Ok(ScanFolder {
+            dir,
+            files,
+            digits,
+            missing,
+        })
+    }
+
+    /// The folder.
+    pub fn dir(&self) -> &Path {
+        &self.dir
     }
 
     /// Whether the folder exists.
-    pub(crate) fn exists(&self) -> bool {
+    pub fn exists(&self) -> bool {
         self.files.is_some()
     }
 
     /// The listed scans, sorted by number; `None` without the folder.
-    pub(crate) fn files(&self) -> Option<&[(u64, PathBuf)]> {
+    pub fn files(&self) -> Option<&[(u64, PathBuf)]> {
         self.files.as_deref()
     }
 
     /// Number of listed scans (0 without the folder).
-    pub(crate) fn count(&self) -> usize {
+    pub fn count(&self) -> usize {
         self.files.as_ref().map_or(0, Vec::len)
     }
 
     /// Number of frames the scans span: the last scan's number + 1 (0 without scans). It
     /// exceeds [`count`](Self::count) when scans were dropped inside the numbering.
-    pub(crate) fn extent(&self) -> usize {
+    pub fn extent(&self) -> usize {
         self.files
             .as_deref()
             .and_then(<[_]>::last)
             .map_or(0, |(n, _)| *n as usize + 1)
     }
 
-    /// Whether frame `k` has a listed scan.
-    pub(crate) fn has_scan(&self, k: usize) -> bool {
+    /// The frames the scans span ([`extent`](Self::extent)) when the folder exists, else
+    /// `otherwise()` (a layout's other count of frames, such as its OXTS packets).
+    pub fn extent_or(&self, otherwise: impl FnOnce() -> usize) -> usize {
+        if self.exists() {
+            self.extent()
+        } else {
+            otherwise()
+        }
+    }
+
+    /// Whether frame `k` has a listed scan. KITTI drops a scan now and then (raw drive 0009,
+    /// tracking sequence 0001: frames 177–180) and keeps the other files' numbers.
+    pub fn has_scan(&self, k: usize) -> bool {
         self.files
             .as_deref()
             .is_some_and(|f| listed_path(f, k as u64).is_some())
@@ -127,12 +152,13 @@ impl ScanFolder {
 
     /// The frames below [`extent`](Self::extent) without a scan (dropped scans), as inclusive
     /// ranges.
-    pub(crate) fn dropped(&self) -> Vec<(u64, u64)> {
+    pub fn dropped(&self) -> Vec<(u64, u64)> {
         numbering_gaps(self.files.iter().flatten().map(|f| f.0))
     }
 
-    /// Path of scan `k`.
-    pub(crate) fn path(&self, k: usize) -> PathBuf {
+    /// Path of scan `k`: the listed `.bin` or `.pcd` file, else (whether or not it exists) the
+    /// `.bin` name.
+    pub fn path(&self, k: usize) -> PathBuf {
         self.files
             .as_deref()
             .and_then(|v| listed_path(v, k as u64))
@@ -143,27 +169,41 @@ impl ScanFolder {
             })
     }
 
-    /// Reads scan `k` with a choice for non-finite points; without the folder, the error
-    /// `missing` makes from its path.
-    pub(crate) fn read(
-        &self,
-        k: usize,
-        policy: NonFinite,
-        missing: impl FnOnce(&Path) -> Error,
-    ) -> Result<BinScan> {
+    /// Adds an [`Issue::Unreadable`](super::Issue::Unreadable) for every listed `.bin` scan
+    /// that cannot be read or whose size is not a whole number of points (16 bytes each).
+    pub(crate) fn check_sizes(&self, issues: &mut Vec<super::Issue>) {
+        for (_, path) in self.files().into_iter().flatten() {
+            if crate::cloud::is_pcd(path) {
+                continue;
+            }
+            match std::fs::metadata(path) {
+                Err(e) => issues.push(super::Issue::Unreadable {
+                    path: path.clone(),
+                    error: e.to_string(),
+                }),
+                Ok(m) if m.len() % 16 != 0 => issues.push(super::Issue::Unreadable {
+                    path: path.clone(),
+                    error: format!("{} bytes is not a multiple of 16", m.len()),
+                }),
+                Ok(_) => {}
+            }
+        }
+    }
+
+    /// Reads scan `k` with a choice for non-finite points. Errors name the file, or the
+    /// folder when it does not exist.
+    pub fn read(&self, k: usize, policy: NonFinite) -> Result<BinScan> {
         if !self.exists() {
-            return Err(missing(&self.dir));
+            return Err(Error::io(
+                &self.dir,
+                std::io::Error::new(
+                    std::io::ErrorKind::NotFound,
+                    format!("folder missing; {}", self.missing),
+                ),
+            ));
         }
         read_scan_with(self.path(k), policy)
     }
-}
-
-/// The error for reading a scan of the folder `dir` that does not exist.
-pub(crate) fn no_scans(dir: &Path) -> Error {
-    Error::io(
-        dir,
-        std::io::Error::new(std::io::ErrorKind::NotFound, "folder missing; no scans"),
-    )
 }
 
 /// The path of frame `k` in a sorted frame list, when listed.

@@ -89,6 +89,14 @@ impl Issue {
         }
     }
 
+    /// Ok when there is no issue, else the first one as an error.
+    pub fn first_as_error(issues: &[Issue]) -> crate::error::Result<()> {
+        match issues.first() {
+            None => Ok(()),
+            Some(issue) => Err(issue.to_error()),
+        }
+    }
+
     /// The issue as an [`Error`] (for callers that want to stop at the first one).
     pub fn to_error(&self) -> Error {
         let line = match self {

@@ -23,7 +23,7 @@ pub mod tracklets;
 
 pub use calib::{read_cam_to_cam, read_rigid_calib, CalibFile, CamToCamCalib, RigidCalib};
 pub use drive::RawDrive;
-pub use frames::frame_file_name;
+pub use frames::{frame_file_name, ScanFolder};
 pub use issue::Issue;
 pub use labels::{
     read_tracking_labels, write_tracking_labels, ObjectType, TrackingLabel, VelodyneBox,

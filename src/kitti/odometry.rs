@@ -15,11 +15,10 @@
 //! Not for: the raw-drive layout (see [`super::drive`]).
 
 use super::calib::{rigid_from_parts, CalibFile};
-use super::frames::{no_scans, numbering_gaps, ScanFolder};
+use super::frames::{numbering_gaps, ScanFolder};
 use super::issue::Issue;
 use super::text::{numbered_lines, parse_f64, read_text};
 use crate::atomic::write_atomically;
-use crate::cloud::{BinScan, NonFinite, PointCloud};
 use crate::error::{Error, Result};
 use nalgebra::{Isometry3, Matrix3, Vector3};
 use std::io::Write;
@@ -119,7 +118,7 @@ impl OdometrySequence {
                 "is not a folder",
             ));
         }
-        let velodyne = ScanFolder::open(dir.join("velodyne"), 6)?;
+        let velodyne = ScanFolder::open(dir.join("velodyne"), 6, "no scans")?;
         Ok(OdometrySequence {
             root,
             name,
@@ -162,20 +161,9 @@ impl OdometrySequence {
         self.velodyne.count()
     }
 
-    /// Path of scan `k`: the listed `.bin` or `.pcd` file, else (whether or not it exists)
-    /// `NNNNNN.bin`, six digits as in the benchmark.
-    pub fn velodyne_path(&self, k: usize) -> PathBuf {
-        self.velodyne.path(k)
-    }
-
-    /// Reads scan `k`; a non-finite value is an error naming the file and point.
-    pub fn velodyne(&self, k: usize) -> Result<PointCloud> {
-        self.velodyne_with(k, NonFinite::Error).map(|s| s.cloud)
-    }
-
-    /// Reads scan `k` with a choice for non-finite points.
-    pub fn velodyne_with(&self, k: usize, policy: NonFinite) -> Result<BinScan> {
-        self.velodyne.read(k, policy, no_scans)
+    /// The scans (`velodyne/`, `NNNNNN.bin`): their paths, reading them.
+    pub fn scans(&self) -> &ScanFolder {
+        &self.velodyne
     }
 
     /// The frame times, seconds.

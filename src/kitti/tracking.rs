@@ -14,7 +14,7 @@
 //! [`super::poses`]. The layout keeps no time stamps: frame k is taken at k·[`FRAME_PERIOD`]
 //! (the recordings' 10 Hz). A scan missing inside the numbering is a dropped scan (sequence
 //! 0001 has none for frames 177–180, whose OXTS lines and labels are there): the sequence's
-//! frames are those the scans span, and [`TrackingSequence::has_scan`] tells which have one.
+//! frames are those the scans span, and [`TrackingSequence::scans`] tells which have one.
 //!
 //! Opening lists the scans only; everything else is read when asked for. [`TrackingSequence::check`]
 //! reports every inconsistency at once.
@@ -23,13 +23,12 @@
 //! [`super::odometry`]).
 
 use super::calib::{rigid_from_parts, CalibEntry, CalibFile};
-use super::frames::{no_scans, numbering_gaps, ScanFolder};
+use super::frames::{numbering_gaps, ScanFolder};
 use super::issue::Issue;
 use super::labels::{read_tracking_labels, TrackingLabel};
 use super::oxts::OxtsPacket;
 use super::poses::{self, VehicleState};
 use super::text::{numbered_lines, read_text};
-use crate::cloud::{BinScan, NonFinite, PointCloud};
 use crate::error::{Error, Result};
 use nalgebra::{Isometry3, Matrix3, Matrix3x4, Point3, Translation3, UnitQuaternion, Vector3};
 use std::path::{Path, PathBuf};
@@ -240,7 +239,7 @@ impl TrackingSequence {
             ));
         }
         let name = format!("{sequence:04}");
-        let velodyne = ScanFolder::open(root.join("velodyne").join(&name), 6)?;
+        let velodyne = ScanFolder::open(root.join("velodyne").join(&name), 6, "no scans")?;
         Ok(TrackingSequence {
             root,
             name,
@@ -308,40 +307,17 @@ impl TrackingSequence {
 
     /// Number of frames: the frames the scans span when `velodyne/NNNN` exists (the last
     /// scan's number + 1, dropped scans inside the numbering included; see
-    /// [`has_scan`](Self::has_scan)), otherwise the OXTS packets (0 when neither can be read).
+    /// [`ScanFolder::has_scan`]), otherwise the OXTS packets (0 when neither can be read).
     pub fn frame_count(&self) -> usize {
-        if self.has_velodyne() {
-            self.velodyne.extent()
-        } else {
-            self.oxts_count()
-        }
+        self.velodyne.extent_or(|| self.oxts_count())
     }
 
-    /// Whether frame `k` has a scan. KITTI's sequence 0001 has none for frames 177–180 (its
-    /// raw drive dropped them); their OXTS lines and labels are there.
-    pub fn has_scan(&self, k: usize) -> bool {
-        self.velodyne.has_scan(k)
-    }
-
-    /// The frames below [`frame_count`](Self::frame_count) without a scan, as inclusive ranges.
-    pub fn dropped_scans(&self) -> Vec<(u64, u64)> {
-        self.velodyne.dropped()
-    }
-
-    /// Path of scan `k`: the listed `.bin` or `.pcd` file, else (whether or not it exists)
-    /// `NNNNNN.bin`, six digits as in the benchmark.
-    pub fn velodyne_path(&self, k: usize) -> PathBuf {
-        self.velodyne.path(k)
-    }
-
-    /// Reads scan `k`; a non-finite value is an error naming the file and point.
-    pub fn velodyne(&self, k: usize) -> Result<PointCloud> {
-        self.velodyne_with(k, NonFinite::Error).map(|s| s.cloud)
-    }
-
-    /// Reads scan `k` with a choice for non-finite points.
-    pub fn velodyne_with(&self, k: usize, policy: NonFinite) -> Result<BinScan> {
-        self.velodyne.read(k, policy, no_scans)
+    /// The scans (`velodyne/NNNN`, `NNNNNN.bin`): which frames have one
+    /// ([`ScanFolder::has_scan`]; KITTI's sequence 0001 has none for frames 177–180, its raw
+    /// drive dropped them, while their OXTS lines and labels are there), their paths, reading
+    /// them.
+    pub fn scans(&self) -> &ScanFolder {
+        &self.velodyne
     }
 
     /// Every packet of the OXTS file, whatever the number of scans.
@@ -479,19 +455,7 @@ impl TrackingSequence {
                         last,
                     });
                 }
-                for (_, path) in files {
-                    match std::fs::metadata(path) {
-                        Err(e) => issues.push(Issue::Unreadable {
-                            path: path.clone(),
-                            error: e.to_string(),
-                        }),
-                        Ok(m) if m.len() % 16 != 0 => issues.push(Issue::Unreadable {
-                            path: path.clone(),
-                            error: format!("{} bytes is not a multiple of 16", m.len()),
-                        }),
-                        Ok(_) => {}
-                    }
-                }
+                self.velodyne.check_sizes(&mut issues);
             }
         }
         if !self.has_oxts() {
@@ -551,10 +515,7 @@ impl TrackingSequence {
 
     /// [`check`](Self::check), stopping with the first issue as an error.
     pub fn ensure_consistent(&self) -> Result<()> {
-        match self.check().first() {
-            None => Ok(()),
-            Some(issue) => Err(issue.to_error()),
-        }
+        Issue::first_as_error(&self.check())
     }
 }
 

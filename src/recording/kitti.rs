@@ -3,10 +3,12 @@
 //! OXTS file and `calib/NNNN.txt`, frames 0.1 s apart) and an odometry sequence (scans,
 //! `times.txt` and the ground-truth poses of sequences 00–10; no vehicle motion).
 //!
+//! A scan with a non-finite value is an error naming the file and point.
+//!
 //! Not for: reading the layouts' files (see [`crate::kitti`]).
 
 use super::{Recording, VehicleMotion};
-use crate::cloud::PointCloud;
+use crate::cloud::{NonFinite, PointCloud};
 use crate::error::{Error, Result};
 use crate::kitti::tracking::FRAME_PERIOD;
 use crate::kitti::{OdometrySequence, RawDrive, TrackingSequence};
@@ -24,13 +26,13 @@ impl Recording for RawDrive {
         RawDrive::frame_count(self)
     }
     fn has_scan(&self, k: usize) -> bool {
-        RawDrive::has_scan(self, k)
+        self.scans().has_scan(k)
     }
     fn scan(&self, k: usize) -> Result<PointCloud> {
-        self.velodyne(k)
+        Ok(self.scans().read(k, NonFinite::Error)?.cloud)
     }
     fn scan_dir(&self) -> Option<PathBuf> {
-        Some(self.velodyne_dir())
+        Some(self.scans().dir().to_path_buf())
     }
     /// The Velodyne time stamps (`velodyne_points/timestamps.txt`) when the drive has them.
     fn times(&self) -> Result<Option<Vec<f64>>> {
@@ -83,13 +85,13 @@ impl Recording for TrackingSequence {
         TrackingSequence::frame_count(self)
     }
     fn has_scan(&self, k: usize) -> bool {
-        TrackingSequence::has_scan(self, k)
+        self.scans().has_scan(k)
     }
     fn scan(&self, k: usize) -> Result<PointCloud> {
-        self.velodyne(k)
+        Ok(self.scans().read(k, NonFinite::Error)?.cloud)
     }
     fn scan_dir(&self) -> Option<PathBuf> {
-        Some(self.velodyne_dir())
+        Some(self.scans().dir().to_path_buf())
     }
     /// Frame k at k · [`FRAME_PERIOD`]: the layout has no time stamps.
     fn times(&self) -> Result<Option<Vec<f64>>> {
@@ -130,10 +132,10 @@ impl Recording for OdometrySequence {
         OdometrySequence::frame_count(self)
     }
     fn scan(&self, k: usize) -> Result<PointCloud> {
-        self.velodyne(k)
+        Ok(self.scans().read(k, NonFinite::Error)?.cloud)
     }
     fn scan_dir(&self) -> Option<PathBuf> {
-        Some(self.velodyne_dir())
+        Some(self.scans().dir().to_path_buf())
     }
     /// `times.txt` when the sequence has it; fewer times than scans is an error naming it.
     fn times(&self) -> Result<Option<Vec<f64>>> {

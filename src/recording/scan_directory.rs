@@ -46,7 +46,7 @@ impl ScanDirectory {
         }
         let what = || format!("scan folder {}", dir.display());
         let mut scans = match (bin.is_empty(), pcd.is_empty()) {
-            (true, true) => return Err(Error::invalid(what(), "holds no .bin or .pcd scan")),
+            (true, true) => return Err(Error::invalid(what(), "holds no .bin or .pcd scans")),
             (false, false) => {
                 return Err(Error::invalid(
                     what(),
