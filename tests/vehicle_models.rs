@@ -179,8 +179,10 @@ fn a_vehicle_model_named_in_a_configuration_moves_the_walls() {
     assert_eq!(t.ego, "oxts+bicycle");
     assert!(t.frames.iter().any(|f| !f.planes.is_empty()));
     // a user's own vehicle model, and an unknown name
-    let mut own = TrackingConfig::default();
-    own.ego = EgoModel::custom(StandsStill);
+    let own = TrackingConfig {
+        ego: EgoModel::custom(StandsStill),
+        ..TrackingConfig::default()
+    };
     assert_eq!(track(&drive, &own).ego, "oxts+StandsStill");
     let bad = r#"{"ego": {"kind": "vehicle", "model": "hovercraft"}}"#;
     let config: TrackingConfig = serde_json::from_str(bad).unwrap();

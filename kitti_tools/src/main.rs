@@ -55,7 +55,7 @@ enum Command {
     /// Track building walls and point clusters of a KITTI raw drive, tracking sequence or
     /// odometry sequence with one labelled multi-Bernoulli filter; write per-frame tracks
     /// (JSON), labelled clouds and a plot.
-    Track(track_cmd::Args),
+    Track(Box<track_cmd::Args>),
     /// Track many recordings (a list file or a folder of raw drives), each into its own
     /// folder, resumably (recordings already tracked are skipped), with one summary table.
     Batch(batch_cmd::Args),
@@ -89,7 +89,7 @@ fn main() -> Result<()> {
         Command::Odometry(args) => odometry_cmd::run(args),
         Command::Planes(args) => planes_cmd::run(args),
         Command::Synth(args) => synth_cmd::run(args),
-        Command::Track(args) => track_cmd::run(args),
+        Command::Track(args) => track_cmd::run(*args),
         Command::Batch(args) => batch_cmd::run(args),
         Command::Eval(args) => eval_cmd::run(args),
     }
