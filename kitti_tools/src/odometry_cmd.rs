@@ -5,7 +5,7 @@
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use nalgebra::Isometry3;
-use smc_lmb::cloud::odometry::{odometry_of_files_at, Fallback, OdometryConfig};
+use smc_lmb::cloud::odometry::{odometry_of_scans_at, Fallback, OdometryConfig};
 use smc_lmb::kitti::odometry::{read_odometry_poses, write_odometry_poses};
 use smc_lmb::kitti::{OdometrySequence, RawDrive};
 use smc_lmb::metrics::{
@@ -62,9 +62,9 @@ pub struct Args {
     quiet: bool,
 }
 
-/// The scans to register, their frame numbers and where the reference trajectory comes from.
+/// The recording, the frames of its scans and where the reference trajectory comes from.
 struct Input {
-    scans: Vec<PathBuf>,
+    rec: Box<dyn Recording>,
     /// Frame number of each scan: `0, 1, 2, …` but where a drive dropped scans (the
     /// reference has a pose per frame).
     frames: Vec<usize>,
@@ -72,30 +72,31 @@ struct Input {
 }
 
 enum Reference {
-    Drive(RawDrive),
-    PoseFile(PathBuf, Option<OdometrySequence>),
+    /// The recording's own poses (OXTS, `poses/NN.txt`), named by where they are.
+    Recorded(String),
+    /// A pose file.
+    PoseFile(PathBuf),
 }
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
     let mut input = input(&args)?;
     if let Some(n) = args.frames {
-        input.scans.truncate(n);
         input.frames.truncate(n);
     }
-    if input.scans.is_empty() {
+    if input.frames.is_empty() {
         bail!("no scans to register");
     }
     let estimate = match &args.evaluate {
         Some(file) => read_odometry_poses(file)
             .with_context(|| format!("reading the poses to score, {}", file.display()))?,
-        None => estimate(&args, &input.scans, &input.frames)?,
+        None => estimate(&args, &*input.rec, &input.frames)?,
     };
     if let Some(file) = &args.reference {
-        input.reference = Some(Reference::PoseFile(file.clone(), None));
+        input.reference = Some(Reference::PoseFile(file.clone()));
     }
     if let Some(reference) = &input.reference {
-        let (name, poses) = reference_poses(reference)?;
+        let (name, poses) = reference_poses(reference, &*input.rec)?;
         // The frame of each estimated pose: the scans' own numbers, and consecutive ones after
         // the last (a scored file may hold more poses than there are scans).
         let gap = input
@@ -121,60 +122,48 @@ pub fn run(args: Args) -> Result<()> {
 }
 
 fn input(args: &Args) -> Result<Input> {
-    match (&args.drive, &args.odometry, &args.scans) {
-        (Some(dir), _, _) => {
-            let drive =
-                RawDrive::open(dir).with_context(|| format!("opening drive {}", dir.display()))?;
-            // Dropped scans are left out; the others keep their frame numbers.
-            let frames: Vec<usize> = (0..drive.frame_count())
-                .filter(|&k| drive.has_scan(k))
-                .collect();
-            let scans = frames.iter().map(|&k| drive.scans().path(k)).collect();
-            let reference = drive.has_oxts().then_some(Reference::Drive(drive));
-            Ok(Input {
-                scans,
-                frames,
-                reference,
-            })
-        }
-        (None, Some(root), _) => {
-            let Some(number) = args.sequence else {
-                bail!("--odometry needs --sequence");
-            };
-            let seq = OdometrySequence::open(root, number).with_context(|| {
-                format!(
-                    "opening odometry sequence {number:02} of {}",
-                    root.display()
-                )
-            })?;
-            let scans: Vec<PathBuf> = (0..seq.frame_count())
-                .map(|k| seq.scans().path(k))
-                .collect();
-            let poses = seq.poses_path();
-            let reference = poses
-                .is_file()
-                .then_some(Reference::PoseFile(poses, Some(seq)));
-            Ok(Input {
-                frames: (0..scans.len()).collect(),
-                scans,
-                reference,
-            })
-        }
-        (None, None, Some(dir)) => {
-            let scans = ScanDirectory::open(dir)?.scan_paths().to_vec();
-            Ok(Input {
-                frames: (0..scans.len()).collect(),
-                scans,
-                reference: None,
-            })
-        }
-        (None, None, None) => {
-            bail!("give --drive DIR, --odometry ROOT --sequence NN or --scans DIR")
-        }
-    }
+    let (rec, reference): (Box<dyn Recording>, Option<String>) =
+        match (&args.drive, &args.odometry, &args.scans) {
+            (Some(dir), _, _) => {
+                let drive = RawDrive::open(dir)
+                    .with_context(|| format!("opening drive {}", dir.display()))?;
+                let oxts = drive
+                    .has_oxts()
+                    .then(|| format!("{} (OXTS)", drive.oxts_dir().display()));
+                (Box::new(drive), oxts)
+            }
+            (None, Some(root), _) => {
+                let Some(number) = args.sequence else {
+                    bail!("--odometry needs --sequence");
+                };
+                let seq = OdometrySequence::open(root, number).with_context(|| {
+                    format!(
+                        "opening odometry sequence {number:02} of {}",
+                        root.display()
+                    )
+                })?;
+                let poses = seq
+                    .has_poses()
+                    .then(|| seq.poses_path().display().to_string());
+                (Box::new(seq), poses)
+            }
+            (None, None, Some(dir)) => (Box::new(ScanDirectory::open(dir)?), None),
+            (None, None, None) => {
+                bail!("give --drive DIR, --odometry ROOT --sequence NN or --scans DIR")
+            }
+        };
+    // Dropped scans are left out; the others keep their frame numbers.
+    let frames = (0..rec.frame_count())
+        .filter(|&k| rec.has_scan(k))
+        .collect();
+    Ok(Input {
+        rec,
+        frames,
+        reference: reference.map(Reference::Recorded),
+    })
 }
 
-fn estimate(args: &Args, scans: &[PathBuf], frames: &[usize]) -> Result<Vec<Isometry3<f64>>> {
+fn estimate(args: &Args, rec: &dyn Recording, frames: &[usize]) -> Result<Vec<Isometry3<f64>>> {
     let config = OdometryConfig {
         max_range: args.max_range,
         voxel_size: args.voxel_size.unwrap_or(args.max_range / 100.0),
@@ -188,7 +177,7 @@ fn estimate(args: &Args, scans: &[PathBuf], frames: &[usize]) -> Result<Vec<Isom
     let bar = if args.quiet {
         ProgressBar::hidden()
     } else {
-        ProgressBar::new(scans.len() as u64)
+        ProgressBar::new(frames.len() as u64)
     };
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} scans {elapsed}")
@@ -197,15 +186,21 @@ fn estimate(args: &Args, scans: &[PathBuf], frames: &[usize]) -> Result<Vec<Isom
     let start = Instant::now();
     let mut fallbacks: BTreeMap<Fallback, Vec<usize>> = BTreeMap::new();
     let mut least_information = f64::INFINITY;
-    let poses = odometry_of_files_at(scans, frames, &config, |k, r| {
-        bar.inc(1);
-        if let Some(f) = r.fallback {
-            fallbacks.entry(f).or_default().push(k);
-        }
-        if let Some(i) = r.information_ratio {
-            least_information = least_information.min(i);
-        }
-    })?;
+    let poses = odometry_of_scans_at(
+        frames,
+        &|i| rec.scan(frames[i]),
+        &|i| rec.scan_name(frames[i]),
+        &config,
+        |k, r| {
+            bar.inc(1);
+            if let Some(f) = r.fallback {
+                fallbacks.entry(f).or_default().push(k);
+            }
+            if let Some(i) = r.information_ratio {
+                least_information = least_information.min(i);
+            }
+        },
+    )?;
     let elapsed = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
     let out = args
@@ -239,20 +234,20 @@ fn estimate(args: &Args, scans: &[PathBuf], frames: &[usize]) -> Result<Vec<Isom
     Ok(poses)
 }
 
-fn reference_poses(reference: &Reference) -> Result<(String, Vec<Isometry3<f64>>)> {
+fn reference_poses(
+    reference: &Reference,
+    rec: &dyn Recording,
+) -> Result<(String, Vec<Isometry3<f64>>)> {
     match reference {
-        Reference::Drive(drive) => {
-            let poses = drive.poses().with_context(|| {
-                format!("reading the OXTS reference of {}", drive.dir().display())
-            })?;
-            Ok((format!("{} (OXTS)", drive.oxts_dir().display()), poses))
+        Reference::Recorded(name) => {
+            let poses = rec
+                .poses()
+                .with_context(|| format!("reading the reference {name}"))?;
+            Ok((name.clone(), poses))
         }
-        Reference::PoseFile(file, seq) => {
-            let poses = match seq {
-                Some(seq) => seq.velodyne_poses(),
-                None => read_odometry_poses(file),
-            }
-            .with_context(|| format!("reading the reference {}", file.display()))?;
+        Reference::PoseFile(file) => {
+            let poses = read_odometry_poses(file)
+                .with_context(|| format!("reading the reference {}", file.display()))?;
             Ok((file.display().to_string(), poses))
         }
     }

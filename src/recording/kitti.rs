@@ -3,12 +3,12 @@
 //! OXTS file and `calib/NNNN.txt`, frames 0.1 s apart) and an odometry sequence (scans,
 //! `times.txt` and the ground-truth poses of sequences 00–10; no vehicle motion).
 //!
-//! A scan with a non-finite value is an error naming the file and point.
+//! Scans are read as every recording reads them ([`super::non_finite_policy`]).
 //!
 //! Not for: reading the layouts' files (see [`crate::kitti`]).
 
 use super::{Recording, VehicleMotion};
-use crate::cloud::{NonFinite, PointCloud};
+use crate::cloud::PointCloud;
 use crate::error::{Error, Result};
 use crate::kitti::tracking::FRAME_PERIOD;
 use crate::kitti::{OdometrySequence, RawDrive, TrackingSequence};
@@ -29,7 +29,11 @@ impl Recording for RawDrive {
         self.scans().has_scan(k)
     }
     fn scan(&self, k: usize) -> Result<PointCloud> {
-        Ok(self.scans().read(k, NonFinite::Error)?.cloud)
+        let policy = super::non_finite_policy(&self.scans().path(k));
+        Ok(self.scans().read(k, policy)?.cloud)
+    }
+    fn scan_name(&self, k: usize) -> String {
+        self.scans().path(k).display().to_string()
     }
     fn scan_dir(&self) -> Option<PathBuf> {
         Some(self.scans().dir().to_path_buf())
@@ -88,7 +92,11 @@ impl Recording for TrackingSequence {
         self.scans().has_scan(k)
     }
     fn scan(&self, k: usize) -> Result<PointCloud> {
-        Ok(self.scans().read(k, NonFinite::Error)?.cloud)
+        let policy = super::non_finite_policy(&self.scans().path(k));
+        Ok(self.scans().read(k, policy)?.cloud)
+    }
+    fn scan_name(&self, k: usize) -> String {
+        self.scans().path(k).display().to_string()
     }
     fn scan_dir(&self) -> Option<PathBuf> {
         Some(self.scans().dir().to_path_buf())
@@ -132,7 +140,11 @@ impl Recording for OdometrySequence {
         OdometrySequence::frame_count(self)
     }
     fn scan(&self, k: usize) -> Result<PointCloud> {
-        Ok(self.scans().read(k, NonFinite::Error)?.cloud)
+        let policy = super::non_finite_policy(&self.scans().path(k));
+        Ok(self.scans().read(k, policy)?.cloud)
+    }
+    fn scan_name(&self, k: usize) -> String {
+        self.scans().path(k).display().to_string()
     }
     fn scan_dir(&self) -> Option<PathBuf> {
         Some(self.scans().dir().to_path_buf())

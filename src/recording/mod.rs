@@ -13,7 +13,7 @@ mod scan_directory;
 
 pub use scan_directory::ScanDirectory;
 
-use crate::cloud::PointCloud;
+use crate::cloud::{is_pcd, NonFinite, PointCloud};
 use crate::error::{Error, Result};
 use crate::models::VehicleState;
 use nalgebra::Isometry3;
@@ -47,6 +47,10 @@ pub trait Recording: Sync {
     }
     /// The scan of frame `k`, in the sensor frame. Errors name the file.
     fn scan(&self, k: usize) -> Result<PointCloud>;
+    /// Scan `k` in messages: its file when the recording keeps scans in files.
+    fn scan_name(&self, k: usize) -> String {
+        format!("frame {k} of {}", self.describe())
+    }
     /// Where the scans are (for an error when there is none), if in one folder.
     fn scan_dir(&self) -> Option<std::path::PathBuf> {
         None
@@ -94,6 +98,9 @@ impl<R: Recording + ?Sized> Recording for &R {
     fn scan(&self, k: usize) -> Result<PointCloud> {
         (**self).scan(k)
     }
+    fn scan_name(&self, k: usize) -> String {
+        (**self).scan_name(k)
+    }
     fn scan_dir(&self) -> Option<std::path::PathBuf> {
         (**self).scan_dir()
     }
@@ -114,6 +121,17 @@ impl<R: Recording + ?Sized> Recording for &R {
     }
     fn vehicle(&self) -> Result<VehicleMotion> {
         (**self).vehicle()
+    }
+}
+
+/// How a recording reads the points of a scan file with a non-finite value: a PCD file's are
+/// left out (organised clouds mark missing returns so), a `.bin` file's are an error naming the
+/// file and point.
+pub fn non_finite_policy(path: &std::path::Path) -> NonFinite {
+    if is_pcd(path) {
+        NonFinite::Skip
+    } else {
+        NonFinite::Error
     }
 }
 

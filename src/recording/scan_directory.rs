@@ -10,7 +10,7 @@
 //! Not for: KITTI's own layouts (see [`crate::kitti`]), which number their files.
 
 use super::Recording;
-use crate::cloud::{is_pcd, read_scan_with, NonFinite, PointCloud};
+use crate::cloud::{read_scan_with, PointCloud};
 use crate::error::{Error, Result};
 use crate::kitti::odometry::{read_odometry_poses, read_times};
 use nalgebra::Isometry3;
@@ -146,12 +146,13 @@ impl Recording for ScanDirectory {
                 format!("has no frame {k} ({} scans)", self.scans.len()),
             )
         })?;
-        let policy = if is_pcd(path) {
-            NonFinite::Skip
-        } else {
-            NonFinite::Error
-        };
-        Ok(read_scan_with(path, policy)?.cloud)
+        Ok(read_scan_with(path, super::non_finite_policy(path))?.cloud)
+    }
+    fn scan_name(&self, k: usize) -> String {
+        match self.scans.get(k) {
+            Some(p) => p.display().to_string(),
+            None => format!("frame {k} of {}", self.describe()),
+        }
     }
     fn scan_dir(&self) -> Option<PathBuf> {
         Some(self.dir.clone())

@@ -48,8 +48,8 @@ mod test_scene;
 pub use config::OdometryConfig;
 pub use downsample::{crop_range, voxel_downsample};
 pub use pipeline::{
-    odometry_of_files, odometry_of_files_at, odometry_of_frames, odometry_of_frames_with, Fallback,
-    LidarOdometry, Registered,
+    odometry_of_files, odometry_of_files_at, odometry_of_frames, odometry_of_frames_with,
+    odometry_of_scans_at, Fallback, LidarOdometry, Registered,
 };
 pub use refine::{fit_plane, refine_point_to_plane, Plane, RefineParams};
 pub use registration::{align_points_to_map, Alignment, IcpParams};

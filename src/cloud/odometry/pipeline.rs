@@ -301,7 +301,7 @@ pub fn odometry_of_files_at(
     paths: &[PathBuf],
     frames: &[usize],
     config: &OdometryConfig,
-    mut on_scan: impl FnMut(usize, &Registered),
+    on_scan: impl FnMut(usize, &Registered),
 ) -> Result<Vec<Isometry3<f64>>> {
     if paths.is_empty() {
         return Err(Error::invalid("odometry scans", "no scans given"));
@@ -316,14 +316,45 @@ pub fn odometry_of_files_at(
             ),
         ));
     }
+    odometry_of_scans_at(
+        frames,
+        &|i| read_scan(&paths[i]),
+        &|i| paths[i].display().to_string(),
+        config,
+        on_scan,
+    )
+}
+
+/// The odometry over scans read by `load(i)`, the i-th taken at frame number `frames[i]`
+/// (ascending; a gap is registered over the longer step, [`LidarOdometry::register_after`]),
+/// and one pose per scan; `name(i)` names scan i in errors (its file, say); `on_scan(i)` is
+/// called after scan i. What [`odometry_of_files_at`] does for files, for any recording.
+/// Errors: no scans, `frames` that do not increase, an error of `load`, a scan with no point
+/// in range (named).
+pub fn odometry_of_scans_at(
+    frames: &[usize],
+    load: &dyn Fn(usize) -> Result<PointCloud>,
+    name: &dyn Fn(usize) -> String,
+    config: &OdometryConfig,
+    mut on_scan: impl FnMut(usize, &Registered),
+) -> Result<Vec<Isometry3<f64>>> {
+    if frames.is_empty() {
+        return Err(Error::invalid("odometry scans", "no scans given"));
+    }
+    if frames.windows(2).any(|w| w[1] <= w[0]) {
+        return Err(Error::invalid(
+            "odometry frame numbers",
+            "must increase from scan to scan",
+        ));
+    }
     let mut odometry = LidarOdometry::new(config.clone())?;
-    for (k, path) in paths.iter().enumerate() {
-        let cloud = read_scan(path)?;
-        let steps = if k == 0 { 1 } else { frames[k] - frames[k - 1] };
+    for (i, &frame) in frames.iter().enumerate() {
+        let cloud = load(i)?;
+        let steps = if i == 0 { 1 } else { frame - frames[i - 1] };
         let registered = odometry
             .register_after(&cloud, steps)
-            .map_err(|e| named(path, e))?;
-        on_scan(k, &registered);
+            .map_err(|e| named(&name(i), e))?;
+        on_scan(i, &registered);
     }
     Ok(odometry.poses.clone())
 }
@@ -391,11 +422,9 @@ fn read_scan(path: &Path) -> Result<PointCloud> {
     Ok(read_scan_with(path, policy)?.cloud)
 }
 
-fn named(path: &Path, e: Error) -> Error {
+fn named(scan: &str, e: Error) -> Error {
     match e {
-        Error::InvalidInput { reason, .. } => {
-            Error::invalid(format!("scan {}", path.display()), reason)
-        }
+        Error::InvalidInput { reason, .. } => Error::invalid(format!("scan {scan}"), reason),
         other => other,
     }
 }
