@@ -15,6 +15,26 @@ use crate::kitti::{OdometrySequence, RawDrive, TrackingSequence};
 use nalgebra::Isometry3;
 use std::path::PathBuf;
 
+/// The [`Recording`] methods of a layout whose scans are a [`crate::kitti::ScanFolder`]
+/// (`scans()`): which frames have one, reading and naming them, their folder.
+macro_rules! scans_in_folder {
+    () => {
+        fn has_scan(&self, k: usize) -> bool {
+            self.scans().has_scan(k)
+        }
+        fn scan(&self, k: usize) -> Result<PointCloud> {
+            let policy = super::non_finite_policy(&self.scans().path(k));
+            Ok(self.scans().read(k, policy)?.cloud)
+        }
+        fn scan_name(&self, k: usize) -> String {
+            self.scans().path(k).display().to_string()
+        }
+        fn scan_dir(&self) -> Option<PathBuf> {
+            Some(self.scans().dir().to_path_buf())
+        }
+    };
+}
+
 impl Recording for RawDrive {
     fn name(&self) -> String {
         RawDrive::name(self)
@@ -25,19 +45,7 @@ impl Recording for RawDrive {
     fn frame_count(&self) -> usize {
         RawDrive::frame_count(self)
     }
-    fn has_scan(&self, k: usize) -> bool {
-        self.scans().has_scan(k)
-    }
-    fn scan(&self, k: usize) -> Result<PointCloud> {
-        let policy = super::non_finite_policy(&self.scans().path(k));
-        Ok(self.scans().read(k, policy)?.cloud)
-    }
-    fn scan_name(&self, k: usize) -> String {
-        self.scans().path(k).display().to_string()
-    }
-    fn scan_dir(&self) -> Option<PathBuf> {
-        Some(self.scans().dir().to_path_buf())
-    }
+    scans_in_folder!();
     /// The Velodyne time stamps (`velodyne_points/timestamps.txt`) when the drive has them.
     fn times(&self) -> Result<Option<Vec<f64>>> {
         if self.velodyne_timestamps_path().is_file() {
@@ -88,19 +96,7 @@ impl Recording for TrackingSequence {
     fn frame_count(&self) -> usize {
         TrackingSequence::frame_count(self)
     }
-    fn has_scan(&self, k: usize) -> bool {
-        self.scans().has_scan(k)
-    }
-    fn scan(&self, k: usize) -> Result<PointCloud> {
-        let policy = super::non_finite_policy(&self.scans().path(k));
-        Ok(self.scans().read(k, policy)?.cloud)
-    }
-    fn scan_name(&self, k: usize) -> String {
-        self.scans().path(k).display().to_string()
-    }
-    fn scan_dir(&self) -> Option<PathBuf> {
-        Some(self.scans().dir().to_path_buf())
-    }
+    scans_in_folder!();
     /// Frame k at k · [`FRAME_PERIOD`]: the layout has no time stamps.
     fn times(&self) -> Result<Option<Vec<f64>>> {
         Ok(Some(TrackingSequence::times(self)))
@@ -139,16 +135,7 @@ impl Recording for OdometrySequence {
     fn frame_count(&self) -> usize {
         OdometrySequence::frame_count(self)
     }
-    fn scan(&self, k: usize) -> Result<PointCloud> {
-        let policy = super::non_finite_policy(&self.scans().path(k));
-        Ok(self.scans().read(k, policy)?.cloud)
-    }
-    fn scan_name(&self, k: usize) -> String {
-        self.scans().path(k).display().to_string()
-    }
-    fn scan_dir(&self) -> Option<PathBuf> {
-        Some(self.scans().dir().to_path_buf())
-    }
+    scans_in_folder!();
     /// `times.txt` when the sequence has it; fewer times than scans is an error naming it.
     fn times(&self) -> Result<Option<Vec<f64>>> {
         if !self.times_path().is_file() {
