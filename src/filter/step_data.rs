@@ -9,6 +9,19 @@
 //! model before a step, a clone of a model shares nothing with its original, and a step whose
 //! frame lacks data a model needs is an error naming the model and the type.
 //!
+//! ```
+//! use smc_lmb::filter::{Frame, Measurements, StepContext, StepData};
+//!
+//! /// The wind a user's drift model reads in each step (m/s along x).
+//! struct Wind(f64);
+//!
+//! let frame = Frame::new(0.1, Measurements::empty(2)).with_data(StepData::new().with(Wind(3.0)));
+//! // the filter hands the frame's data to every model in the step's context
+//! let ctx = StepContext::new(1, 0.1, 0.1).with_data(frame.data.clone());
+//! assert_eq!(ctx.data.get::<Wind>().map(|w| w.0), Some(3.0));
+//! assert!(ctx.data.require::<String>("DriftModel").is_err());
+//! ```
+//!
 //! Values are kept behind `Arc`s: cloning a context (the filter keeps the previous step's for
 //! adaptive birth) copies a few pointers, never the data.
 //!
