@@ -1,9 +1,10 @@
 //! A lidar recording, whatever its layout on disk: frames, which of them have a scan, the
 //! scans, their times, the sensor poses and the vehicle's measured motion when the recording
-//! has them. [`Recording`] is what the pipelines take (`track_recording`, `predict_pairs`);
-//! the KITTI raw drive, tracking and odometry layouts implement it ([`kitti`]) and so does a
-//! plain folder of `.bin` or `.pcd` scans with an optional pose file and time file
-//! ([`ScanDirectory`]). A user's own layout is one more implementation.
+//! has them. [`Recording`] is what the pipelines take (`track_recording`, `predict_pairs`,
+//! `odometry_of_scans_at`); the KITTI raw drive, tracking and odometry layouts implement it
+//! (`recording/kitti.rs`) and so does a plain folder of `.bin` or `.pcd` scans with an
+//! optional pose file and time file ([`ScanDirectory`]). A user's own layout is one more
+//! implementation.
 //!
 //! Not for: reading the files of a layout (see [`crate::kitti`] and [`crate::cloud`]) or
 //! labels and their scoring (see [`crate::pipeline`]).
@@ -133,18 +134,4 @@ pub fn non_finite_policy(path: &std::path::Path) -> NonFinite {
     } else {
         NonFinite::Error
     }
-}
-
-/// The poses of `rec`, checked to cover its frames: an error naming the recording when there
-/// are fewer poses than frames.
-pub fn poses_covering(rec: &dyn Recording) -> Result<Vec<Isometry3<f64>>> {
-    let poses = rec.poses()?;
-    let n = rec.frame_count();
-    if poses.len() < n {
-        return Err(Error::invalid(
-            rec.describe(),
-            format!("has {} poses for {n} frames", poses.len()),
-        ));
-    }
-    Ok(poses)
 }
