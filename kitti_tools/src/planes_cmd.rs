@@ -7,8 +7,9 @@ use anyhow::{bail, Context, Result};
 use smc_lmb::cloud::planes::PlaneConfig;
 use smc_lmb::kitti::{OdometrySequence, RawDrive, TrackingSequence};
 use smc_lmb::metrics::{PlanePairError, PlanePredictionSummary};
+use smc_lmb::pipeline::drive_tracking::RecordingSource;
 use smc_lmb::pipeline::{predict_pairs, PairPrediction, PlanePredictionConfig};
-use smc_lmb::recording::{Recording, ScanDirectory};
+use smc_lmb::recording::Recording;
 use std::path::PathBuf;
 
 /// Flags of `planes`.
@@ -173,13 +174,12 @@ pub fn run(args: Args) -> Result<()> {
             })?)
         }
         (None, None, None) => match &args.scans {
-            Some(dir) => {
-                let mut scans = ScanDirectory::open(dir)?;
-                if let Some(p) = &args.poses {
-                    scans = scans.with_poses(p)?;
-                }
-                Box::new(scans)
+            Some(dir) => RecordingSource::Scans {
+                dir: dir.clone(),
+                poses: args.poses.clone(),
+                times: None,
             }
+            .open()?,
             None => bail!(
                 "give --drive DIR, --odometry ROOT --sequence NN, --tracking ROOT --sequence \
                  NNNN or --scans DIR"

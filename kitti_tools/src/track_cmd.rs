@@ -1,5 +1,6 @@
 //! `kitti-tools track`: one LMB run over a KITTI raw drive, tracking sequence, odometry
-//! sequence or folder of scans in which building walls and point clusters are labelled objects; writes the per-frame tracks as JSON and, on request,
+//! sequence or folder of scans in which building walls and point clusters are labelled
+//! objects; writes the per-frame tracks as JSON and, on request,
 //! labelled LAS/PLY clouds of chosen frames and a bird's-eye plot; prints a summary.
 
 use crate::config_file::tracking_config;

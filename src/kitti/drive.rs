@@ -22,7 +22,7 @@
 
 use super::calib::{read_cam_to_cam, read_rigid_calib, CamToCamCalib, RigidCalib};
 use super::frames::{
-    list_frame_files, listed_path, numbering_gaps, require_contiguous, ScanFolder,
+    list_frame_files, listed_path, missing_folder, numbering_gaps, require_contiguous, ScanFolder,
 };
 use super::issue::Issue;
 use super::oxts::{read_oxts_file, OxtsPacket};
@@ -59,16 +59,6 @@ fn list_if_present(dir: &Path, ext: &str) -> Result<Option<FrameFiles>> {
     } else {
         Ok(None)
     }
-}
-
-fn missing_folder(path: &Path, consequence: &str) -> Error {
-    Error::io(
-        path,
-        std::io::Error::new(
-            std::io::ErrorKind::NotFound,
-            format!("folder missing; {consequence}"),
-        ),
-    )
 }
 
 impl RawDrive {

@@ -194,16 +194,21 @@ impl ScanFolder {
     /// folder when it does not exist.
     pub fn read(&self, k: usize, policy: NonFinite) -> Result<BinScan> {
         if !self.exists() {
-            return Err(Error::io(
-                &self.dir,
-                std::io::Error::new(
-                    std::io::ErrorKind::NotFound,
-                    format!("folder missing; {}", self.missing),
-                ),
-            ));
+            return Err(missing_folder(&self.dir, self.missing));
         }
         read_scan_with(self.path(k), policy)
     }
+}
+
+/// The error for a folder `path` that does not exist, saying what that means.
+pub(crate) fn missing_folder(path: &Path, consequence: &str) -> Error {
+    Error::io(
+        path,
+        std::io::Error::new(
+            std::io::ErrorKind::NotFound,
+            format!("folder missing; {consequence}"),
+        ),
+    )
 }
 
 /// The path of frame `k` in a sorted frame list, when listed.

@@ -125,6 +125,14 @@ impl<R: Recording + ?Sized> Recording for &R {
     }
 }
 
+/// A folder's own name (its last component), or the whole path when it has none: the output
+/// name of a recording that is a folder.
+pub fn folder_name(dir: &std::path::Path) -> String {
+    dir.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| dir.display().to_string())
+}
+
 /// How a recording reads the points of a scan file with a non-finite value: a PCD file's are
 /// left out (organised clouds mark missing returns so), a `.bin` file's are an error naming the
 /// file and point.

@@ -126,10 +126,7 @@ impl ScanDirectory {
 
 impl Recording for ScanDirectory {
     fn name(&self) -> String {
-        self.dir
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_else(|| self.dir.display().to_string())
+        super::folder_name(&self.dir)
     }
     fn describe(&self) -> String {
         format!("scan folder {}", self.dir.display())

@@ -168,8 +168,6 @@ pub struct VehicleStart(pub Vec<f64>);
 #[derive(Clone)]
 pub struct MixedTransition {
     plane: PlaneTransition,
-    /// Whether planes move by a vehicle model's draw from the step's [`VehicleStart`].
-    predicted: bool,
     cluster: ConstantVelocity,
     /// A user's road-user model, used instead of `cluster` when set.
     road_users: Option<Arc<dyn TransitionModel>>,
@@ -200,7 +198,6 @@ impl MixedTransition {
                 plane_sigma_angle,
                 plane_sigma_offset,
             )?,
-            predicted: false,
             cluster: ConstantVelocity::spatial(cluster_sigma_accel)?,
             road_users: None,
         })
@@ -229,7 +226,6 @@ impl MixedTransition {
         )?;
         Ok(MixedTransition {
             plane,
-            predicted: true,
             cluster: ConstantVelocity::spatial(cluster_sigma_accel)?,
             road_users: None,
         })
@@ -261,6 +257,13 @@ impl MixedTransition {
     }
 }
 
+impl MixedTransition {
+    /// Whether planes move by a vehicle model's draw from the step's [`VehicleStart`].
+    fn moves_by_vehicle(&self) -> bool {
+        matches!(self.plane.ego(), EgoSource::Predicted { .. })
+    }
+}
+
 impl TransitionModel for MixedTransition {
     fn state_dim(&self) -> usize {
         STATE_DIM
@@ -277,7 +280,7 @@ impl TransitionModel for MixedTransition {
             return Ok(());
         }
         match kind_of_set(particles) {
-            Some(ObjectKind::Plane) if self.predicted => {
+            Some(ObjectKind::Plane) if self.moves_by_vehicle() => {
                 let start = ctx.data.require::<VehicleStart>(&self.name())?;
                 self.plane.predict_from(&start.0, particles, ctx, rng)
             }
@@ -336,11 +339,6 @@ impl OwnModels {
     pub fn clutter(mut self, c: impl ClutterModel + 'static) -> Self {
         self.clutter = Some(Arc::new(c));
         self
-    }
-
-    /// Whether no model is set.
-    pub fn is_empty(&self) -> bool {
-        self.measurement.is_none() && self.detection.is_none() && self.clutter.is_none()
     }
 
     /// Checks the measurement model's dimensions against the mixed layout; `what` names the
@@ -790,11 +788,12 @@ impl MixedDetection {
 
 impl DetectionModel for MixedDetection {
     fn detection_probability(&self, particles: &ParticleSet, ctx: &StepContext, out: &mut [f64]) {
-        if let Some(m) = kind_of_set(particles).and_then(|k| self.own[slot(k)].as_ref()) {
+        let kind = kind_of_set(particles);
+        if let Some(m) = kind.and_then(|k| self.own[slot(k)].as_ref()) {
             m.detection_probability(particles, ctx, out);
             return;
         }
-        let p = match kind_of_set(particles) {
+        let p = match kind {
             Some(ObjectKind::Plane) => self.plane,
             Some(ObjectKind::Cluster) => self.cluster,
             None => 0.0,
@@ -861,13 +860,14 @@ impl MixedClutter {
 
 impl ClutterModel for MixedClutter {
     fn log_intensity(&self, z: &[f64], ctx: &StepContext) -> f64 {
+        // a measurement of no known kind counts as a wall's
         let kind = kind_of_measurement(z).unwrap_or(ObjectKind::Plane);
         if let Some(m) = &self.own[slot(kind)] {
             return m.log_intensity(z, ctx);
         }
-        match kind_of_measurement(z) {
-            Some(ObjectKind::Cluster) => self.log_cluster,
-            _ => self.log_plane,
+        match kind {
+            ObjectKind::Cluster => self.log_cluster,
+            ObjectKind::Plane => self.log_plane,
         }
     }
 }

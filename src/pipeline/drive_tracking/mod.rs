@@ -11,9 +11,9 @@
 //! frame with constant velocity. The ground is not tracked (see [`detect`]).
 //!
 //! [`DriveTracker::step`] is the per-frame step on ready-made detections (for benchmarks);
-//! [`track_recording`] runs a whole
-//! recording and hands every frame (cloud, detections, report) to a callback, which is where a
-//! caller draws progress or writes labelled point clouds ([`export`]).
+//! [`track_recording`] runs a whole recording and hands every frame (cloud, detections,
+//! report) to a callback, which is where a caller draws progress or writes labelled point
+//! clouds ([`export`]).
 //!
 //! Not for: plane prediction scoring (see [`super::plane_prediction`]) or evaluation against
 //! ground truth.
@@ -436,9 +436,9 @@ pub const DUPLICATE_MERGE_THRESHOLD: f64 = 9.0;
 /// estimate, or only those at 0.99, both scored lower.
 pub const REPORT_MIN_EXISTENCE: f64 = 0.9;
 
-/// Everything [`track_recording`] needs besides the recording and the seed. Every field has a default;
-/// a JSON or TOML file may set any subset (in `planes` too: the fields it leaves out keep
-/// [`PlaneConfig::default`]'s values).
+/// Everything [`track_recording`] needs besides the recording and the seed. Every field has a
+/// default; a JSON or TOML file may set any subset (in `planes` too: the fields it leaves out
+/// keep [`PlaneConfig::default`]'s values).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct TrackingConfig {
@@ -655,11 +655,7 @@ pub fn track_recording(
         return Err(Error::invalid(what, reason));
     }
     check_frame_range(frames.as_ref(), n, &what)?;
-    if config.ego.is_predicted() && !rec.has_vehicle() {
-        // the recording's own words for what is missing
-        rec.vehicle()?;
-    }
-    let (poses, ego) = choose_poses(config, rec)?;
+    // A recording without vehicle motion says so in its own words, before any pose is read.
     let vehicle = if config.ego.is_predicted() {
         let v = rec.vehicle()?;
         let measured: Vec<[f64; 6]> = v.states.iter().map(|s| s.to_array()).collect();
@@ -667,21 +663,13 @@ pub fn track_recording(
     } else {
         None
     };
+    let (poses, ego) = choose_poses(config, rec)?;
     let times = match rec.times()? {
         Some(t) => t,
         None => (0..n).map(|k| k as f64 * config.dt).collect(),
     };
     track_frames(
-        rec,
-        &rec.name(),
-        &ego,
-        poses,
-        vehicle,
-        &times,
-        frames,
-        config,
-        seed,
-        on_frame,
+        rec, &ego, poses, vehicle, &times, frames, config, seed, on_frame,
     )
 }
 
@@ -792,7 +780,6 @@ fn check_frame_range(frames: Option<&Range<usize>>, n: usize, what: &str) -> Res
 #[allow(clippy::too_many_arguments)]
 fn track_frames(
     rec: &dyn Recording,
-    name: &str,
     ego_name: &str,
     poses: Option<Vec<Isometry3<f64>>>,
     vehicle_motion: Option<(Vec<[f64; 6]>, Isometry3<f64>)>,
@@ -802,6 +789,7 @@ fn track_frames(
     seed: u64,
     mut on_frame: impl FnMut(&FrameView<'_>) -> Result<()>,
 ) -> Result<DriveTracks> {
+    let name = &rec.name();
     let range = frames.unwrap_or(0..rec.frame_count());
     // The frames of the range that have a scan.
     let scans: Vec<usize> = range.clone().filter(|&k| rec.has_scan(k)).collect();

@@ -1,13 +1,14 @@
 //! [`RecordingSource`]: which recording a tracking run reads — a KITTI raw drive, a tracking
-//! sequence, an odometry sequence or a folder of scans, by where it lives — opened and tracked the same way
-//! whatever its layout, for the command line and the Python package alike.
+//! sequence, an odometry sequence or a folder of scans, by where it lives — opened and
+//! tracked the same way whatever its layout, for the command line and the Python package
+//! alike.
 //!
 //! Not for: the tracking loop itself (see [`super::track_recording`]).
 
 use super::{track_recording, DriveTracks, FrameView, TrackingConfig};
 use crate::error::Result;
 use crate::kitti::{OdometrySequence, RawDrive, TrackingSequence};
-use crate::recording::{Recording, ScanDirectory};
+use crate::recording::{folder_name, Recording, ScanDirectory};
 use std::ops::Range;
 use std::path::PathBuf;
 
@@ -33,19 +34,12 @@ pub enum RecordingSource {
 }
 
 impl RecordingSource {
-    /// A short name: the drive folder's name, or `tracking_NNNN` / `odometry_NN`.
+    /// A short name: the drive's or scan folder's name, or `tracking_NNNN` / `odometry_NN`.
     pub fn name(&self) -> String {
         match self {
-            RecordingSource::Raw(dir) => dir
-                .file_name()
-                .map(|n| n.to_string_lossy().into_owned())
-                .unwrap_or_else(|| dir.display().to_string()),
+            RecordingSource::Raw(dir) | RecordingSource::Scans { dir, .. } => folder_name(dir),
             RecordingSource::Tracking(_, n) => format!("tracking_{n:04}"),
             RecordingSource::Odometry(_, n) => format!("odometry_{n:02}"),
-            RecordingSource::Scans { dir, .. } => dir
-                .file_name()
-                .map(|n| n.to_string_lossy().into_owned())
-                .unwrap_or_else(|| dir.display().to_string()),
         }
     }
 

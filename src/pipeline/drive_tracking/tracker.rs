@@ -9,7 +9,8 @@
 //! takes the detection's box size. The matches also give every detection (and so every
 //! point) a track number for the labelled exports.
 //!
-//! Not for: reading drives or segmenting clouds (see [`super::detect`], [`super::track_recording`]).
+//! Not for: reading drives or segmenting clouds (see [`super::detect`],
+//! [`super::track_recording`]).
 
 use super::detect::{detect_here, FrameDetections};
 use super::output::{OrientedBox, StageTimes, TrackedCluster, TrackedFrame, TrackedPlane};
