@@ -46,22 +46,30 @@ impl MergeDistance for ScaledDistance {
 }
 
 /// Squared distance between two densities' means, component `c` scaled by `σ²_a,c + σ²_b,c`.
-/// Components that neither density spreads (variance 0 in both, such as a kind code) must be
-/// equal; otherwise the densities are of different things and `None` is returned.
+/// Components that neither density spreads (such as a kind code) must be equal; otherwise the
+/// densities are of different things and `None` is returned. "Not spread" and "equal" are
+/// judged to rounding ([`CONSTANT_TOLERANCE`] of the component's magnitude): a weighted mean of
+/// equal values is not always exactly that value, and the spread it leaves (about 1e-16) must
+/// not count as a distance.
 pub fn scaled_distance2(a: (&[f64], &[f64]), b: (&[f64], &[f64])) -> Option<f64> {
     let ((ma, sa), (mb, sb)) = (a, b);
     let mut d2 = 0.0;
     for c in 0..ma.len().min(mb.len()) {
         let var = sa[c] * sa[c] + sb[c] * sb[c];
         let diff = ma[c] - mb[c];
-        if var > 0.0 {
+        let rounding = CONSTANT_TOLERANCE * ma[c].abs().max(mb[c].abs()).max(1.0);
+        if var > rounding * rounding {
             d2 += diff * diff / var;
-        } else if diff != 0.0 {
+        } else if diff.abs() > rounding {
             return None;
         }
     }
     d2.is_finite().then_some(d2)
 }
+
+/// The relative size below which a component's spread, or two means' difference, is rounding
+/// ([`scaled_distance2`]).
+pub const CONSTANT_TOLERANCE: f64 = 1e-12;
 
 /// The pairs `(survivor, absorbed)` of track indices to merge: among the pairs of tracks that
 /// claim the same measurement (`claims[i]` is the measurement track `i` most probably
@@ -176,6 +184,21 @@ mod tests {
         assert_eq!(same_kind, Some(2.0));
         let other_kind = scaled_distance2((&[1.0, 2.0], &[0.0, 1.0]), (&[2.0, 2.0], &[0.0, 1.0]));
         assert_eq!(other_kind, None);
+    }
+
+    #[test]
+    fn a_constant_component_left_with_rounding_spread_counts_only_by_being_equal() {
+        // Six equal weights of 1/6 sum to 0.9999999999999999: the weighted mean of a constant
+        // 1.0 misses it by one rounding step and leaves a spread of about 1e-16.
+        let rows = vec![vec![1.0, 0.0]; 6];
+        let set = ParticleSet::from_rows(&rows, &[1.0; 6]).unwrap();
+        let (mean, std) = set.mean_and_std_dev();
+        assert!(mean[0] < 1.0 && std[0] > 0.0, "mean {mean:?} std {std:?}");
+        let exact = ([1.0, 0.5], [0.0, 1.0]);
+        let d2 = scaled_distance2((&mean, &std), (&exact.0, &exact.1)).unwrap();
+        assert!((d2 - 0.25).abs() < 1e-12, "{d2}");
+        let other = ([2.0, 0.5], [1e-17, 1.0]);
+        assert_eq!(scaled_distance2((&mean, &std), (&other.0, &other.1)), None);
     }
 
     #[test]
