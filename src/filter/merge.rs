@@ -33,6 +33,20 @@ pub trait MergeDistance: Send + Sync {
     /// Squared distance between two densities, each summarised by its mean and the standard
     /// deviation of every component; `None` when the two may not merge.
     fn distance2(&self, a: (&[f64], &[f64]), b: (&[f64], &[f64])) -> Option<f64>;
+
+    /// [`MergeDistance::distance2`] for two densities with the tags of their particle sets
+    /// ([`crate::filter::ParticleSet::tag`]), which is what the filter calls: by default sets
+    /// of different tags never merge and the tags say nothing else.
+    fn tagged_distance2(
+        &self,
+        a: (Option<u32>, &[f64], &[f64]),
+        b: (Option<u32>, &[f64], &[f64]),
+    ) -> Option<f64> {
+        if a.0 != b.0 {
+            return None;
+        }
+        self.distance2((a.1, a.2), (b.1, b.2))
+    }
 }
 
 /// [`scaled_distance2`] for every pair of tracks: the default [`MergeDistance`].
@@ -110,7 +124,8 @@ pub fn duplicate_pairs(
         .filter_map(|(a, b)| {
             let (ma, sa) = summary[a].as_ref()?;
             let (mb, sb) = summary[b].as_ref()?;
-            let d2 = distance.distance2((ma, sa), (mb, sb))?;
+            let (ta, tb) = (tracks[a].particles.tag(), tracks[b].particles.tag());
+            let d2 = distance.tagged_distance2((ta, ma, sa), (tb, mb, sb))?;
             (d2 <= threshold).then_some((d2, a, b))
         })
         .collect();
@@ -172,6 +187,28 @@ mod tests {
         let rows: Vec<Vec<f64>> = xs.iter().map(|&x| vec![x]).collect();
         let particles = ParticleSet::from_rows(&rows, &vec![1.0; xs.len()]).unwrap();
         Track::new(Label::new(step, 0), existence, particles)
+    }
+
+    #[test]
+    fn sets_of_different_tags_never_merge() {
+        let (m, sd) = ([0.0, 0.0], [1.0, 1.0]);
+        let d = ScaledDistance;
+        assert_eq!(
+            d.tagged_distance2((None, &m, &sd), (None, &m, &sd)),
+            Some(0.0)
+        );
+        assert_eq!(
+            d.tagged_distance2((Some(1), &m, &sd), (Some(1), &m, &sd)),
+            Some(0.0)
+        );
+        assert_eq!(
+            d.tagged_distance2((Some(0), &m, &sd), (Some(1), &m, &sd)),
+            None
+        );
+        assert_eq!(
+            d.tagged_distance2((Some(0), &m, &sd), (None, &m, &sd)),
+            None
+        );
     }
 
     #[test]

@@ -83,20 +83,35 @@ impl StepContext {
 }
 
 /// Per-track summary handed to gates: weighted mean and per-component standard deviation of
-/// the predicted particle set.
+/// the predicted particle set, and the set's tag ([`ParticleSet::tag`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TrackSummary {
     /// Weighted mean state.
     pub mean: Vec<f64>,
     /// Weighted standard deviation of each state component.
     pub std: Vec<f64>,
+    /// The particle set's tag.
+    pub tag: Option<u32>,
 }
 
 impl TrackSummary {
-    /// The weighted mean and standard deviation of `particles`.
+    /// The weighted mean and standard deviation of `particles`, and its tag.
     pub fn of(particles: &ParticleSet) -> TrackSummary {
         let (mean, std) = particles.mean_and_std_dev();
-        TrackSummary { mean, std }
+        TrackSummary {
+            mean,
+            std,
+            tag: particles.tag(),
+        }
+    }
+
+    /// An untagged summary of `mean` and `std`.
+    pub fn new(mean: Vec<f64>, std: Vec<f64>) -> TrackSummary {
+        TrackSummary {
+            mean,
+            std,
+            tag: None,
+        }
     }
 }
 

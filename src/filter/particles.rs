@@ -45,6 +45,8 @@ pub struct ParticleSet {
     history_depth: usize,
     /// The slot holding the states one step back.
     history_head: usize,
+    /// What kind of object the set describes, when a user marks it ([`ParticleSet::tag`]).
+    tag: Option<u32>,
 }
 
 /// What is added to resampled particles to restore diversity.
@@ -135,6 +137,7 @@ impl ParticleSet {
             history_lag: 0,
             history_depth: 0,
             history_head: 0,
+            tag: None,
         }
     }
 
@@ -178,6 +181,26 @@ impl ParticleSet {
     /// State dimension.
     pub fn dim(&self) -> usize {
         self.dim
+    }
+
+    /// What kind of object the set describes, when its maker marked it: a typed tag beside
+    /// the states (the drive tracker marks walls and clusters so), never a state component.
+    /// Every operation on the set keeps it (prediction, reweighting, resampling, merging, a
+    /// clone); the filter itself never reads it, except that sets of different tags are never
+    /// merged as duplicates ([`crate::filter::MergeDistance::tagged_distance2`]).
+    pub fn tag(&self) -> Option<u32> {
+        self.tag
+    }
+
+    /// The same set marked with `tag` ([`ParticleSet::tag`]).
+    pub fn with_tag(mut self, tag: u32) -> Self {
+        self.tag = Some(tag);
+        self
+    }
+
+    /// Marks the set with `tag`, or clears the mark.
+    pub fn set_tag(&mut self, tag: Option<u32>) {
+        self.tag = tag;
     }
 
     /// Number of particles.

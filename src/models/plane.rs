@@ -633,6 +633,7 @@ mod tests {
         let track = TrackSummary {
             mean: vec![-1.0, 0.0, 0.0, 10.0],
             std: vec![0.0, 0.01, 0.0, 0.1],
+            tag: None,
         };
         let ctx = StepContext::new(1, 0.1, 0.1);
         assert!(m.gate(&[1.0, 0.0, 0.0, -10.5], &track, &ctx));

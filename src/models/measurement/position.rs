@@ -219,6 +219,7 @@ mod tests {
         let track = TrackSummary {
             mean: vec![0.0, 0.0, 0.0, 0.0],
             std: vec![4.0, 1.0, 4.0, 1.0],
+            tag: None,
         };
         // combined std 5, gate 10 per axis
         assert!(m.gate(&[10.0, -10.0], &track, &ctx()));

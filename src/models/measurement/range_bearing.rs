@@ -612,6 +612,7 @@ mod tests {
             let mut track = TrackSummary {
                 mean: vec![mean.0, 0.0, mean.1, 0.0],
                 std: vec![spread.0, 0.1, spread.1, 0.1],
+                tag: None,
             };
             match broken {
                 1 => track.mean[0] = f64::NAN,
@@ -650,6 +651,7 @@ mod tests {
         let track = TrackSummary {
             mean: vec![0.0, 0.0, 1000.0, 0.0, 0.0],
             std: vec![20.0, 5.0, 20.0, 5.0, 0.01],
+            tag: None,
         };
         // 3σ in range and 3σ in bearing away from the mean: inside a 5σ gate
         let z = [1030.0, 6f64.to_radians()];
@@ -672,6 +674,7 @@ mod tests {
         let track = TrackSummary {
             mean: vec![0.0, 0.0, 1000.0, 0.0, 0.0],
             std: vec![20.0, 5.0, 20.0, 5.0, 0.01],
+            tag: None,
         };
         assert!(m.gate(&[1180.0, 0.0], &track, &ctx()));
         assert!(!m.gate(&[1200.0, 0.0], &track, &ctx()));
@@ -681,6 +684,7 @@ mod tests {
         let near = TrackSummary {
             mean: vec![0.0, 0.0, 10.0, 0.0, 0.0],
             std: vec![5.0, 1.0, 5.0, 1.0, 0.0],
+            tag: None,
         };
         assert!(m.gate(&[10.0, PI], &near, &ctx()));
     }

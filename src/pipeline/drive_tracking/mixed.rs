@@ -1,18 +1,18 @@
 //! Two kinds of object in one filter: building-wall planes and Euclidean point clusters
 //! (cars, pedestrians, poles), each a labelled track of the same [`LmbFilter`].
 //!
-//! # State (7 components)
+//! # State (6 components) and kind (a tag)
 //!
-//! | kind | components 0–5 | component 6 |
-//! |---|---|---|
-//! | plane | `[n_x, n_y, n_z, d, 0, 0]` in the **sensor frame of the current step** | 0 |
-//! | cluster | `[x, ẋ, y, ẏ, z, ż]` in the **world frame** | 1 |
+//! | kind | state |
+//! |---|---|
+//! | plane | `[n_x, n_y, n_z, d, 0, 0]` in the **sensor frame of the current step** |
+//! | cluster | `[x, ẋ, y, ẏ, z, ż]` in the **world frame** |
 //!
-//! The kind is one state component ([`KIND`]) so that a track is an ordinary particle set;
-//! every particle of a track carries the same kind (births set it, no transition changes it,
-//! and the resampling kernel adds nothing to a component without spread). Models read the kind
-//! of a set from its first particle ([`kind_of_set`]) and dispatch once per set, so the hot
-//! loops stay the plain structure-of-arrays loops of the single-kind models.
+//! The kind is not a state component: it is the particle set's tag
+//! ([`crate::filter::ParticleSet::tag`], [`ObjectKind::tag`]), set by the birth sampler and
+//! kept by everything the filter does to the set. Models read the kind of a set
+//! ([`kind_of_set`]) and dispatch once per set, so the hot loops stay the plain
+//! structure-of-arrays loops of the single-kind models.
 //!
 //! # Measurement (5 components)
 //!
@@ -68,9 +68,7 @@ use rand_distr::{Distribution, StandardNormal};
 use std::sync::Arc;
 
 /// Dimension of the mixed state.
-pub const STATE_DIM: usize = 7;
-/// Index of the kind component in the state.
-pub const KIND: usize = 6;
+pub const STATE_DIM: usize = 6;
 /// Dimension of a mixed measurement.
 pub const MEASUREMENT_DIM: usize = 5;
 /// Index of the kind component in a measurement.
@@ -82,12 +80,19 @@ pub const MEASUREMENT_KIND: usize = 4;
 pub struct MixedMergeDistance;
 
 impl MergeDistance for MixedMergeDistance {
+    /// Untagged densities (not the tracker's): [`ScaledDistance`].
     fn distance2(&self, a: (&[f64], &[f64]), b: (&[f64], &[f64])) -> Option<f64> {
-        let cluster = |m: &[f64]| {
-            m.get(KIND).copied().and_then(ObjectKind::from_code) == Some(ObjectKind::Cluster)
-        };
-        if cluster(a.0) && cluster(b.0) {
-            ScaledDistance.distance2(a, b)
+        ScaledDistance.distance2(a, b)
+    }
+
+    fn tagged_distance2(
+        &self,
+        a: (Option<u32>, &[f64], &[f64]),
+        b: (Option<u32>, &[f64], &[f64]),
+    ) -> Option<f64> {
+        let cluster = Some(ObjectKind::Cluster.tag());
+        if a.0 == cluster && b.0 == cluster {
+            ScaledDistance.distance2((a.1, a.2), (b.1, b.2))
         } else {
             None
         }
@@ -105,7 +110,24 @@ pub enum ObjectKind {
 }
 
 impl ObjectKind {
-    /// The value stored in the kind component.
+    /// The particle-set tag of the kind ([`crate::filter::ParticleSet::tag`]).
+    pub fn tag(self) -> u32 {
+        match self {
+            ObjectKind::Plane => 0,
+            ObjectKind::Cluster => 1,
+        }
+    }
+
+    /// The kind of a particle-set tag.
+    pub fn from_tag(tag: u32) -> Option<Self> {
+        match tag {
+            0 => Some(ObjectKind::Plane),
+            1 => Some(ObjectKind::Cluster),
+            _ => None,
+        }
+    }
+
+    /// The value stored in a measurement's kind component.
     pub fn code(self) -> f64 {
         match self {
             ObjectKind::Plane => 0.0,
@@ -126,13 +148,9 @@ impl ObjectKind {
     }
 }
 
-/// The kind of a particle set, read from its first particle (`None` when empty, too short or
-/// not a known code).
+/// The kind of a particle set, its tag (`None` when untagged or not a kind's tag).
 pub fn kind_of_set(particles: &ParticleSet) -> Option<ObjectKind> {
-    if particles.dim() <= KIND || particles.is_empty() {
-        return None;
-    }
-    ObjectKind::from_code(particles.component(KIND)[0])
+    particles.tag().and_then(ObjectKind::from_tag)
 }
 
 /// The kind of a measurement or of a mean state.
@@ -241,9 +259,8 @@ impl MixedTransition {
     }
 
     /// The same transition whose clusters move by `model` instead of constant velocity: it
-    /// gets a cluster's state [x, ẋ, y, ẏ, z, ż] (and the kind tag after it, which it must
-    /// not need: the tag is written back after each prediction). A model of neither 4 nor 6
-    /// components is an error naming it.
+    /// gets a cluster's state [x, ẋ, y, ẏ, z, ż] (a 4-component model moves the first four
+    /// and leaves the height). A model of neither 4 nor 6 components is an error naming it.
     pub fn with_road_users(mut self, model: Arc<dyn TransitionModel>) -> Result<Self> {
         let d = model.state_dim();
         if d != 4 && d != 6 {
@@ -287,19 +304,13 @@ impl TransitionModel for MixedTransition {
             Some(ObjectKind::Plane) => self.plane.predict(particles, ctx, rng),
             Some(ObjectKind::Cluster) => match &self.road_users {
                 None => self.cluster.predict(particles, ctx, rng),
-                Some(m) => {
-                    m.predict(particles, ctx, rng)?;
-                    particles
-                        .component_mut(KIND)
-                        .fill(ObjectKind::Cluster.code());
-                    Ok(())
-                }
+                Some(m) => m.predict(particles, ctx, rng),
             },
             None => Err(Error::invalid(
-                format!("state handed to {}", self.name()),
+                format!("particle set handed to {}", self.name()),
                 format!(
-                    "component {KIND} of particle 0 is {}, neither a wall's nor a cluster's kind",
-                    particles.component(KIND)[0]
+                    "its tag {:?} is neither a wall's nor a cluster's kind",
+                    particles.tag()
                 ),
             )),
         }
@@ -716,11 +727,7 @@ impl MeasurementModel for MixedMeasurement {
     }
 
     fn gate(&self, z: &[f64], track: &TrackSummary, ctx: &StepContext) -> bool {
-        let track_kind = track
-            .mean
-            .get(KIND)
-            .copied()
-            .and_then(ObjectKind::from_code);
+        let track_kind = track.tag.and_then(ObjectKind::from_tag);
         let z_kind = kind_of_measurement(z);
         if track_kind.is_none() || track_kind != z_kind {
             return false;
@@ -729,10 +736,7 @@ impl MeasurementModel for MixedMeasurement {
             return m.gate(z, track, ctx);
         }
         if track_kind == Some(ObjectKind::Plane) {
-            let summary = TrackSummary {
-                mean: track.mean[..4].to_vec(),
-                std: track.std[..4].to_vec(),
-            };
+            let summary = TrackSummary::new(track.mean[..4].to_vec(), track.std[..4].to_vec());
             return self.plane.gate(&z[..4], &summary, ctx);
         }
         // Cluster: compare in the world frame, per axis.
@@ -916,15 +920,14 @@ impl MixedBirthSampler {
 
 impl BirthSampler for MixedBirthSampler {
     fn sample(&self, z: &[f64], ctx: &StepContext, n: usize, rng: &mut FilterRng) -> ParticleSet {
-        let mut set = ParticleSet::zeroed(STATE_DIM, n);
         let Some(kind) = kind_of_measurement(z) else {
             return ParticleSet::zeroed(STATE_DIM, 0);
         };
+        let mut set = ParticleSet::zeroed(STATE_DIM, n).with_tag(kind.tag());
         let mut comps = set.components_mut();
-        let [c0, c1, c2, c3, c4, c5, kind_col] = comps.as_mut_slice() else {
+        let [c0, c1, c2, c3, c4, c5] = comps.as_mut_slice() else {
             unreachable!("a mixed set has {STATE_DIM} components");
         };
-        kind_col.fill(kind.code());
         let mut g = || -> f64 { StandardNormal.sample(rng) };
         match kind {
             ObjectKind::Plane => {
@@ -975,6 +978,20 @@ mod tests {
             previous_platform: Some(Isometry3::identity()),
             ..StepContext::new(1, 0.1, 0.1)
         }
+    }
+
+    /// Equally weighted cluster particles of `rows`.
+    fn cluster_set(rows: &[Vec<f64>]) -> ParticleSet {
+        ParticleSet::from_rows(rows, &vec![1.0; rows.len()])
+            .unwrap()
+            .with_tag(ObjectKind::Cluster.tag())
+    }
+
+    /// Equally weighted wall particles of `rows`.
+    fn plane_set(rows: &[Vec<f64>]) -> ParticleSet {
+        ParticleSet::from_rows(rows, &vec![1.0; rows.len()])
+            .unwrap()
+            .with_tag(ObjectKind::Plane.tag())
     }
 
     fn sampler() -> MixedBirthSampler {
@@ -1034,10 +1051,7 @@ mod tests {
         assert!(out.iter().all(|v| *v == f64::NEG_INFINITY));
         m.log_likelihood(&plane_z, &planes, &c, &mut out);
         assert!(out.iter().all(|v| v.is_finite()));
-        let summary = |s: &ParticleSet| TrackSummary {
-            mean: s.mean(),
-            std: s.std_dev(),
-        };
+        let summary = TrackSummary::of;
         assert!(!m.gate(&cluster_z, &summary(&planes), &c));
         assert!(!m.gate(&plane_z, &summary(&clusters), &c));
         assert!(m.gate(&plane_z, &summary(&planes), &c));
@@ -1079,10 +1093,7 @@ mod tests {
         m.log_likelihood(&plane_z, &planes, &c, &mut out);
         built_in.log_likelihood(&plane_z, &planes, &c, &mut want);
         assert_eq!(out, want);
-        let summary = |s: &ParticleSet| TrackSummary {
-            mean: s.mean(),
-            std: s.std_dev(),
-        };
+        let summary = TrackSummary::of;
         assert!(!m.gate(&cluster_z, &summary(&clusters), &c));
         assert!(m.gate(&plane_z, &summary(&planes), &c));
         // the relative likelihoods of a cluster set: every particle as likely as the best
@@ -1104,8 +1115,7 @@ mod tests {
             Vector3::new(0.0, 0.0, std::f64::consts::FRAC_PI_2),
         );
         let c = ctx(pose);
-        let set =
-            ParticleSet::from_rows(&[vec![10.0, 0.0, 5.0, 0.0, 0.0, 0.0, 1.0]], &[1.0]).unwrap();
+        let set = cluster_set(&[vec![10.0, 0.0, 5.0, 0.0, 0.0, 0.0]]);
         let m = MixedMeasurement::new(PlaneMeasurement::new(0.05, 0.2).unwrap(), 0.5, 4.0).unwrap();
         let mut out = [0.0];
         m.log_likelihood(&cluster_measurement([5.0, 0.0, 0.0]), &set, &c, &mut out);
@@ -1127,9 +1137,9 @@ mod tests {
         let offsets = [0.2, 0.7, 1.0, 2.5, 8.0, 40.0, f64::NAN];
         let rows: Vec<Vec<f64>> = offsets
             .iter()
-            .map(|&d| vec![7.0 + d, 0.0, 3.0, 0.0, -1.0, 0.0, 1.0])
+            .map(|&d| vec![7.0 + d, 0.0, 3.0, 0.0, -1.0, 0.0])
             .collect();
-        let set = ParticleSet::from_rows(&rows, &[1.0; 7]).unwrap();
+        let set = cluster_set(&rows);
         let m = MixedMeasurement::new(PlaneMeasurement::new(0.05, 0.2).unwrap(), 0.3, 4.0)
             .unwrap()
             .with_cluster_outliers(0.1, 4.0)
@@ -1172,9 +1182,9 @@ mod tests {
         let c = ctx(Isometry3::identity());
         let rows: Vec<Vec<f64>> = [0.0, 0.3, 1.0, 2.5, 8.0]
             .iter()
-            .map(|&d| vec![5.0 + d, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0])
+            .map(|&d| vec![5.0 + d, 0.0, 0.0, 0.0, 0.0, 0.0])
             .collect();
-        let set = ParticleSet::from_rows(&rows, &[1.0; 5]).unwrap();
+        let set = cluster_set(&rows);
         let plane = PlaneMeasurement::new(0.05, 0.2).unwrap();
         let m = MixedMeasurement::new(plane, 0.3, 4.0)
             .unwrap()
@@ -1246,15 +1256,21 @@ mod tests {
         let mv = Isometry3::new(Vector3::new(1.0, 0.0, 0.0), Vector3::zeros());
         let c = ctx(mv);
         let t = MixedTransition::measured(0.0, 0.0, 0.0).unwrap();
-        let mut plane =
-            ParticleSet::from_rows(&[vec![-1.0, 0.0, 0.0, 10.0, 0.0, 0.0, 0.0]], &[1.0]).unwrap();
+        let mut plane = plane_set(&[vec![-1.0, 0.0, 0.0, 10.0, 0.0, 0.0]]);
         t.predict(&mut plane, &c, &mut seeded(1)).unwrap();
-        assert_eq!(plane.state(0), vec![-1.0, 0.0, 0.0, 9.0, 0.0, 0.0, 0.0]);
-        let mut cluster =
-            ParticleSet::from_rows(&[vec![0.0, 2.0, 0.0, -1.0, 0.0, 0.0, 1.0]], &[1.0]).unwrap();
+        assert_eq!(plane.state(0), vec![-1.0, 0.0, 0.0, 9.0, 0.0, 0.0]);
+        let mut cluster = cluster_set(&[vec![0.0, 2.0, 0.0, -1.0, 0.0, 0.0]]);
         t.predict(&mut cluster, &c, &mut seeded(1)).unwrap();
         let s = cluster.state(0);
-        assert!((s[0] - 0.2).abs() < 1e-12 && (s[2] + 0.1).abs() < 1e-12 && s[6] == 1.0);
+        assert!((s[0] - 0.2).abs() < 1e-12 && (s[2] + 0.1).abs() < 1e-12);
+        assert_eq!(kind_of_set(&cluster), Some(ObjectKind::Cluster));
+        // an untagged set is neither kind: an error naming the model
+        let mut bare = ParticleSet::from_rows(&[vec![0.0; 6]], &[1.0]).unwrap();
+        let e = t
+            .predict(&mut bare, &c, &mut seeded(1))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("MixedTransition") && e.contains("tag"), "{e}");
     }
 
     /// A vehicle-model ego moves walls from the vehicle state the frame brings, and a step
@@ -1264,9 +1280,7 @@ mod tests {
         let ect = crate::models::ExtendedConstantTurn::new(0.5, 0.1).unwrap();
         let t = MixedTransition::predicted(Arc::new(ect), Isometry3::identity(), 0.0, 0.0, 0.0)
             .unwrap();
-        let wall = || {
-            ParticleSet::from_rows(&[vec![-1.0, 0.0, 0.0, 10.0, 0.0, 0.0, 0.0]], &[1.0]).unwrap()
-        };
+        let wall = || plane_set(&[vec![-1.0, 0.0, 0.0, 10.0, 0.0, 0.0]]);
         let bare = StepContext::new(1, 0.1, 0.1);
         let e = t
             .predict(&mut wall(), &bare, &mut seeded(1))
@@ -1277,8 +1291,7 @@ mod tests {
             "{e}"
         );
         // clusters need no vehicle state
-        let mut cluster =
-            ParticleSet::from_rows(&[vec![0.0, 2.0, 0.0, -1.0, 0.0, 0.0, 1.0]], &[1.0]).unwrap();
+        let mut cluster = cluster_set(&[vec![0.0, 2.0, 0.0, -1.0, 0.0, 0.0]]);
         t.predict(&mut cluster, &bare, &mut seeded(1)).unwrap();
         // 10 m/s along x for 0.1 s: the wall 10 m ahead (normal −x) comes about 1 m nearer
         let start = VehicleStart(vec![0.0, 10.0, 0.0, 0.0, 0.0, 0.0]);
@@ -1303,8 +1316,7 @@ mod tests {
             (cl.log_intensity(&cluster_measurement([0.0; 3]), &c) - 0.002f64.ln()).abs() < 1e-12
         );
         let d = MixedDetection::new(0.9, 0.7).unwrap();
-        let set =
-            ParticleSet::from_rows(&[vec![0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]], &[1.0]).unwrap();
+        let set = cluster_set(&[vec![0.0; 6]]);
         let mut out = [0.0];
         d.detection_probability(&set, &c, &mut out);
         assert_eq!(out, [0.7]);

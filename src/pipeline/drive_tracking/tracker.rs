@@ -27,8 +27,8 @@ use crate::geometry::Plane;
 use crate::models::plane::plane_residual;
 use crate::models::{PlaneMeasurement, VehicleModel, VehicleState};
 use crate::pipeline::drive_tracking::mixed::{
-    MixedBirthSampler, MixedClutter, MixedDetection, MixedMeasurement, MixedMergeDistance,
-    MixedTransition, ObjectKind, VehicleStart, KIND,
+    kind_of_set, MixedBirthSampler, MixedClutter, MixedDetection, MixedMeasurement,
+    MixedMergeDistance, MixedTransition, ObjectKind, VehicleStart,
 };
 use crate::rng::{seeded, FilterRng};
 use nalgebra::{Isometry3, Point3, Vector3};
@@ -435,8 +435,15 @@ impl DriveTracker {
     ) -> Result<(Vec<TrackedPlane>, Vec<TrackedCluster>)> {
         let mut planes: Vec<(&Estimate, [f64; 4])> = Vec::new();
         let mut clusters: Vec<(&Estimate, Point3<f64>)> = Vec::new();
+        // the kind of each track: its particle set's tag
+        let kinds: HashMap<Label, ObjectKind> = self
+            .filter
+            .tracks()
+            .iter()
+            .filter_map(|t| kind_of_set(&t.particles).map(|k| (t.label, k)))
+            .collect();
         for e in estimates {
-            match e.state.get(KIND).copied().and_then(ObjectKind::from_code) {
+            match kinds.get(&e.label).copied() {
                 Some(ObjectKind::Plane) => {
                     let s = &e.state;
                     planes.push((e, canonical(&[s[0], s[1], s[2], s[3]])));
