@@ -320,9 +320,9 @@ impl TransitionModel for MixedTransition {
 /// A user's own measurement, detection and clutter models for one kind of object (walls or
 /// clusters), used by the drive tracker instead of its built-in ones (code only: a
 /// configuration file tunes the built-in ones). Each gets the mixed layout of the module
-/// documentation: the 7-component state (the kind in component 6) and the 5-component
-/// measurement (the kind in component 4), and is only ever asked about its own kind: a
-/// measurement of the other kind never reaches it.
+/// documentation: the 6-component state (the kind is the particle set's tag, not a component)
+/// and the 5-component measurement (the kind in component 4), and is only ever asked about its
+/// own kind: a measurement of the other kind never reaches it.
 #[derive(Clone, Default)]
 pub struct OwnModels {
     /// The measurement model (its `measurement_dim` must be 5).
