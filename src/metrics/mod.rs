@@ -9,6 +9,7 @@
 //! | [`gospa`](mod@gospa) | GOSPA (α = 2) with localisation / missed / false-alarm parts |
 //! | [`ospa2`](mod@ospa2) | OSPA(2) between sets of tracks over a time window (and a sliding series) |
 //! | [`cardinality`] | Per-step and mean error in the number of objects |
+//! | [`detection_ap`] | KITTI's average precision of 3-D detections (11 and 40 recall points, easy / moderate / hard) |
 //! | [`labels`] | Label switches and label persistence of estimates matched to truth |
 //! | [`plane_prediction`] | Area, vertex-distance and normal-angle errors of predicted plane patches |
 //! | [`rmse`] | RMS error of error vectors and the averaged-NIS consistency check |
@@ -25,6 +26,7 @@
 //! for the set metrics.
 
 pub mod cardinality;
+pub mod detection_ap;
 pub mod gospa;
 pub mod labels;
 pub mod ospa;
