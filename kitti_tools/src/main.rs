@@ -8,6 +8,7 @@ mod demo_cmd;
 mod detections_cmd;
 mod eval_cmd;
 mod info_cmd;
+mod objects_cmd;
 mod odometry_cmd;
 mod paper_tables;
 mod planes_cmd;
@@ -64,6 +65,10 @@ enum Command {
     /// the clusters, wall accuracy, and optionally the recording's plane-prediction
     /// statistics.
     Eval(eval_cmd::Args),
+    /// Score the tracker's road-user detector on single labelled frames of KITTI's 3-D object
+    /// benchmark: recall of cars and vans by occlusion level and range, precision, and
+    /// KITTI's bird's-eye average precision for Car (40 and 11 recall points, IoU 0.5 and 0.7).
+    Objects(objects_cmd::Args),
 }
 
 /// Writing to a closed pipe (`kitti-tools planes --all … | head`) ends the process quietly, as
@@ -92,5 +97,6 @@ fn main() -> Result<()> {
         Command::Track(args) => track_cmd::run(*args),
         Command::Batch(args) => batch_cmd::run(args),
         Command::Eval(args) => eval_cmd::run(args),
+        Command::Objects(args) => objects_cmd::run(args),
     }
 }

@@ -2,6 +2,7 @@
 //! segmenting walls in consecutive LiDAR frames, predicting them forward and scoring the
 //! prediction ([`plane_prediction`]); tracking walls and clusters through a whole drive
 //! ([`drive_tracking`]) and scoring the tracks against ground truth ([`drive_evaluation`]);
+//! scoring the tracker's detector on single labelled scans ([`object_frame_eval`]);
 //! tracking people in planar laser scans and scoring the trackers ([`people_tracking`]).
 //!
 //! Not for: the filter itself (see [`crate::filter`]) or command-line parsing.
@@ -24,6 +25,8 @@ pub use drive_tracking::{track_recording, DriveTracker, DriveTracks, TrackingCon
 pub mod drive_evaluation;
 #[cfg(feature = "kitti")]
 pub mod kitti_tracking_eval;
+#[cfg(feature = "kitti")]
+pub mod object_frame_eval;
 
 #[cfg(feature = "kitti")]
 pub mod box_baseline;
