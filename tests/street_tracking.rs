@@ -16,7 +16,8 @@
 
 use smc_lmb::kitti::RawDrive;
 use smc_lmb::pipeline::drive_evaluation::{
-    evaluate_clusters, evaluate_walls, street_object_truth, ClusterEvaluationConfig,
+    evaluate_clusters, evaluate_recording, evaluate_walls, street_object_truth,
+    ClusterEvaluationConfig, EvaluationOptions,
 };
 use smc_lmb::pipeline::{track_recording, TrackingConfig};
 use smc_lmb::sim::street::{write_drive, StreetConfig};
@@ -77,4 +78,26 @@ fn cluster_and_wall_tracks_of_a_simulated_street_meet_their_bounds() {
         "localisation {localisation} > {bound}"
     );
     assert!(missed < 0.5, "missed {missed} per frame");
+
+    // The drive as a recording scores the same through its own labels (its truth.json).
+    let options = EvaluationOptions::default();
+    let by_recording = evaluate_recording(&tracks, &drive, &options).unwrap();
+    assert_eq!(by_recording.clusters, eval);
+    assert_eq!(by_recording.walls.as_ref(), Some(&walls));
+    // Only a tracking sequence's labels have a camera view.
+    let camera = EvaluationOptions {
+        camera_view: true,
+        ..options
+    };
+    let err = evaluate_recording(&tracks, &drive, &camera)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("camera view"), "{err}");
+    // Without its truth.json the drive has nothing to score against, and says which drive.
+    std::fs::remove_file(written.dir.join("truth.json")).unwrap();
+    let err = evaluate_recording(&tracks, &drive, &options)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("has no labels"), "{err}");
+    assert!(err.contains(&written.dir.display().to_string()), "{err}");
 }

@@ -318,3 +318,55 @@ fn pipelines_run_on_the_tracking_layout_as_on_the_raw_drive() {
         .to_string();
     assert!(err.contains("beyond its 100 frames"), "{err}");
 }
+
+#[test]
+fn the_sequence_scores_tracks_against_its_own_labels() {
+    use smc_lmb::pipeline::drive_evaluation::{
+        evaluate_clusters, evaluate_recording, label_truth, retain_clusters, EvaluationOptions,
+    };
+    use smc_lmb::pipeline::{track_recording, TrackingConfig};
+    use smc_lmb::recording::RecordingLabels;
+    let Some(s) = shared() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    assemble(&s, tmp.path(), FRAMES);
+    let seq = TrackingSequence::open(tmp.path(), 0).unwrap();
+    // The labels are the file's lines; the raw drive of the shared data has none.
+    let lines = std::fs::read_to_string(s.tracking.join("label_02/0000.txt"))
+        .unwrap()
+        .lines()
+        .filter(|l| !l.trim().is_empty())
+        .count();
+    match Recording::labels(&seq).unwrap() {
+        Some(RecordingLabels::Camera { labels, .. }) => assert_eq!(labels.len(), lines),
+        other => panic!("{other:?}"),
+    }
+    assert!(Recording::labels(&RawDrive::open(&s.drive).unwrap())
+        .unwrap()
+        .is_none());
+    let mut c = TrackingConfig::default();
+    c.filter.particles = 100;
+    let tracks = track_recording(&seq, Some(0..10), &c, 1, |_| Ok(())).unwrap();
+    let options = EvaluationOptions {
+        camera_view: true,
+        ..EvaluationOptions::default()
+    };
+    let scored = evaluate_recording(&tracks, &seq, &options).unwrap();
+    assert!(scored.walls.is_none());
+    // The same as the pieces put together by hand: labels within 40 m in camera 2's view,
+    // tracks in its view.
+    let calib = seq.calib().unwrap();
+    let truth = label_truth(
+        &seq.labels().unwrap(),
+        &calib.rect_from_velo(),
+        &seq.poses().unwrap(),
+        |b| b.center.x.hypot(b.center.y) <= 40.0 && calib.in_image2(&b.center),
+    );
+    let mut in_view = tracks.clone();
+    retain_clusters(&mut in_view, |p| {
+        calib.in_image2(&Point3::new(p[0], p[1], p[2]))
+    });
+    let by_hand = evaluate_clusters(&in_view, &truth, &options.clusters).unwrap();
+    assert_eq!(scored.clusters, by_hand);
+    assert_eq!(scored.clusters.frames.len(), 10);
+    assert!(scored.clusters.frames.iter().any(|f| f.truth > 0));
+}

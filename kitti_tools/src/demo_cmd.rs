@@ -7,12 +7,10 @@
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use smc_lmb::kitti::RawDrive;
-use smc_lmb::pipeline::drive_evaluation::{
-    evaluate_clusters, evaluate_walls, street_object_truth, ClusterEvaluationConfig,
-};
+use smc_lmb::pipeline::drive_evaluation::{evaluate_recording, Evaluation, EvaluationOptions};
 use smc_lmb::pipeline::drive_tracking::drive_plot;
 use smc_lmb::pipeline::{predict_pairs, track_recording, PlanePredictionConfig, TrackingConfig};
-use smc_lmb::sim::street::{write_drive, StreetConfig, StreetTruth, TRUTH_FILE};
+use smc_lmb::sim::street::{write_drive, StreetConfig, TRUTH_FILE};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -87,7 +85,6 @@ pub fn run(args: Args) -> Result<()> {
         println!("reusing the simulated street in {}", dir.display());
     }
     let drive = RawDrive::open(&dir).with_context(|| format!("opening {}", dir.display()))?;
-    let truth = StreetTruth::read(dir.join(TRUTH_FILE))?;
 
     // Plane prediction, seed 001 Sec. 5: frame k's walls moved to k + 1 by ECT Monte Carlo.
     println!(
@@ -132,12 +129,8 @@ pub fn run(args: Args) -> Result<()> {
 
     // Scores against the street's truth.
     println!();
-    let clusters = evaluate_clusters(
-        &tracks,
-        &street_object_truth(&truth, 15, 40.0),
-        &ClusterEvaluationConfig::default(),
-    )?;
-    let walls = evaluate_walls(&tracks, &truth)?;
-    crate::eval_cmd::print_evaluation(&tracks, &clusters, Some(&walls));
+    let Evaluation { clusters, walls } =
+        evaluate_recording(&tracks, &drive, &EvaluationOptions::default())?;
+    crate::eval_cmd::print_evaluation(&tracks.drive, &clusters, walls.as_ref());
     Ok(())
 }

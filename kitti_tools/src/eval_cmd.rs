@@ -8,13 +8,13 @@ use anyhow::{bail, Context, Result};
 use smc_lmb::kitti::{read_tracklets, RawDrive, TrackingSequence};
 use smc_lmb::metrics::PlanePredictionSummary;
 use smc_lmb::pipeline::drive_evaluation::{
-    evaluate_clusters, evaluate_walls, label_truth, retain_clusters, street_object_truth,
-    tracklet_truth, ClusterEvaluation, ClusterEvaluationConfig, FrameScore, TruthFrames,
-    WallEvaluation,
+    evaluate_labels, ClusterEvaluation, ClusterEvaluationConfig, Evaluation, EvaluationOptions,
+    FrameScore, WallEvaluation,
 };
 use smc_lmb::pipeline::{predict_pairs, DriveTracks, PlanePredictionConfig};
+use smc_lmb::recording::{Recording, RecordingLabels};
 use smc_lmb::sim::street::StreetTruth;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Flags of `eval`.
 #[derive(clap::Args)]
@@ -80,12 +80,6 @@ pub struct Args {
     json: bool,
 }
 
-enum Truth {
-    Street(Box<StreetTruth>),
-    /// Objects per frame only (KITTI tracklets or tracking labels): no walls.
-    Objects(TruthFrames),
-}
-
 /// The tracking sequence of `--tracking` / `--sequence`, if given.
 fn tracking_sequence(args: &Args) -> Result<Option<(TrackingSequence, String)>> {
     let (Some(root), Some(n)) = (&args.tracking, args.sequence) else {
@@ -96,103 +90,71 @@ fn tracking_sequence(args: &Args) -> Result<Option<(TrackingSequence, String)>> 
     Ok(Some((seq, what)))
 }
 
-/// The objects of a tracking sequence's `label_02` file in the world frame of its poses,
-/// within `max_range` and, with `camera_view`, in camera 2's image.
-fn label_02_truth(
-    seq: &TrackingSequence,
-    what: &str,
-    max_range: f64,
-    camera_view: bool,
-) -> Result<Truth> {
-    let labels = seq
-        .labels()
-        .with_context(|| format!("reading the labels of {what}"))?;
-    let calib = seq
-        .calib()
-        .with_context(|| format!("reading the calibration of {what}"))?;
-    let poses = seq.poses().with_context(|| format!("poses of {what}"))?;
-    Ok(Truth::Objects(label_truth(
-        &labels,
-        &calib.rect_from_velo(),
-        &poses,
-        |b| {
-            b.center.x.hypot(b.center.y) <= max_range
-                && (!camera_view || calib.in_image2(&b.center))
-        },
-    )))
+/// The recording of `--tracking` / `--sequence` or `--drive`, if given.
+fn open_recording(args: &Args) -> Result<Option<Box<dyn Recording>>> {
+    if let Some((seq, _)) = tracking_sequence(args)? {
+        return Ok(Some(Box::new(seq)));
+    }
+    match &args.drive {
+        Some(dir) => {
+            Ok(Some(Box::new(RawDrive::open(dir).with_context(|| {
+                format!("opening drive {}", dir.display())
+            })?)))
+        }
+        None => Ok(None),
+    }
 }
 
-fn load_truth(args: &Args) -> Result<Truth> {
-    if let Some((seq, what)) = tracking_sequence(args)? {
-        return label_02_truth(&seq, &what, args.max_range, args.camera_view);
-    }
-    let street = |p: &Path| -> Result<Truth> {
-        Ok(Truth::Street(Box::new(StreetTruth::read(p).with_context(
-            || format!("reading street truth {}", p.display()),
-        )?)))
-    };
-    let tracklets = |p: &Path| -> Result<Truth> {
-        let Some(dir) = &args.drive else {
-            bail!("--tracklets needs --drive for the poses of the frames");
-        };
-        let drive =
-            RawDrive::open(dir).with_context(|| format!("opening drive {}", dir.display()))?;
-        let poses = drive
-            .poses()
-            .with_context(|| format!("poses of drive {}", dir.display()))?;
-        let t = read_tracklets(p).with_context(|| format!("reading tracklets {}", p.display()))?;
-        Ok(Truth::Objects(tracklet_truth(&t, &poses)))
-    };
-    match (&args.truth, &args.tracklets, &args.drive) {
+/// The labels to score against: `--truth` or `--tracklets` when given, else the recording's
+/// own.
+fn labels(args: &Args, recording: Option<&dyn Recording>) -> Result<RecordingLabels> {
+    match (&args.truth, &args.tracklets, recording) {
         (Some(_), Some(_), _) => bail!("give --truth or --tracklets, not both"),
-        (Some(p), None, _) => street(p),
-        (None, Some(p), _) => tracklets(p),
-        (None, None, Some(dir)) => {
-            let (t, x) = (dir.join("truth.json"), dir.join("tracklet_labels.xml"));
-            if t.is_file() {
-                street(&t)
-            } else if x.is_file() {
-                tracklets(&x)
-            } else {
-                bail!(
-                    "{} holds neither truth.json nor tracklet_labels.xml; name the truth with \
-                     --truth or --tracklets",
-                    dir.display()
-                )
+        (Some(p), None, _) => Ok(RecordingLabels::Street(Box::new(
+            StreetTruth::read(p)
+                .with_context(|| format!("reading street truth {}", p.display()))?,
+        ))),
+        (None, Some(p), _) => {
+            if args.drive.is_none() {
+                bail!("--tracklets needs --drive for the poses of the frames");
             }
+            Ok(RecordingLabels::Tracklets(read_tracklets(p).with_context(
+                || format!("reading tracklets {}", p.display()),
+            )?))
         }
+        (None, None, Some(rec)) => rec
+            .labels()
+            .with_context(|| format!("reading the labels of {}", rec.describe()))?
+            .with_context(|| {
+                format!(
+                    "{} has no labels (a tracking sequence's label_02, a drive's truth.json or \
+                     tracklet_labels.xml); name the truth with --truth or --tracklets",
+                    rec.describe()
+                )
+            }),
         (None, None, None) => bail!("give --drive, --truth, --tracklets or --tracking"),
     }
 }
 
-fn plane_statistics(args: &Args) -> Result<Option<PlanePredictionSummary>> {
+fn plane_statistics(
+    args: &Args,
+    recording: Option<&dyn Recording>,
+) -> Result<Option<PlanePredictionSummary>> {
     if !args.planes {
         return Ok(None);
     }
-    let mut rng = smc_lmb::rng::seeded(1);
-    if let Some((seq, what)) = tracking_sequence(args)? {
-        let results = predict_pairs(
-            &seq,
-            None,
-            &PlanePredictionConfig::default(),
-            args.runs,
-            &mut rng,
-        )
-        .with_context(|| format!("predicting planes of {what}"))?;
-        return Ok(Some(crate::planes_cmd::pairs_and_summary(&results).1));
-    }
-    let Some(dir) = &args.drive else {
+    let Some(rec) = recording else {
         bail!("--planes needs --drive or --tracking");
     };
-    let drive = RawDrive::open(dir).with_context(|| format!("opening drive {}", dir.display()))?;
+    let mut rng = smc_lmb::rng::seeded(1);
     let results = predict_pairs(
-        &drive,
+        rec,
         None,
         &PlanePredictionConfig::default(),
         args.runs,
         &mut rng,
     )
-    .with_context(|| format!("predicting planes of drive {}", dir.display()))?;
+    .with_context(|| format!("predicting planes of {}", rec.describe()))?;
     Ok(Some(crate::planes_cmd::pairs_and_summary(&results).1))
 }
 
@@ -216,33 +178,30 @@ pub fn run(args: Args) -> Result<()> {
         .tracks
         .clone()
         .context("give --tracks (or --results)")?;
-    let mut tracks = DriveTracks::read_json(&tracks_path)
+    let tracks = DriveTracks::read_json(&tracks_path)
         .with_context(|| format!("reading tracks {}", tracks_path.display()))?;
-    if args.camera_view {
-        if let Some((seq, what)) = tracking_sequence(&args)? {
-            let calib = seq
-                .calib()
-                .with_context(|| format!("reading the calibration of {what}"))?;
-            retain_clusters(&mut tracks, |p| {
-                calib.in_image2(&nalgebra::Point3::new(p[0], p[1], p[2]))
-            });
-        }
-    }
-    let truth = load_truth(&args)?;
-    let config = ClusterEvaluationConfig {
-        cutoff: args.cutoff,
-        order: args.order,
-    };
-    let (frames, walls): (TruthFrames, Option<WallEvaluation>) = match &truth {
-        Truth::Street(t) => (
-            street_object_truth(t, args.min_points, args.max_range),
-            Some(evaluate_walls(&tracks, t)?),
+    let recording = open_recording(&args)?;
+    let labels = labels(&args, recording.as_deref())?;
+    let poses = match (&labels, &recording) {
+        (RecordingLabels::Street(_), _) | (_, None) => None,
+        (_, Some(rec)) => Some(
+            rec.poses()
+                .with_context(|| format!("poses of {}", rec.describe()))?,
         ),
-        Truth::Objects(f) => (f.clone(), None),
     };
-    let clusters = evaluate_clusters(&tracks, &frames, &config)
-        .with_context(|| format!("scoring {}", tracks_path.display()))?;
-    let planes = plane_statistics(&args)?;
+    let options = EvaluationOptions {
+        clusters: ClusterEvaluationConfig {
+            cutoff: args.cutoff,
+            order: args.order,
+        },
+        min_points: args.min_points,
+        max_range: args.max_range,
+        camera_view: args.camera_view,
+    };
+    let Evaluation { clusters, walls } =
+        evaluate_labels(&tracks, &labels, poses.as_deref(), &options)
+            .with_context(|| format!("scoring {}", tracks_path.display()))?;
+    let planes = plane_statistics(&args, recording.as_deref())?;
     if args.json {
         let out = serde_json::json!({
             "tracks": tracks_path,
@@ -253,7 +212,7 @@ pub fn run(args: Args) -> Result<()> {
         println!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
     }
-    print_evaluation(&tracks, &clusters, walls.as_ref());
+    print_evaluation(&tracks.drive, &clusters, walls.as_ref());
     if let Some(s) = &planes {
         println!(
             "plane prediction ({} runs): {} pairs, normal angle median {:.3}° p90 {:.3}°, vertex \
@@ -271,14 +230,10 @@ pub fn run(args: Args) -> Result<()> {
 }
 
 /// Prints the cluster and wall scores.
-pub fn print_evaluation(
-    tracks: &DriveTracks,
-    clusters: &ClusterEvaluation,
-    walls: Option<&WallEvaluation>,
-) {
+pub fn print_evaluation(run: &str, clusters: &ClusterEvaluation, walls: Option<&WallEvaluation>) {
     println!(
         "cluster tracks of {} ({} frames), c = {} m, p = {}:",
-        tracks.drive,
+        run,
         clusters.frames.len(),
         clusters.config.cutoff,
         clusters.config.order

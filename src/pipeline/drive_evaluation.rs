@@ -17,6 +17,7 @@ use super::drive_tracking::DriveTracks;
 use crate::error::{Error, Result};
 use crate::kitti::{TrackingLabel, Tracklets, VelodyneBox};
 use crate::metrics::{gospa, ospa, percentile, LabelConsistency, LabelStats};
+use crate::recording::{Recording, RecordingLabels};
 use crate::sim::street::StreetTruth;
 use nalgebra::{Isometry3, Point3, Vector3};
 
@@ -259,6 +260,120 @@ pub struct WallEvaluation {
     pub p90_offset_m: f64,
     /// Distinct truth walls matched at least once.
     pub walls_matched: usize,
+}
+
+/// What [`evaluate_labels`] and [`evaluate_recording`] count and how.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct EvaluationOptions {
+    /// OSPA / GOSPA settings.
+    pub clusters: ClusterEvaluationConfig,
+    /// A simulated object counts in a frame only with at least this many lidar points.
+    pub min_points: usize,
+    /// Simulated and tracking-labelled objects count only within this horizontal range of
+    /// the sensor (m); tracklets count wherever they are.
+    pub max_range: f64,
+    /// Score only what camera 2 sees — labelled objects and cluster tracks whose centre
+    /// appears in its image — as KITTI's tracking labels cover only that view (needs
+    /// [`RecordingLabels::Camera`]).
+    pub camera_view: bool,
+}
+
+impl Default for EvaluationOptions {
+    /// The default OSPA settings, 15 points, 40 m (the tracker's default cluster range), the
+    /// whole view.
+    fn default() -> Self {
+        EvaluationOptions {
+            clusters: ClusterEvaluationConfig::default(),
+            min_points: 15,
+            max_range: 40.0,
+            camera_view: false,
+        }
+    }
+}
+
+/// The scores of a tracking run against labels.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Evaluation {
+    /// The cluster tracks.
+    pub clusters: ClusterEvaluation,
+    /// The wall tracks, when the labels have walls (a simulated street).
+    pub walls: Option<WallEvaluation>,
+}
+
+/// Scores `tracks` against `labels`; `poses` are the recording's sensor poses, which
+/// tracklets and tracking labels need to reach the tracks' world frame (an error naming the
+/// labels when they are missing).
+pub fn evaluate_labels(
+    tracks: &DriveTracks,
+    labels: &RecordingLabels,
+    poses: Option<&[Isometry3<f64>]>,
+    options: &EvaluationOptions,
+) -> Result<Evaluation> {
+    let need_poses = || {
+        poses.ok_or_else(|| {
+            Error::invalid(
+                format!("scoring against {}", labels.kind()),
+                "needs the recording's poses",
+            )
+        })
+    };
+    if options.camera_view && !matches!(labels, RecordingLabels::Camera { .. }) {
+        return Err(Error::invalid(
+            format!("scoring against {}", labels.kind()),
+            "the camera view needs a tracking sequence's labels and calibration",
+        ));
+    }
+    let mut in_view;
+    let mut tracks = tracks;
+    let (frames, walls) = match labels {
+        RecordingLabels::Street(t) => (
+            street_object_truth(t, options.min_points, options.max_range),
+            Some(evaluate_walls(tracks, t)?),
+        ),
+        RecordingLabels::Tracklets(t) => (tracklet_truth(t, need_poses()?), None),
+        RecordingLabels::Camera { labels, calib } => {
+            if options.camera_view {
+                in_view = tracks.clone();
+                retain_clusters(&mut in_view, |p| {
+                    calib.in_image2(&Point3::new(p[0], p[1], p[2]))
+                });
+                tracks = &in_view;
+            }
+            let keep = |b: &VelodyneBox| {
+                b.center.x.hypot(b.center.y) <= options.max_range
+                    && (!options.camera_view || calib.in_image2(&b.center))
+            };
+            (
+                label_truth(labels, &calib.rect_from_velo(), need_poses()?, keep),
+                None,
+            )
+        }
+    };
+    Ok(Evaluation {
+        clusters: evaluate_clusters(tracks, &frames, &options.clusters)?,
+        walls,
+    })
+}
+
+/// Scores `tracks` against `recording`'s own labels ([`Recording::labels`]): the one entry
+/// point of the evaluation for a recording. A recording without labels is an error naming it.
+pub fn evaluate_recording(
+    tracks: &DriveTracks,
+    recording: &dyn Recording,
+    options: &EvaluationOptions,
+) -> Result<Evaluation> {
+    let Some(labels) = recording.labels()? else {
+        return Err(Error::invalid(
+            recording.describe(),
+            "has no labels to score against (a tracking sequence's label_02, a drive's \
+             tracklet_labels.xml or a simulated street's truth.json)",
+        ));
+    };
+    let poses = match labels {
+        RecordingLabels::Street(_) => None,
+        _ => Some(recording.poses()?),
+    };
+    evaluate_labels(tracks, &labels, poses.as_deref(), options)
 }
 
 /// Compares every confirmed wall report that has a rectangle with the truth wall closest to

@@ -7,11 +7,12 @@
 //!
 //! Not for: reading the layouts' files (see [`crate::kitti`]).
 
-use super::{Recording, VehicleMotion};
+use super::{Recording, RecordingLabels, VehicleMotion};
 use crate::cloud::PointCloud;
 use crate::error::{Error, Result};
 use crate::kitti::tracking::FRAME_PERIOD;
-use crate::kitti::{OdometrySequence, RawDrive, TrackingSequence};
+use crate::kitti::{read_tracklets, OdometrySequence, RawDrive, TrackingSequence};
+use crate::sim::street::StreetTruth;
 use nalgebra::Isometry3;
 use std::path::PathBuf;
 
@@ -80,6 +81,25 @@ impl Recording for RawDrive {
             intervals: self.oxts_timestamps()?.intervals(),
         })
     }
+    /// A simulated street's `truth.json` in the drive folder, else KITTI's
+    /// `tracklet_labels.xml` there, else none.
+    fn labels(&self) -> Result<Option<RecordingLabels>> {
+        let (street, tracklets) = (
+            self.dir().join("truth.json"),
+            self.dir().join("tracklet_labels.xml"),
+        );
+        if street.is_file() {
+            Ok(Some(RecordingLabels::Street(Box::new(StreetTruth::read(
+                &street,
+            )?))))
+        } else if tracklets.is_file() {
+            Ok(Some(RecordingLabels::Tracklets(read_tracklets(
+                &tracklets,
+            )?)))
+        } else {
+            Ok(None)
+        }
+    }
 }
 
 impl Recording for TrackingSequence {
@@ -122,6 +142,16 @@ impl Recording for TrackingSequence {
             vehicle_to_sensor: self.calib()?.imu_to_velo,
             intervals: vec![FRAME_PERIOD; steps],
         })
+    }
+    /// `label_02/NNNN.txt` with `calib/NNNN.txt`, when the sequence has labels.
+    fn labels(&self) -> Result<Option<RecordingLabels>> {
+        if !self.has_labels() {
+            return Ok(None);
+        }
+        Ok(Some(RecordingLabels::Camera {
+            labels: TrackingSequence::labels(self)?,
+            calib: Box::new(self.calib()?),
+        }))
     }
 }
 

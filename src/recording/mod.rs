@@ -4,14 +4,17 @@
 //! `odometry_of_scans_at`); the KITTI raw drive, tracking and odometry layouts implement it
 //! (`recording/kitti.rs`) and so does a plain folder of `.bin` or `.pcd` scans with an
 //! optional pose file and time file ([`ScanDirectory`]). A user's own layout is one more
-//! implementation.
+//! implementation. A recording with ground truth hands it over as [`RecordingLabels`]
+//! ([`Recording::labels`]), which `evaluate_recording` scores tracks against.
 //!
 //! Not for: reading the files of a layout (see [`crate::kitti`] and [`crate::cloud`]) or
-//! labels and their scoring (see [`crate::pipeline`]).
+//! scoring (see [`crate::pipeline::drive_evaluation`]).
 
 mod kitti;
+mod labels;
 mod scan_directory;
 
+pub use labels::RecordingLabels;
 pub use scan_directory::ScanDirectory;
 
 use crate::cloud::{is_pcd, NonFinite, PointCloud};
@@ -81,6 +84,11 @@ pub trait Recording: Sync {
             "has no measured vehicle motion (OXTS packets), which a vehicle ego model needs",
         ))
     }
+    /// The recording's own ground truth, `None` when it has none (the default). A labels
+    /// file that is there but cannot be read is an error naming it.
+    fn labels(&self) -> Result<Option<RecordingLabels>> {
+        Ok(None)
+    }
 }
 
 impl<R: Recording + ?Sized> Recording for &R {
@@ -122,6 +130,9 @@ impl<R: Recording + ?Sized> Recording for &R {
     }
     fn vehicle(&self) -> Result<VehicleMotion> {
         (**self).vehicle()
+    }
+    fn labels(&self) -> Result<Option<RecordingLabels>> {
+        (**self).labels()
     }
 }
 
