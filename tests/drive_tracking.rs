@@ -925,3 +925,63 @@ fn well_explained_walls_breed_no_lasting_duplicates() {
         "plane tracks per frame: {counts:?}"
     );
 }
+
+/// A folder of scans that knows its sensor's height hands it to the tracker: where a frame has
+/// no ground plane, points are clustered only above `ground_clearance` over the road at that
+/// height below the sensor. A van-sized box standing on a road 1.73 m below the sensor, with
+/// no road points, is a cluster with KITTI's height and none with a 0.5 m one (its top is
+/// 0.2 m under the sensor, not above 0.5 − 0.3 = 0.2 m under it).
+#[test]
+fn a_scan_folder_with_its_sensor_height_sets_the_ground_of_frames_without_one() {
+    use smc_lmb::cloud::write_kitti_bin;
+    use smc_lmb::pipeline::{track_recording, TrackingConfig};
+    use smc_lmb::recording::ScanDirectory;
+    let dir = tempfile::tempdir().unwrap();
+    // The four sides of a 4.5 × 1.9 × 1.53 m box from z = −1.73 to −0.2 (no top or bottom
+    // face: a horizontal face would be taken for the ground).
+    let (x0, y0, z0) = (5.75, -0.95, -1.73);
+    let mut points = Vec::new();
+    for (origin, along) in [
+        ([x0, y0, z0], [4.5, 0.0, 0.0]),
+        ([x0, y0 + 1.9, z0], [4.5, 0.0, 0.0]),
+        ([x0, y0, z0], [0.0, 1.9, 0.0]),
+        ([x0 + 4.5, y0, z0], [0.0, 1.9, 0.0]),
+    ] {
+        points.extend(grid(origin, along, [0.0, 0.0, 1.53], 0.1));
+    }
+    let cloud = PointCloud::from_records(
+        &points
+            .iter()
+            .map(|p| [p.x as f32, p.y as f32, p.z as f32, 0.5])
+            .collect::<Vec<_>>(),
+    );
+    for k in 0..3 {
+        write_kitti_bin(dir.path().join(format!("{k:06}.bin")), &cloud).unwrap();
+    }
+    let clusters_seen = |scans: ScanDirectory| {
+        let mut seen = 0;
+        track_recording(&scans, None, &TrackingConfig::default(), 1, |view| {
+            seen += view.detections.clusters.len();
+            Ok(())
+        })
+        .unwrap();
+        seen
+    };
+    let kitti = ScanDirectory::open(dir.path()).unwrap();
+    assert_eq!(kitti.sensor_height(), None);
+    assert_eq!(clusters_seen(kitti), 3);
+    let low = ScanDirectory::open(dir.path())
+        .unwrap()
+        .with_sensor_height(0.5)
+        .unwrap();
+    assert_eq!(low.sensor_height(), Some(0.5));
+    assert_eq!(clusters_seen(low), 0);
+    for bad in [0.0, -1.0, f64::NAN] {
+        let err = ScanDirectory::open(dir.path())
+            .unwrap()
+            .with_sensor_height(bad)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("sensor height"), "{err}");
+    }
+}

@@ -178,6 +178,7 @@ pub fn run(args: Args) -> Result<()> {
                 dir: dir.clone(),
                 poses: args.poses.clone(),
                 times: None,
+                sensor_height: None,
             }
             .open()?,
             None => bail!(

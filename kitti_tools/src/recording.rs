@@ -100,6 +100,7 @@ fn parse_line(line: &str, base: &Path) -> Result<Recording> {
             dir: at(dir),
             poses: rest.first().map(|p| at(p)),
             times: rest.get(1).map(|t| at(t)),
+            sensor_height: None,
         }),
         ["scans", ..] => bail!("expected `scans DIR [POSES [TIMES]]`"),
         [dir] => Ok(Recording::Raw(at(dir))),
@@ -141,6 +142,7 @@ mod tests {
                     dir: tmp.path().join("lidar/run1"),
                     poses: Some(tmp.path().join("lidar/run1_poses.txt")),
                     times: None,
+                    sensor_height: None,
                 },
             ]
         );

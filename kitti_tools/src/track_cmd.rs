@@ -37,6 +37,10 @@ pub struct Args {
     /// With `--scans`: a time file, one time in seconds per line, at least one per scan.
     #[arg(long, requires = "scans")]
     times: Option<PathBuf>,
+    /// With `--scans`: the sensor's height over the road (m), used where a frame has no
+    /// ground plane (overrides the config's `clusters.sensor_height`, KITTI's 1.73 m).
+    #[arg(long, requires = "scans")]
+    sensor_height: Option<f64>,
     /// A KITTI odometry root (holding `sequences/` and `poses/`); needs `--sequence`. Walls
     /// move by the ground-truth poses (sequences 00–10).
     #[arg(long, requires = "sequence", conflicts_with = "tracking")]
@@ -208,8 +212,13 @@ pub fn run(args: Args) -> Result<()> {
         ProgressStyle::with_template("{bar:40} {pos}/{len} frames {elapsed} {msg}")
             .expect("valid template"),
     );
-    if args.scans.is_none() && (args.poses.is_some() || args.times.is_some()) {
-        bail!("--poses and --times go with --scans DIR (the KITTI layouts bring their own)");
+    if args.scans.is_none()
+        && (args.poses.is_some() || args.times.is_some() || args.sensor_height.is_some())
+    {
+        bail!(
+            "--poses, --times and --sensor-height go with --scans DIR (the KITTI layouts bring \
+             their own)"
+        );
     }
     let recording = match (&args.drive, &args.odometry, &args.tracking, args.sequence) {
         (Some(dir), _, _, _) => Recording::Raw(dir.clone()),
@@ -220,6 +229,7 @@ pub fn run(args: Args) -> Result<()> {
                 dir: dir.clone(),
                 poses: args.poses.clone(),
                 times: args.times.clone(),
+                sensor_height: args.sensor_height,
             },
             None => bail!(
                 "give --drive DIR, --odometry ROOT --sequence NN, --tracking ROOT --sequence NNNN \

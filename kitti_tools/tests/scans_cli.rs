@@ -89,6 +89,24 @@ fn a_scan_folder_tracks_as_the_drive_it_came_from() {
         ],
     );
     assert_eq!(posed["ego"], "poses");
+    // A sensor height is taken; one that is no height is refused naming it.
+    let high = track(
+        "--scans",
+        &data,
+        &tmp.path().join("h.json"),
+        &["--sensor-height", "1.9"],
+    );
+    assert_eq!(high["frames"].as_array().unwrap().len(), 3);
+    let (ok, _, stderr) = run(&[
+        "track",
+        "--scans",
+        data.to_str().unwrap(),
+        "--sensor-height=0",
+        "--out",
+        tmp.path().join("bad.json").to_str().unwrap(),
+    ]);
+    assert!(!ok && stderr.contains("sensor height"), "{stderr}");
+    assert!(!tmp.path().join("bad.json").exists());
     let frames = posed["frames"].as_array().unwrap();
     assert_eq!(frames[2]["time"], 10.2);
     assert_eq!(
@@ -217,6 +235,16 @@ fn broken_scan_folders_and_files_are_named_and_nothing_is_written() {
         data.to_str().unwrap(),
         "--poses",
         short.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!ok && stderr.contains("--scans"), "{stderr}");
+    let (ok, _, stderr) = run(&[
+        "track",
+        "--drive",
+        data.to_str().unwrap(),
+        "--sensor-height",
+        "1.9",
         "--out",
         out.to_str().unwrap(),
     ]);

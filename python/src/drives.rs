@@ -63,6 +63,7 @@ pub fn recording_source(
             RecordingSource::Scans {
                 poses: beside("poses.txt"),
                 times: beside("times.txt"),
+                sensor_height: None,
                 dir: path,
             }
         }

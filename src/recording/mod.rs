@@ -89,6 +89,12 @@ pub trait Recording: Sync {
     fn labels(&self) -> Result<Option<RecordingLabels>> {
         Ok(None)
     }
+    /// The sensor's height over the road (m) when the recording knows it (a folder of scans
+    /// given one); the tracker's configured height (`ClusterTuning::sensor_height`, KITTI's
+    /// 1.73 m by default) otherwise. The tracker uses it where a frame has no ground plane.
+    fn sensor_height(&self) -> Option<f64> {
+        None
+    }
 }
 
 impl<R: Recording + ?Sized> Recording for &R {
@@ -133,6 +139,9 @@ impl<R: Recording + ?Sized> Recording for &R {
     }
     fn labels(&self) -> Result<Option<RecordingLabels>> {
         (**self).labels()
+    }
+    fn sensor_height(&self) -> Option<f64> {
+        (**self).sensor_height()
     }
 }
 

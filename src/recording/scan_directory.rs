@@ -23,6 +23,7 @@ pub struct ScanDirectory {
     scans: Vec<PathBuf>,
     poses: Option<(PathBuf, Vec<Isometry3<f64>>)>,
     times: Option<Vec<f64>>,
+    sensor_height: Option<f64>,
 }
 
 impl ScanDirectory {
@@ -66,6 +67,7 @@ impl ScanDirectory {
             scans,
             poses: None,
             times: None,
+            sensor_height: None,
         })
     }
 
@@ -110,6 +112,20 @@ impl ScanDirectory {
             ));
         }
         self.times = Some(times);
+        Ok(self)
+    }
+
+    /// The same folder with the sensor's height over the road (m), which the tracker uses
+    /// where a frame has no ground plane ([`Recording::sensor_height`]); a height that is not
+    /// finite and positive is an error.
+    pub fn with_sensor_height(mut self, height: f64) -> Result<ScanDirectory> {
+        if !(height.is_finite() && height > 0.0) {
+            return Err(Error::invalid(
+                format!("sensor height of {}", self.describe()),
+                format!("must be finite and positive, got {height}"),
+            ));
+        }
+        self.sensor_height = Some(height);
         Ok(self)
     }
 
@@ -159,6 +175,9 @@ impl Recording for ScanDirectory {
     }
     fn has_poses(&self) -> bool {
         self.poses.is_some()
+    }
+    fn sensor_height(&self) -> Option<f64> {
+        self.sensor_height
     }
     fn poses(&self) -> Result<Vec<Isometry3<f64>>> {
         match &self.poses {

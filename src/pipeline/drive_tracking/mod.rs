@@ -645,6 +645,20 @@ pub fn track_recording(
     on_frame: impl FnMut(&FrameView<'_>) -> Result<()>,
 ) -> Result<DriveTracks> {
     config.validate()?;
+    let with_height;
+    let config = match rec.sensor_height() {
+        Some(h) if h != config.clusters.sensor_height => {
+            with_height = TrackingConfig {
+                clusters: ClusterDetectionConfig {
+                    sensor_height: h,
+                    ..config.clusters.clone()
+                },
+                ..config.clone()
+            };
+            &with_height
+        }
+        _ => config,
+    };
     let what = rec.describe();
     let n = rec.frame_count();
     if n == 0 {

@@ -13,7 +13,7 @@ use std::ops::Range;
 use std::path::PathBuf;
 
 /// One recording to track.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum RecordingSource {
     /// A raw drive folder (`.../2011_09_26/2011_09_26_drive_0001_sync`).
     Raw(PathBuf),
@@ -30,6 +30,8 @@ pub enum RecordingSource {
         poses: Option<PathBuf>,
         /// One time (s) per line.
         times: Option<PathBuf>,
+        /// The sensor's height over the road (m), when known.
+        sensor_height: Option<f64>,
     },
 }
 
@@ -74,8 +76,16 @@ impl RecordingSource {
             RecordingSource::Raw(dir) => Box::new(RawDrive::open(dir)?),
             RecordingSource::Tracking(root, n) => Box::new(TrackingSequence::open(root, *n)?),
             RecordingSource::Odometry(root, n) => Box::new(OdometrySequence::open(root, *n)?),
-            RecordingSource::Scans { dir, poses, times } => {
+            RecordingSource::Scans {
+                dir,
+                poses,
+                times,
+                sensor_height,
+            } => {
                 let mut scans = ScanDirectory::open(dir)?;
+                if let Some(h) = sensor_height {
+                    scans = scans.with_sensor_height(*h)?;
+                }
                 if let Some(p) = poses {
                     scans = scans.with_poses(p)?;
                 }
