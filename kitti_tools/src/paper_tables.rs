@@ -41,9 +41,9 @@ const fn pair(pred: f64, seg: f64, v: [f64; 4], rad: f64) -> PaperPair {
     }
 }
 
-/// Seed 001, Tables 4–6 (k = 12, predicted from k = 11) and Tables 1–3 (k = 125), means of
-/// 100 Monte-Carlo runs on drive 0005.
-pub const SEED_001: [PaperTables; 2] = [
+/// Gostar et al. (2019), Tables 4–6 (k = 12, predicted from k = 11) and Tables 1–3 (k = 125),
+/// means of 100 Monte-Carlo runs on drive 0005.
+pub const GOSTAR_2019: [PaperTables; 2] = [
     PaperTables {
         frame: 12,
         tables: [4, 5, 6],
@@ -74,7 +74,7 @@ pub fn reference_for(source: &str, frame: usize) -> Option<&'static PaperTables>
     if !seed_drive {
         return None;
     }
-    SEED_001.iter().find(|t| t.frame == frame)
+    GOSTAR_2019.iter().find(|t| t.frame == frame)
 }
 
 /// For each of the paper's pairs, the index of our pair whose segmented area is closest in
@@ -231,14 +231,56 @@ pub fn print(result: &PairPrediction, runs: usize, paper: Option<&PaperTables>) 
         result.pairs.len()
     );
     if let Some(p) = paper {
-        let found = match_pairs(&result.pairs, p)
-            .iter()
-            .filter(|m| m.is_some())
-            .count();
+        let matched = match_pairs(&result.pairs, p);
+        let found = matched.iter().filter(|m| m.is_some()).count();
         println!(
             "{found} of the paper's 3 walls found and paired (segmented area within a factor of 2)"
         );
+        for (i, (theirs, m)) in p.pairs.iter().zip(matched).enumerate() {
+            println!(
+                "  {}",
+                wall_report(i + 1, theirs, m.map(|j| &result.pairs[j]))
+            );
+        }
     }
+}
+
+/// Largest relative difference of our segmented area from the paper's for a wall to count as
+/// reproduced, and the floors under the paper's normal angle (°) and mean vertex distance (m)
+/// that a reproduced wall's errors are held to.
+pub const AREA_TOLERANCE: f64 = 0.2;
+/// See [`AREA_TOLERANCE`].
+pub const ANGLE_FLOOR_DEG: f64 = 0.5;
+/// See [`AREA_TOLERANCE`].
+pub const VERTEX_FLOOR_M: f64 = 0.3;
+
+/// One line on the paper's wall `n`: not found, or our pair's segmented area, normal angle and
+/// mean vertex distance against the paper's, each marked as within the targets or not (area
+/// within [`AREA_TOLERANCE`]; angle and vertex distance at most the paper's or the floor).
+pub fn wall_report(n: usize, theirs: &PaperPair, ours: Option<&PlanePairError>) -> String {
+    let Some(o) = ours else {
+        return format!(
+            "paper wall {n} ({:.1} m² segmented): not found",
+            theirs.segmented_area
+        );
+    };
+    let mark = |ok: bool| if ok { "ok" } else { "not yet" };
+    let area = o.segmented_area / theirs.segmented_area - 1.0;
+    let angle = theirs.angle_rad.to_degrees().max(ANGLE_FLOOR_DEG);
+    let mean = |v: &[f64; 4]| v.iter().sum::<f64>() / 4.0;
+    let vertex = mean(&theirs.vertex_distances).max(VERTEX_FLOOR_M);
+    format!(
+        "paper wall {n} ({:.1} m² segmented): ours {:.1} m² ({:+.0} %, {}), normal angle {:.3}° \
+         (target ≤ {angle:.2}°, {}), mean vertex distance {:.3} m (target ≤ {vertex:.2} m, {})",
+        theirs.segmented_area,
+        o.segmented_area,
+        100.0 * area,
+        mark(area.abs() <= AREA_TOLERANCE),
+        o.normal_angle_deg,
+        mark(o.normal_angle_deg <= angle),
+        mean(&o.vertex_distances),
+        mark(mean(&o.vertex_distances) <= vertex),
+    )
 }
 
 #[cfg(test)]
@@ -270,8 +312,28 @@ mod tests {
     }
 
     #[test]
+    fn a_wall_is_judged_against_the_paper_or_the_floors() {
+        let p = &GOSTAR_2019[0];
+        // Paper wall 1: 33.78 m², 0.0034 rad = 0.19° (floor 0.5°), mean vertex 0.0989 m
+        // (floor 0.3 m).
+        let mut o = err(36.0);
+        o.normal_angle_deg = 0.4;
+        o.vertex_distances = [0.2, 0.3, 0.3, 0.3];
+        let line = wall_report(1, &p.pairs[0], Some(&o));
+        assert!(line.contains("36.0 m² (+7 %, ok)"), "{line}");
+        assert!(line.contains("0.400° (target ≤ 0.50°, ok)"), "{line}");
+        assert!(line.contains("0.275 m (target ≤ 0.30 m, ok)"), "{line}");
+        o.segmented_area = 41.0;
+        o.normal_angle_deg = 1.46;
+        let line = wall_report(1, &p.pairs[0], Some(&o));
+        assert!(line.contains("(+21 %, not yet)"), "{line}");
+        assert!(line.contains("1.460° (target ≤ 0.50°, not yet)"), "{line}");
+        assert!(wall_report(2, &p.pairs[1], None).ends_with("not found"));
+    }
+
+    #[test]
     fn pairs_match_by_area_one_to_one_within_a_factor_of_two() {
-        let p = &SEED_001[0];
+        let p = &GOSTAR_2019[0];
         // 90 m² goes to the paper's 90.57 m², 30 m² to 33.78 m², 21 to 23.06; 300 m² to none.
         let ours = [err(300.0), err(21.0), err(30.0), err(90.0)];
         assert_eq!(match_pairs(&ours, p), [Some(2), Some(1), Some(3)]);

@@ -83,6 +83,17 @@ fn paper_tables_on_the_papers_drive_find_its_three_walls() {
         text.contains("3 of the paper's 3 walls found and paired"),
         "{text}"
     );
+    // Each of the paper's walls on a line of its own, judged against the targets.
+    for n in 1..=3 {
+        let line = text
+            .lines()
+            .find(|l| l.trim_start().starts_with(&format!("paper wall {n} (")))
+            .unwrap_or_else(|| panic!("no line on paper wall {n} in\n{text}"));
+        assert!(
+            line.contains("normal angle") && line.contains("target"),
+            "{line}"
+        );
+    }
 }
 
 /// A simulated street of `frames` frames (seed 4) written under `dir` as a raw drive.
