@@ -6,8 +6,9 @@
 //! Each frame runs the tracker's own detection ([`detect_objects`]: ground and walls removed,
 //! clusters, oriented boxes, the one-frame class likelihood) with the tracking configuration the
 //! user gives, so a change of the detector shows here exactly as the tracker will see it.
-//! KITTI labels only what camera 2 sees, so only detections whose centre appears in its image
-//! are scored.
+//! KITTI labels only what camera 2 sees, so only detections whose box centre appears in its
+//! image count as false or enter the average precision; a labelled car whose visible part
+//! lies in the image may be found by a detection whose box centre lies just outside it.
 //!
 //! Two views of the same detections:
 //!
@@ -79,6 +80,8 @@ pub struct ScoredDetection {
     pub height_px: f64,
     /// Points in the cluster.
     pub points: usize,
+    /// Whether the box centre appears in camera 2's image.
+    pub in_view: bool,
 }
 
 /// Found of how many.
@@ -150,8 +153,8 @@ pub struct Miss {
     pub occluded: i32,
     /// Bird's-eye range of the label's centre from the sensor (m).
     pub range: f64,
-    /// The nearest detection in camera 2's view, whatever its class: its bird's-eye centre
-    /// distance (m), class and points.
+    /// The nearest detection, whatever its class: its bird's-eye centre distance (m), class
+    /// and points.
     pub nearest: Option<(f64, ObjectClass, usize)>,
 }
 
@@ -191,7 +194,7 @@ fn image_height(b: &Box3, calib: &TrackingCalib) -> f64 {
     }
 }
 
-/// The clusters of frame `k` whose centre camera 2 sees, scored.
+/// The clusters of frame `k`, scored.
 pub fn detect_object_frame(
     frames: &ObjectFrames,
     k: usize,
@@ -205,10 +208,8 @@ pub fn detect_object_frame(
     let mut out = Vec::new();
     for d in &found.clusters {
         let Some(shape) = &d.shape else { continue };
-        if !calib.in_image2(&shape.bbox.center) {
-            continue;
-        }
         out.push(ScoredDetection {
+            in_view: calib.in_image2(&shape.bbox.center),
             bbox: shape.bbox,
             class: shape.class,
             car_score: car_probability(&model.log_likelihoods(&shape.features)?),
@@ -324,7 +325,7 @@ fn count_frame(
         }
     }
     for (i, d) in reported.iter().enumerate() {
-        if bev_range(&d.bbox.center) > config.within {
+        if !d.in_view || bev_range(&d.bbox.center) > config.within {
             continue;
         }
         match det_match[i] {
@@ -355,6 +356,7 @@ struct ApFrame {
 }
 
 fn ap_frame(detections: &[ScoredDetection], truth: &FrameTruth) -> ApFrame {
+    let detections: Vec<&ScoredDetection> = detections.iter().filter(|d| d.in_view).collect();
     let class = |t: ObjectType| match t {
         ObjectType::Car => TruthClass::Evaluated,
         ObjectType::Van => TruthClass::Neighbour,
@@ -524,6 +526,7 @@ mod tests {
             car_score: score,
             height_px: 100.0,
             points: 100,
+            in_view: calib().in_image2(&Point3::new(x, y, -1.0)),
         }
     }
 
@@ -546,6 +549,7 @@ mod tests {
             label(ObjectType::Van, 25.0, 3.0, 2), // missed: only a pedestrian on it
             label(ObjectType::Truck, 15.0, -4.0, 1), // a vehicle on it: neither
             label(ObjectType::Car, 45.0, 0.0, 0), // beyond 40 m: not counted
+            label(ObjectType::Car, 4.0, 3.0, 0),  // in view, found from just outside it
             // Around the pixel of a point 30 m ahead, 6 m left and 1 m down:
             // (600 − 700·6/30, 180 + 700·1/30) = (460, 203.3).
             dont_care([420.0, 170.0, 500.0, 230.0]),
@@ -557,15 +561,18 @@ mod tests {
             detection(ObjectClass::Car, 30.0, 6.0, 0.8), // in the DontCare region
             detection(ObjectClass::Van, 20.0, -8.0, 0.7), // false
             detection(ObjectClass::Car, 44.0, 0.0, 0.6), // beyond range: not scored
+            detection(ObjectClass::Car, 2.0, 9.0, 0.9), // out of view, on nothing: not scored
+            // Out of view (y/x = 0.94 > 600/700) and 0.8 m from the last label.
+            detection(ObjectClass::Car, 3.2, 3.0, 0.9),
         ];
         let config = ObjectEvalConfig::default();
         let r = score_object_frames(&[(detections, labels, calib())], &config).unwrap();
-        assert_eq!(r.recall, Tally { hits: 1, total: 2 });
+        assert_eq!(r.recall, Tally { hits: 2, total: 3 });
         // The pedestrian cluster on the van finds it as a cluster, not as a vehicle.
-        assert_eq!(r.cluster_recall, Tally { hits: 2, total: 2 });
-        assert_eq!(r.recall_by_occlusion[0], Tally { hits: 1, total: 1 });
+        assert_eq!(r.cluster_recall, Tally { hits: 3, total: 3 });
+        assert_eq!(r.recall_by_occlusion[0], Tally { hits: 2, total: 2 });
         assert_eq!(r.recall_by_occlusion[2], Tally { hits: 0, total: 1 });
-        assert_eq!(r.recall_by_range[0], Tally { hits: 1, total: 1 });
+        assert_eq!(r.recall_by_range[0], Tally { hits: 2, total: 2 });
         assert_eq!(r.recall_by_range[2], Tally { hits: 0, total: 1 });
         assert_eq!(r.precision, Tally { hits: 1, total: 2 });
         assert_eq!(r.bev_ap.len(), 6);
