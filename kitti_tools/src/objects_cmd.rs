@@ -39,22 +39,6 @@ pub struct Args {
     quiet: bool,
 }
 
-fn parse_range(s: &str) -> Result<Vec<usize>> {
-    let (a, b) = s
-        .split_once("..")
-        .with_context(|| format!("--frames {s}: expected A..B"))?;
-    let a: usize = a
-        .trim()
-        .parse()
-        .with_context(|| format!("--frames {s}: start"))?;
-    let b: usize = b
-        .trim()
-        .parse()
-        .with_context(|| format!("--frames {s}: end"))?;
-    anyhow::ensure!(a < b, "--frames {s}: the range is empty");
-    Ok((a..b).collect())
-}
-
 fn ratio(t: &Tally) -> String {
     match t.ratio() {
         Some(r) => format!("{r:.2} ({}/{})", t.hits, t.total),
@@ -140,7 +124,7 @@ fn json_report(r: &ObjectFrameReport) -> serde_json::Value {
 pub fn run(args: Args) -> Result<()> {
     let frames = ObjectFrames::open(&args.root)?;
     let ks = match &args.frames {
-        Some(s) => parse_range(s)?,
+        Some(s) => crate::track_cmd::parse_range(s)?.collect(),
         None => frames
             .frames()
             .with_context(|| format!("listing the scans of {}", args.root.display()))?,

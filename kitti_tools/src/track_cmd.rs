@@ -154,7 +154,8 @@ impl From<Ego> for PoseSource {
     }
 }
 
-fn parse_range(text: &str) -> Result<Range<usize>> {
+/// `--frames A..B` (B excluded, after A); errors quote the flag.
+pub(crate) fn parse_range(text: &str) -> Result<Range<usize>> {
     let Some((a, b)) = text.split_once("..") else {
         bail!("--frames `{text}`: expected A..B");
     };

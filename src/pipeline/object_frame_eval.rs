@@ -549,7 +549,7 @@ mod tests {
             label(ObjectType::Van, 25.0, 3.0, 2), // missed: only a pedestrian on it
             label(ObjectType::Truck, 15.0, -4.0, 1), // a vehicle on it: neither
             label(ObjectType::Car, 45.0, 0.0, 0), // beyond 40 m: not counted
-            label(ObjectType::Car, 4.0, 3.0, 0),  // in view, found from just outside it
+            label(ObjectType::Car, 4.0, 3.0, 0), // in view, found from just outside it
             // Around the pixel of a point 30 m ahead, 6 m left and 1 m down:
             // (600 − 700·6/30, 180 + 700·1/30) = (460, 203.3).
             dont_care([420.0, 170.0, 500.0, 230.0]),
@@ -561,7 +561,7 @@ mod tests {
             detection(ObjectClass::Car, 30.0, 6.0, 0.8), // in the DontCare region
             detection(ObjectClass::Van, 20.0, -8.0, 0.7), // false
             detection(ObjectClass::Car, 44.0, 0.0, 0.6), // beyond range: not scored
-            detection(ObjectClass::Car, 2.0, 9.0, 0.9), // out of view, on nothing: not scored
+            detection(ObjectClass::Car, 2.0, 9.0, 0.9),  // out of view, on nothing: not scored
             // Out of view (y/x = 0.94 > 600/700) and 0.8 m from the last label.
             detection(ObjectClass::Car, 3.2, 3.0, 0.9),
         ];
