@@ -182,9 +182,9 @@ pub fn run(args: Args) -> Result<()> {
         .with_context(|| format!("reading tracks {}", tracks_path.display()))?;
     let recording = open_recording(&args)?;
     let labels = labels(&args, recording.as_deref())?;
-    let poses = match (&labels, &recording) {
-        (RecordingLabels::Street(_), _) | (_, None) => None,
-        (_, Some(rec)) => Some(
+    let poses = match (labels.needs_poses(), &recording) {
+        (false, _) | (_, None) => None,
+        (true, Some(rec)) => Some(
             rec.poses()
                 .with_context(|| format!("poses of {}", rec.describe()))?,
         ),

@@ -185,9 +185,10 @@ impl ParticleSet {
 
     /// What kind of object the set describes, when its maker marked it: a typed tag beside
     /// the states (the drive tracker marks walls and clusters so), never a state component.
-    /// Every operation on the set keeps it (prediction, reweighting, resampling, merging, a
-    /// clone); the filter itself never reads it, except that sets of different tags are never
-    /// merged as duplicates ([`crate::filter::MergeDistance::tagged_distance2`]).
+    /// Every operation that keeps particles keeps it (prediction, reweighting, resampling,
+    /// merging, a clone); a set resampled to nothing is left empty and untagged. The filter
+    /// itself never reads it, except that sets of different tags are never merged as
+    /// duplicates ([`crate::filter::MergeDistance::tagged_distance2`]).
     pub fn tag(&self) -> Option<u32> {
         self.tag
     }
@@ -196,11 +197,6 @@ impl ParticleSet {
     pub fn with_tag(mut self, tag: u32) -> Self {
         self.tag = Some(tag);
         self
-    }
-
-    /// Marks the set with `tag`, or clears the mark.
-    pub fn set_tag(&mut self, tag: Option<u32>) {
-        self.tag = tag;
     }
 
     /// Number of particles.

@@ -369,9 +369,10 @@ pub fn evaluate_recording(
              tracklet_labels.xml or a simulated street's truth.json)",
         ));
     };
-    let poses = match labels {
-        RecordingLabels::Street(_) => None,
-        _ => Some(recording.poses()?),
+    let poses = if labels.needs_poses() {
+        Some(recording.poses()?)
+    } else {
+        None
     };
     evaluate_labels(tracks, &labels, poses.as_deref(), options)
 }

@@ -31,7 +31,7 @@
 
 use super::drive_tracking::detect::detect_objects;
 use super::drive_tracking::TrackingConfig;
-use crate::cloud::classes::{default_prior, ClassModel, ObjectClass, CLASS_COUNT};
+use crate::cloud::classes::{default_prior, ClassBelief, ClassModel, ObjectClass, CLASS_COUNT};
 use crate::error::{Error, Result};
 use crate::geometry::{iou_bev, Box3};
 use crate::kitti::object::ObjectFrames;
@@ -163,17 +163,12 @@ fn is_vehicle(c: ObjectClass) -> bool {
     matches!(c, ObjectClass::Car | ObjectClass::Van | ObjectClass::Truck)
 }
 
-/// The car-or-van probability of a cluster's class log-likelihoods under the default prior.
-fn car_probability(ll: &[f64; CLASS_COUNT]) -> f64 {
-    let prior = default_prior();
-    let log_post: Vec<f64> = ll.iter().zip(&prior).map(|(l, p)| l + p.ln()).collect();
-    let top = log_post.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    if !top.is_finite() {
-        return 0.0;
-    }
-    let w: Vec<f64> = log_post.iter().map(|l| (l - top).exp()).collect();
-    let total: f64 = w.iter().sum();
-    (w[ObjectClass::Car.index()] + w[ObjectClass::Van.index()]) / total
+/// The car-or-van probability of a cluster's class log-likelihoods: one frame's Bayes update
+/// of the default prior.
+fn car_probability(ll: &[f64; CLASS_COUNT]) -> Result<f64> {
+    let mut belief = ClassBelief::new(default_prior())?;
+    belief.update(ll, 0.0)?;
+    Ok(belief.probability(ObjectClass::Car) + belief.probability(ObjectClass::Van))
 }
 
 /// Height in pixels of `b`'s projection into camera 2's image, clipped to the image; 0 when
@@ -212,7 +207,7 @@ pub fn detect_object_frame(
             in_view: calib.in_image2(&shape.bbox.center),
             bbox: shape.bbox,
             class: shape.class,
-            car_score: car_probability(&model.log_likelihoods(&shape.features)?),
+            car_score: car_probability(&model.log_likelihoods(&shape.features)?)?,
             height_px: image_height(&shape.bbox, calib),
             points: d.indices.len(),
         });
@@ -616,7 +611,7 @@ mod tests {
     fn equal_evidence_gives_the_prior_share_of_cars_and_vans() {
         // The prior's road-user counts (KITTI's label statistics), road users at 1/2.
         let want = 0.5 * (28_742.0 + 2_914.0) / (28_742.0 + 2_914.0 + 1_094.0 + 4_709.0 + 1_627.0);
-        assert!((car_probability(&[-3.0; CLASS_COUNT]) - want).abs() < 1e-12);
+        assert!((car_probability(&[-3.0; CLASS_COUNT]).unwrap() - want).abs() < 1e-12);
     }
 
     #[test]

@@ -12,7 +12,7 @@ use crate::cloud::PointCloud;
 use crate::error::{Error, Result};
 use crate::kitti::tracking::FRAME_PERIOD;
 use crate::kitti::{read_tracklets, OdometrySequence, RawDrive, TrackingSequence};
-use crate::sim::street::StreetTruth;
+use crate::sim::street::{StreetTruth, TRUTH_FILE};
 use nalgebra::Isometry3;
 use std::path::PathBuf;
 
@@ -81,11 +81,11 @@ impl Recording for RawDrive {
             intervals: self.oxts_timestamps()?.intervals(),
         })
     }
-    /// A simulated street's `truth.json` in the drive folder, else KITTI's
+    /// A simulated street's truth ([`TRUTH_FILE`]) in the drive folder, else KITTI's
     /// `tracklet_labels.xml` there, else none.
     fn labels(&self) -> Result<Option<RecordingLabels>> {
         let (street, tracklets) = (
-            self.dir().join("truth.json"),
+            self.dir().join(TRUTH_FILE),
             self.dir().join("tracklet_labels.xml"),
         );
         if street.is_file() {

@@ -27,6 +27,13 @@ pub enum RecordingLabels {
 }
 
 impl RecordingLabels {
+    /// Whether scoring against them needs the recording's poses: tracklets and tracking
+    /// labels are given per frame in the sensor frame, a simulated street's truth in the
+    /// world frame.
+    pub fn needs_poses(&self) -> bool {
+        !matches!(self, RecordingLabels::Street(_))
+    }
+
     /// What the labels are, for messages.
     pub fn kind(&self) -> &'static str {
         match self {

@@ -110,7 +110,9 @@ pub enum ObjectKind {
 }
 
 impl ObjectKind {
-    /// The particle-set tag of the kind ([`crate::filter::ParticleSet::tag`]).
+    /// The particle-set tag of the kind ([`crate::filter::ParticleSet::tag`]); also its
+    /// measurement code ([`ObjectKind::code`]) and its place in the per-kind arrays of the
+    /// mixed models.
     pub fn tag(self) -> u32 {
         match self {
             ObjectKind::Plane => 0,
@@ -127,21 +129,17 @@ impl ObjectKind {
         }
     }
 
-    /// The value stored in a measurement's kind component.
+    /// The value stored in a measurement's kind component: the tag.
     pub fn code(self) -> f64 {
-        match self {
-            ObjectKind::Plane => 0.0,
-            ObjectKind::Cluster => 1.0,
-        }
+        f64::from(self.tag())
     }
 
-    /// The kind of a stored code (rounded, so tiny rounding drift does not matter); `None`
-    /// for anything else.
+    /// The kind of a stored code (within 0.25 of a kind's, so tiny rounding drift does not
+    /// matter); `None` for anything else.
     pub fn from_code(v: f64) -> Option<Self> {
-        if (v - 0.0).abs() < 0.25 {
-            Some(ObjectKind::Plane)
-        } else if (v - 1.0).abs() < 0.25 {
-            Some(ObjectKind::Cluster)
+        let nearest = v.round();
+        if (v - nearest).abs() < 0.25 && (0.0..=f64::from(u32::MAX)).contains(&nearest) {
+            ObjectKind::from_tag(nearest as u32)
         } else {
             None
         }
@@ -153,7 +151,7 @@ pub fn kind_of_set(particles: &ParticleSet) -> Option<ObjectKind> {
     particles.tag().and_then(ObjectKind::from_tag)
 }
 
-/// The kind of a measurement or of a mean state.
+/// The kind of a measurement.
 pub fn kind_of_measurement(z: &[f64]) -> Option<ObjectKind> {
     z.get(MEASUREMENT_KIND)
         .copied()
@@ -272,9 +270,7 @@ impl MixedTransition {
         self.road_users = Some(model);
         Ok(self)
     }
-}
 
-impl MixedTransition {
     /// Whether planes move by a vehicle model's draw from the step's [`VehicleStart`].
     fn moves_by_vehicle(&self) -> bool {
         matches!(self.plane.ego(), EgoSource::Predicted { .. })
@@ -403,12 +399,9 @@ impl PartialEq for OwnModels {
     }
 }
 
-/// The index of a kind in the per-kind arrays of the mixed models.
+/// The index of a kind in the per-kind arrays of the mixed models: its tag.
 fn slot(kind: ObjectKind) -> usize {
-    match kind {
-        ObjectKind::Plane => 0,
-        ObjectKind::Cluster => 1,
-    }
+    kind.tag() as usize
 }
 
 /// Plane likelihood or sensor-frame position likelihood, chosen by the kind of the set; −∞
@@ -848,9 +841,7 @@ impl MixedClutter {
             own: [None, None],
         })
     }
-}
 
-impl MixedClutter {
     /// The same with a user's model for false walls and for false clusters where given.
     pub fn with_own(
         mut self,
