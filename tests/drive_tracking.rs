@@ -651,12 +651,24 @@ fn vendored_real_frame_static_sensor_keeps_labels() {
     assert!(!two.is_empty());
     let kept = two.intersection(&three).count();
     assert!(kept * 10 >= two.len() * 8, "{two:?} vs {three:?}");
+    // A static scene: the tracks seen since the first frame have settled near rest, and the
+    // reported speeds are small on the whole. A track born later carries its birth's velocity
+    // spread (4 m/s per axis) through two updates 0.1 s apart of a centre measured to 0.3 m:
+    // about 0.3·√2 / 0.2 ≈ 2.1 m/s per axis, so its speed alone says little.
+    let mut speeds = Vec::new();
     for f in &tracks.frames {
         for c in &f.clusters {
             let speed = c.velocity[0].hypot(c.velocity[1]);
-            assert!(speed < 3.0, "static scene, cluster {c:?}");
+            if c.label.birth_step == 0 {
+                assert!(speed < 3.0, "static scene, cluster {c:?}");
+            }
+            speeds.push(speed);
         }
     }
+    speeds.sort_by(f64::total_cmp);
+    let median = speeds[speeds.len() / 2];
+    eprintln!("reported cluster speeds: median {median:.2} m/s, max {:.2}", speeds[speeds.len() - 1]);
+    assert!(median < 1.0, "static scene, median speed {median}");
 }
 
 #[test]
