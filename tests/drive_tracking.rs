@@ -667,7 +667,10 @@ fn vendored_real_frame_static_sensor_keeps_labels() {
     }
     speeds.sort_by(f64::total_cmp);
     let median = speeds[speeds.len() / 2];
-    eprintln!("reported cluster speeds: median {median:.2} m/s, max {:.2}", speeds[speeds.len() - 1]);
+    eprintln!(
+        "reported cluster speeds: median {median:.2} m/s, max {:.2}",
+        speeds[speeds.len() - 1]
+    );
     assert!(median < 1.0, "static scene, median speed {median}");
 }
 

@@ -720,7 +720,10 @@ mod tests {
         // The rear of a car 20 m ahead (1.65 m wide, 1.45 m high) and 0.6 m of its sides: the
         // fit's longer side is the car's width. Points: ≈ 110 points/m² at 20 m (see above) ×
         // 0.8 × 1.65 m × 1.45 m ≈ 210.
-        assert_eq!(best(&features(1.65, 0.6, 1.45, 20.0, 210)), ObjectClass::Car);
+        assert_eq!(
+            best(&features(1.65, 0.6, 1.45, 20.0, 210)),
+            ObjectClass::Car
+        );
     }
 
     #[test]
