@@ -143,3 +143,69 @@ fn halves_out_of_order_are_errors_that_change_nothing() {
         .unwrap();
     f.update_step(&z).unwrap();
 }
+
+/// Data handed with the update reaches the update's models: a detection model that reads a
+/// p_D from the step data, handed only with `update_step_with`, decides how much a missed
+/// track's existence falls (the LMB's missed-detection update r(1 − p_D) / (1 − r p_D)).
+#[test]
+fn data_handed_with_the_update_reaches_its_models() {
+    use smc_lmb::filter::{DetectionModel, ParticleSet, StepContext};
+    #[derive(Clone, Debug)]
+    struct SeenShare(f64);
+    #[derive(Clone, Debug)]
+    struct ShareDetection;
+    impl DetectionModel for ShareDetection {
+        fn detection_probability(&self, p: &ParticleSet, ctx: &StepContext, out: &mut [f64]) {
+            let pd = ctx.data.get::<SeenShare>().map_or(0.9, |s| s.0);
+            out[..p.len()].fill(pd);
+        }
+    }
+    let build = || {
+        LmbFilter::builder()
+            .transition(ConstantVelocity::new(2, 1.0).unwrap())
+            .measurement(PositionMeasurement::new(2, 1.0).unwrap())
+            .detection(ShareDetection)
+            .clutter(UniformClutter::rectangle(2.0, [-50.0, 50.0], [-50.0, 50.0]).unwrap())
+            .birth(
+                AdaptiveBirth::new(
+                    PositionBirthSampler {
+                        position_std: 1.0,
+                        velocity_std: 2.0,
+                    },
+                    0.5,
+                    0.3,
+                    64,
+                )
+                .unwrap(),
+            )
+            .build()
+            .unwrap()
+    };
+    let z = Measurements::from_rows(2, &[[1.0, 2.0]]).unwrap();
+    let none = Measurements::empty(2);
+    let mut existence = Vec::new();
+    for hidden in [None, Some(0.1)] {
+        let mut f = build();
+        let mut rng = seeded(5);
+        f.step(&Frame::new(0.0, z.clone()), &mut rng).unwrap();
+        f.step(&Frame::new(0.1, z.clone()), &mut rng).unwrap();
+        let before = f.tracks()[0].existence;
+        f.predict_step(0.2, None, StepData::new(), &mut rng)
+            .unwrap();
+        let data = hidden.map_or_else(StepData::new, |pd| StepData::new().with(SeenShare(pd)));
+        f.update_step_with(&none, data).unwrap();
+        let after = f.tracks()[0].existence;
+        existence.push((before, after));
+    }
+    // Both steps predict the same track to the same existence r; the miss maps it to
+    // r' = r (1 − p_D) / (1 − r p_D), so r = r' / (1 − p_D + r' p_D) is the same from both.
+    let ((b0, a0), (b1, a1)) = (existence[0], existence[1]);
+    assert_eq!(b0, b1);
+    let r = |pd: f64, a: f64| a / (1.0 - pd + a * pd);
+    let implied = [r(0.9, a0), r(0.1, a1)];
+    assert!(
+        (implied[0] - implied[1]).abs() < 1e-9 * implied[0].max(1e-12),
+        "{implied:?} from {existence:?}"
+    );
+    assert!(a1 > a0, "{existence:?}");
+}

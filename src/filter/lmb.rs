@@ -592,6 +592,18 @@ impl LmbFilter {
     /// when no step is predicted or the measurements have the wrong dimension (the prediction
     /// then stays pending).
     pub fn update_step(&mut self, measurements: &Measurements) -> Result<Vec<Estimate>> {
+        self.update_step_with(measurements, StepData::new())
+    }
+
+    /// [`LmbFilter::update_step`] with `data` added to the step's data (replacing values of the
+    /// same types) before the update's models see it: data that exists only once the frame's
+    /// measurements do, such as what the scan's detections hide (the drive tracker's
+    /// occlusion of clusters). The prediction's models saw the step's data without it.
+    pub fn update_step_with(
+        &mut self,
+        measurements: &Measurements,
+        data: StepData,
+    ) -> Result<Vec<Estimate>> {
         if self.pending.is_none() {
             return Err(Error::invalid(
                 format!("update of step {}", self.step),
@@ -601,13 +613,14 @@ impl LmbFilter {
         let z = measurements;
         self.check_measurements(z)?;
         let Some(Pending {
-            context: ctx,
+            context: mut ctx,
             seed,
             summaries,
         }) = self.pending.take()
         else {
             unreachable!("checked above");
         };
+        ctx.data.extend(data);
         self.add_births(&ctx, z, seed, &summaries)?;
         let predicted = self.predicted_copies();
         let likelihoods = self.likelihoods(z, &ctx, &summaries)?;

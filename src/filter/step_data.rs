@@ -72,6 +72,16 @@ impl StepData {
         }
     }
 
+    /// Adds every value of `other`, replacing values of the same types.
+    pub fn extend(&mut self, other: StepData) {
+        for entry in other.entries {
+            match self.entries.iter_mut().find(|e| e.id == entry.id) {
+                Some(e) => *e = entry,
+                None => self.entries.push(entry),
+            }
+        }
+    }
+
     /// The value of type `T`, if the step has one.
     pub fn get<T: Any + Send + Sync>(&self) -> Option<&T> {
         let id = TypeId::of::<T>();

@@ -50,6 +50,7 @@
 //!
 //! [`LmbFilter`]: crate::filter::LmbFilter
 
+use super::occlusion::{ClusterOccluders, OcclusionShape};
 use crate::error::{ensure_positive, ensure_probability, Error, Result};
 use crate::filter::{
     check_state_dim, relative_from_logs, BirthSampler, LikelihoodFault, MergeDistance, ParticleSet,
@@ -741,12 +742,15 @@ impl MeasurementModel for MixedMeasurement {
     }
 }
 
-/// A constant detection probability per kind, or a user's model for a kind
+/// A constant detection probability per kind, for clusters lowered by the share of the track
+/// that the step's [`ClusterOccluders`] hide when occlusion is on
+/// ([`MixedDetection::with_occlusion`]); or a user's model for a kind
 /// ([`MixedDetection::with_own`]).
 #[derive(Clone)]
 pub struct MixedDetection {
     plane: f64,
     cluster: f64,
+    occlusion: Option<OcclusionShape>,
     own: [Option<Arc<dyn DetectionModel>>; 2],
 }
 
@@ -755,6 +759,7 @@ impl std::fmt::Debug for MixedDetection {
         f.debug_struct("MixedDetection")
             .field("plane", &self.plane)
             .field("cluster", &self.cluster)
+            .field("occlusion", &self.occlusion)
             .field("own", &self.own.each_ref().map(|m| m.is_some()))
             .finish()
     }
@@ -768,8 +773,22 @@ impl MixedDetection {
         Ok(MixedDetection {
             plane,
             cluster,
+            occlusion: None,
             own: [None, None],
         })
+    }
+
+    /// The same with the cluster p_D lowered by the hidden share of each track's silhouette
+    /// `shape` ([`super::occlusion`]), in steps whose data hold the frame's
+    /// [`ClusterOccluders`] and whose context has the platform pose. Fails on a floor outside
+    /// [0, 1] or a silhouette side that is not positive.
+    pub fn with_occlusion(mut self, shape: OcclusionShape) -> Result<Self> {
+        ensure_probability("occlusion floor", shape.floor)?;
+        ensure_positive("occlusion half-width", shape.half_width)?;
+        ensure_positive("occlusion half-height", shape.half_height)?;
+        ensure_positive("occlusion depth", shape.depth)?;
+        self.occlusion = Some(shape);
+        Ok(self)
     }
 
     /// The same with a user's model for walls and for clusters where given.
@@ -792,10 +811,31 @@ impl DetectionModel for MixedDetection {
         }
         let p = match kind {
             Some(ObjectKind::Plane) => self.plane,
-            Some(ObjectKind::Cluster) => self.cluster,
+            Some(ObjectKind::Cluster) => self.cluster * self.visible_factor(particles, ctx),
             None => 0.0,
         };
         out[..particles.len()].fill(p);
+    }
+}
+
+impl MixedDetection {
+    /// f + (1 − f) · the visible share of a cluster set's mean position (module
+    /// [`super::occlusion`]); 1 without occlusion, occluders or platform pose.
+    fn visible_factor(&self, particles: &ParticleSet, ctx: &StepContext) -> f64 {
+        let (Some(shape), Some(occluders), Some(pose)) = (
+            self.occlusion.as_ref(),
+            ctx.data.get::<ClusterOccluders>(),
+            ctx.platform.as_ref(),
+        ) else {
+            return 1.0;
+        };
+        if particles.is_empty() || particles.dim() < 6 {
+            return 1.0;
+        }
+        let mut mean = [0.0; STATE_DIM];
+        particles.mean_into(&mut mean);
+        let s = pose.inverse_transform_point(&nalgebra::Point3::new(mean[0], mean[2], mean[4]));
+        shape.floor + (1.0 - shape.floor) * occluders.visible_share([s.x, s.y, s.z], shape)
     }
 }
 
@@ -1312,5 +1352,50 @@ mod tests {
         d.detection_probability(&set, &c, &mut out);
         assert_eq!(out, [0.7]);
         assert!(MixedDetection::new(1.2, 0.5).is_err());
+    }
+
+    #[test]
+    fn occluded_clusters_keep_the_floor_of_their_detection_probability() {
+        use super::super::occlusion::{ClusterOccluders, OcclusionShape};
+        use crate::geometry::Box3;
+        let shape = OcclusionShape::default();
+        let d = MixedDetection::new(0.9, 0.8)
+            .unwrap()
+            .with_occlusion(shape)
+            .unwrap();
+        // The sensor 5 m along world x: a car 10 m ahead of it hides a cluster 20 m ahead.
+        let pose = Isometry3::translation(5.0, 0.0, 0.0);
+        let front = Box3::new(
+            nalgebra::Point3::new(10.0, 0.0, -0.98),
+            [3.9, 1.6, 1.5],
+            0.0,
+        );
+        let mut ctx = StepContext::new(1, 0.1, 0.1)
+            .with_data(crate::filter::StepData::new().with(ClusterOccluders::from_boxes([front])));
+        ctx.platform = Some(pose);
+        let hidden = cluster_set(&[vec![25.0, 0.0, 0.0, 0.0, -0.98, 0.0]]);
+        let beside = cluster_set(&[vec![25.0, 0.0, 12.0, 0.0, -0.98, 0.0]]);
+        let mut out = [0.0];
+        d.detection_probability(&hidden, &ctx, &mut out);
+        assert!((out[0] - 0.8 * shape.floor).abs() < 1e-12, "{out:?}");
+        d.detection_probability(&beside, &ctx, &mut out);
+        assert_eq!(out, [0.8]);
+        // Without the frame's occluders, or with occlusion off, the constant.
+        let mut bare = StepContext::new(1, 0.1, 0.1);
+        bare.platform = Some(pose);
+        d.detection_probability(&hidden, &bare, &mut out);
+        assert_eq!(out, [0.8]);
+        MixedDetection::new(0.9, 0.8)
+            .unwrap()
+            .detection_probability(&hidden, &ctx, &mut out);
+        assert_eq!(out, [0.8]);
+        let bad = OcclusionShape {
+            floor: 1.5,
+            ..shape
+        };
+        assert!(MixedDetection::new(0.9, 0.8)
+            .unwrap()
+            .with_occlusion(bad)
+            .is_err());
     }
 }

@@ -22,6 +22,7 @@ pub mod detect;
 pub mod export;
 pub mod kitti_out;
 pub mod mixed;
+pub mod occlusion;
 pub mod output;
 pub mod repeatability;
 pub mod road_users;
@@ -228,6 +229,10 @@ pub struct ClusterTuning {
     pub outlier_scale: f64,
     /// Detection probability. Default 0.8.
     pub detection: f64,
+    /// Lower a track's detection probability by the share of it that nearer clusters of the
+    /// frame hide ([`occlusion`]): a parked car behind others keeps its track through the
+    /// frames it is not seen in. Default true.
+    pub occlusion: bool,
     /// Expected false clusters per frame. Default 2.
     pub clutter_rate: f64,
     /// Volume they spread over (m³). Default 80 × 80 × 4.
@@ -310,6 +315,7 @@ impl Default for ClusterTuning {
             outlier_weight: 0.1,
             outlier_scale: 4.0,
             detection: 0.8,
+            occlusion: true,
             clutter_rate: 2.0,
             clutter_volume: 80.0 * 80.0 * 4.0,
             birth_position: 0.3,

@@ -13,6 +13,7 @@
 //! [`super::track_recording`]).
 
 use super::detect::{detect_here, FrameDetections};
+use super::occlusion::{ClusterOccluders, OcclusionShape};
 use super::output::{OrientedBox, StageTimes, TrackedCluster, TrackedFrame, TrackedPlane};
 use super::road_users::{contained_in_others, speed_evidence, travel_direction, RoadUserState};
 use super::TrackingConfig;
@@ -195,8 +196,14 @@ impl DriveTracker {
                     .with_own(po.measurement.clone(), co.measurement.clone()),
             )
             .detection(
-                MixedDetection::new(p.detection, c.detection)?
-                    .with_own(po.detection.clone(), co.detection.clone()),
+                {
+                    let d = MixedDetection::new(p.detection, c.detection)?;
+                    match c.occlusion {
+                        true => d.with_occlusion(OcclusionShape::default())?,
+                        false => d,
+                    }
+                }
+                .with_own(po.detection.clone(), co.detection.clone()),
             )
             .clutter(
                 MixedClutter::new(
@@ -325,7 +332,9 @@ impl DriveTracker {
         rayon::scope(|_| {
             let start = Instant::now();
             let measurements = detections.measurements()?;
-            let estimates = self.filter.update_step(&measurements)?;
+            let estimates = self
+                .filter
+                .update_step_with(&measurements, occluders(detections))?;
             self.predicted = None;
             self.finish(frame, time, pose, detections, &estimates, start)
         })
@@ -360,7 +369,8 @@ impl DriveTracker {
         detections: &FrameDetections,
     ) -> Result<TrackedFrame> {
         let start = Instant::now();
-        let data = self.step_data(vehicle_state);
+        let mut data = self.step_data(vehicle_state);
+        data.extend(occluders(detections));
         let measurements = detections.measurements()?;
         let estimates = self.filter.step(
             &Frame::new(time, measurements).at(pose).with_data(data),
@@ -704,6 +714,12 @@ fn yaw_of(pose: &Isometry3<f64>) -> f64 {
 /// Area of the rectangle v0 v1 v2 v3.
 fn rectangle_area(v: &[Point3<f64>; 4]) -> f64 {
     (v[1] - v[0]).norm() * (v[3] - v[0]).norm()
+}
+
+/// The step data the update's models read of the frame's detections: its clusters as
+/// occluders ([`ClusterOccluders`]).
+fn occluders(detections: &FrameDetections) -> StepData {
+    StepData::new().with(ClusterOccluders::of(detections))
 }
 
 #[cfg(test)]
