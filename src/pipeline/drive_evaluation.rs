@@ -404,7 +404,6 @@ pub fn car_van_recall(
     gate: f64,
 ) -> RecallBreakdown {
     let mut r = RecallBreakdown::default();
-    let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
     for f in &tracks.frames {
         let Some(labelled) = vehicles.get(f.frame) else {
             continue;
@@ -415,29 +414,39 @@ pub fn car_van_recall(
             .filter(|c| matches!(c.class.as_deref(), Some("Car" | "Van")))
             .map(|c| [c.position_world[0], c.position_world[1]])
             .collect();
-        pairs.clear();
-        for (i, p) in reported.iter().enumerate() {
-            for (j, v) in labelled.iter().enumerate() {
-                let d = (p[0] - v.position[0]).hypot(p[1] - v.position[1]);
-                if d <= gate {
-                    pairs.push((d, i, j));
-                }
-            }
-        }
-        pairs.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
-        let mut used = vec![false; reported.len()];
-        let mut found = vec![false; labelled.len()];
-        for &(_, i, j) in &pairs {
-            if !used[i] && !found[j] {
-                used[i] = true;
-                found[j] = true;
-            }
-        }
-        for (v, f) in labelled.iter().zip(found) {
-            r.add(v.occluded, v.range, f);
+        let positions: Vec<[f64; 2]> = labelled.iter().map(|v| v.position).collect();
+        for (v, found) in labelled
+            .iter()
+            .zip(nearest_found(&reported, &positions, gate))
+        {
+            r.add(v.occluded, v.range, found);
         }
     }
     r
+}
+
+/// Which of `labelled` a one-to-one matching with `reported` finds: pairs within `gate`
+/// (horizontal distance), nearest first (ties by index), each side used once.
+fn nearest_found(reported: &[[f64; 2]], labelled: &[[f64; 2]], gate: f64) -> Vec<bool> {
+    let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
+    for (i, p) in reported.iter().enumerate() {
+        for (j, q) in labelled.iter().enumerate() {
+            let d = (p[0] - q[0]).hypot(p[1] - q[1]);
+            if d <= gate {
+                pairs.push((d, i, j));
+            }
+        }
+    }
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
+    let mut used = vec![false; reported.len()];
+    let mut found = vec![false; labelled.len()];
+    for (_, i, j) in pairs {
+        if !used[i] && !found[j] {
+            used[i] = true;
+            found[j] = true;
+        }
+    }
+    found
 }
 
 /// Scores `tracks` against `labels`; `poses` are the recording's sensor poses, which
@@ -592,6 +601,25 @@ mod tests {
     use crate::kitti::TrackingLabel;
     use nalgebra::{Matrix3, Translation3, UnitQuaternion};
     use std::path::Path;
+
+    #[test]
+    fn nearest_matching_is_one_to_one_nearest_first() {
+        // Tracks at (0, 0) and (2.5, 0); labels at (1, 0), (2, 0) and (10, 0), gate 3 m. The
+        // nearest pair is track 2 – label 2 (0.5 m), then track 1 – label 1 (1 m); label 3
+        // is beyond every gate. With one track at (1.5, 0), equidistant from labels 1 and 2,
+        // the tie goes to the lower index.
+        let labels = [[1.0, 0.0], [2.0, 0.0], [10.0, 0.0]];
+        assert_eq!(
+            nearest_found(&[[0.0, 0.0], [2.5, 0.0]], &labels, 3.0),
+            [true, true, false]
+        );
+        assert_eq!(
+            nearest_found(&[[1.5, 0.0]], &labels, 3.0),
+            [true, false, false]
+        );
+        assert_eq!(nearest_found(&[[0.0, 0.0]], &labels, 0.9), [false; 3]);
+        assert!(nearest_found(&[], &[], 3.0).is_empty());
+    }
 
     #[test]
     fn label_truth_by_hand() {
