@@ -129,8 +129,9 @@ pub fn run(args: Args) -> Result<()> {
 
     // Scores against the street's truth.
     println!();
-    let Evaluation { clusters, walls } =
-        evaluate_recording(&tracks, &drive, &EvaluationOptions::default())?;
+    let Evaluation {
+        clusters, walls, ..
+    } = evaluate_recording(&tracks, &drive, &EvaluationOptions::default())?;
     crate::eval_cmd::print_evaluation(&tracks.drive, &clusters, walls.as_ref());
     Ok(())
 }

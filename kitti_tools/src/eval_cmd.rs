@@ -6,6 +6,7 @@
 
 use anyhow::{bail, Context, Result};
 use smc_lmb::kitti::{read_tracklets, RawDrive, TrackingSequence};
+use smc_lmb::metrics::recall::{RecallBreakdown, Tally, RANGE_BINS};
 use smc_lmb::metrics::PlanePredictionSummary;
 use smc_lmb::pipeline::drive_evaluation::{
     evaluate_labels, ClusterEvaluation, ClusterEvaluationConfig, Evaluation, EvaluationOptions,
@@ -198,9 +199,12 @@ pub fn run(args: Args) -> Result<()> {
         max_range: args.max_range,
         camera_view: args.camera_view,
     };
-    let Evaluation { clusters, walls } =
-        evaluate_labels(&tracks, &labels, poses.as_deref(), &options)
-            .with_context(|| format!("scoring {}", tracks_path.display()))?;
+    let Evaluation {
+        clusters,
+        walls,
+        car_van_recall,
+    } = evaluate_labels(&tracks, &labels, poses.as_deref(), &options)
+        .with_context(|| format!("scoring {}", tracks_path.display()))?;
     let planes = plane_statistics(&args, recording.as_deref())?;
     if args.json {
         let out = serde_json::json!({
@@ -208,11 +212,22 @@ pub fn run(args: Args) -> Result<()> {
             "clusters": clusters,
             "walls": walls,
             "plane_prediction": planes,
+            "car_van_recall": car_van_recall.as_ref().map(breakdown_json),
         });
         println!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
     }
     print_evaluation(&tracks.drive, &clusters, walls.as_ref());
+    if let Some(r) = &car_van_recall {
+        print_breakdown(
+            &format!(
+                "cars and vans within 40 m found by a track reported as a car or van (nearest, \
+                 within c = {} m)",
+                clusters.config.cutoff
+            ),
+            r,
+        );
+    }
     if let Some(s) = &planes {
         println!(
             "plane prediction ({} runs): {} pairs, normal angle median {:.3}° p90 {:.3}°, vertex \
@@ -270,4 +285,41 @@ pub fn print_evaluation(run: &str, clusters: &ClusterEvaluation, walls: Option<&
             w.p90_offset_m
         );
     }
+}
+
+/// A tally as "0.75 (3/4)", or "– (0/0)".
+fn ratio(t: &Tally) -> String {
+    match t.ratio() {
+        Some(r) => format!("{r:.2} ({}/{})", t.hits, t.total),
+        None => "– (0/0)".to_string(),
+    }
+}
+
+/// Prints a recall breakdown under `title`: in all, by occlusion level, by range.
+pub fn print_breakdown(title: &str, r: &RecallBreakdown) {
+    println!("{title}: {}", ratio(&r.recall));
+    let levels = [
+        "fully visible",
+        "partly occluded",
+        "largely occluded",
+        "unknown",
+    ];
+    for (name, t) in levels.iter().zip(&r.by_occlusion) {
+        println!("  {name:<17} {}", ratio(t));
+    }
+    for (w, t) in RANGE_BINS.windows(2).zip(&r.by_range) {
+        println!("  {:>2}–{:<2} m           {}", w[0], w[1], ratio(t));
+    }
+}
+
+/// A recall breakdown as JSON: tallies with their ratios, and the range bins' edges.
+pub fn breakdown_json(r: &RecallBreakdown) -> serde_json::Value {
+    let tally =
+        |t: &Tally| serde_json::json!({"hits": t.hits, "total": t.total, "ratio": t.ratio()});
+    serde_json::json!({
+        "recall": tally(&r.recall),
+        "by_occlusion": r.by_occlusion.iter().map(tally).collect::<Vec<_>>(),
+        "by_range": r.by_range.iter().map(tally).collect::<Vec<_>>(),
+        "range_bins_m": RANGE_BINS,
+    })
 }

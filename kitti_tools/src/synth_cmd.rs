@@ -28,6 +28,10 @@ pub enum Street {
     /// A city street: cars, vans, a truck, cyclists and pedestrians, with poles, tree trunks,
     /// hedges and low walls (`StreetConfig::urban`).
     Urban,
+    /// The city street with both kerbs lined by parked cars and vans nose to tail, 0.5–2 m
+    /// apart, so that the farther ones along a row are largely hidden
+    /// (`StreetConfig::parked_rows`).
+    ParkedRows,
 }
 
 /// Flags of `synth`.
@@ -84,6 +88,7 @@ pub fn run(args: Args) -> Result<()> {
     let base = match street {
         Street::Plain => StreetConfig::default(),
         Street::Urban => StreetConfig::urban(),
+        Street::ParkedRows => StreetConfig::parked_rows(),
     };
     let config = match &args.config {
         Some(path) => read_config(path, &base)?,

@@ -153,6 +153,17 @@ fn print_table(path: &Path, e: &KittiTrackingEvaluation) {
             c.tracker_objects
         );
     }
+    for c in &e.classes {
+        if let Some(r) = &c.recall_breakdown {
+            crate::eval_cmd::print_breakdown(
+                &format!(
+                    "{} truth within 40 m found (CLEAR matches), by occlusion and range",
+                    c.class.name()
+                ),
+                r,
+            );
+        }
+    }
 }
 
 #[cfg(test)]

@@ -12,6 +12,7 @@
 //! | [`detection_ap`] | KITTI's average precision of 3-D detections (11 and 40 recall points, easy / moderate / hard) |
 //! | [`labels`] | Label switches and label persistence of estimates matched to truth |
 //! | [`plane_prediction`] | Area, vertex-distance and normal-angle errors of predicted plane patches |
+//! | [`recall`] | Found-of-how-many tallies, and recall by KITTI occlusion level and range |
 //! | [`rmse`] | RMS error of error vectors and the averaged-NIS consistency check |
 //! | [`tracking`](mod@tracking) | HOTA, CLEAR MOT and IDF1 of tracks against truth, computed as TrackEval does |
 //! | [`trajectory`] | Relative pose errors and KITTI's segment errors of an ego trajectory |
@@ -33,6 +34,7 @@ pub mod ospa;
 pub mod ospa2;
 pub mod plane_prediction;
 mod points;
+pub mod recall;
 pub mod rmse;
 pub mod tracking;
 pub mod trajectory;

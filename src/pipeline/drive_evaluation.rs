@@ -10,12 +10,20 @@
 //! mostly in the horizontal plane. Vertical offsets would add the sensor-height bias of
 //! partially seen objects, which says nothing about tracking.
 //!
+//! **Cars and vans by occlusion and range.** Against labels with occlusion levels (a simulated
+//! street's truth, a tracking sequence's labels) the evaluation also reports the recall of the
+//! counted cars and vans within 40 m by KITTI occlusion level and range ([`car_van_recall`]):
+//! this evaluation has no CLEAR matching, so a vehicle is found when a cluster track reported
+//! as a car or van lies within the OSPA cut-off of it, pairs taken nearest first, one to one.
+//!
 //! Not for: producing the tracks (see [`super::drive_tracking`]) or the plane prediction
 //! between frames (see [`super::plane_prediction`]).
 
 use super::drive_tracking::DriveTracks;
 use crate::error::{Error, Result};
+use crate::kitti::ObjectType;
 use crate::kitti::{TrackingLabel, Tracklets, VelodyneBox};
+use crate::metrics::recall::RecallBreakdown;
 use crate::metrics::{gospa, ospa, percentile, LabelConsistency, LabelStats};
 use crate::recording::{Recording, RecordingLabels};
 use crate::sim::street::StreetTruth;
@@ -298,6 +306,147 @@ pub struct Evaluation {
     pub clusters: ClusterEvaluation,
     /// The wall tracks, when the labels have walls (a simulated street).
     pub walls: Option<WallEvaluation>,
+    /// Recall of the cars and vans within 40 m by occlusion level and range
+    /// ([`car_van_recall`]), when the labels have occlusion levels (a simulated street's
+    /// truth, a tracking sequence's labels).
+    pub car_van_recall: Option<RecallBreakdown>,
+}
+
+/// A labelled car or van in one frame, for [`car_van_recall`].
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct LabelledVehicle {
+    /// x, y in the world frame of the tracking output (m).
+    pub position: [f64; 2],
+    /// KITTI occlusion level.
+    pub occluded: i32,
+    /// Horizontal distance from the sensor (m).
+    pub range: f64,
+}
+
+/// The cars and vans (parked or moving) of a simulated street that count in
+/// [`street_object_truth`] (`min_points`, `max_range`), per frame, with the truth's occlusion
+/// levels.
+pub fn street_vehicles(
+    truth: &StreetTruth,
+    min_points: usize,
+    max_range: f64,
+) -> Vec<Vec<LabelledVehicle>> {
+    use crate::sim::street::ObjectKind;
+    let drive_from_world = truth.world_from_drive.to_isometry().inverse();
+    let mut frames = vec![Vec::new(); truth.frames.len()];
+    for object in &truth.objects {
+        if !matches!(
+            object.kind,
+            ObjectKind::Car | ObjectKind::ParkedCar | ObjectKind::Van | ObjectKind::ParkedVan
+        ) {
+            continue;
+        }
+        for state in &object.states {
+            if state.points < min_points || state.frame >= frames.len() {
+                continue;
+            }
+            let [x, y, z] = state.position;
+            let sensor = truth.frames[state.frame].velodyne_pose.translation;
+            let range = (x - sensor[0]).hypot(y - sensor[1]);
+            if range > max_range {
+                continue;
+            }
+            let c = drive_from_world * Point3::new(x, y, z + object.size[2] / 2.0);
+            frames[state.frame].push(LabelledVehicle {
+                position: [c.x, c.y],
+                occluded: state.occluded,
+                range,
+            });
+        }
+    }
+    frames
+}
+
+/// The cars and vans of KITTI tracking labels that `keep` accepts (as [`label_truth`]), per
+/// frame, in the world frame of the tracking output, with their labelled occlusion levels.
+pub fn label_vehicles(
+    labels: &[TrackingLabel],
+    rect_from_velo: &Isometry3<f64>,
+    poses: &[Isometry3<f64>],
+    keep: impl Fn(&VelodyneBox) -> bool,
+) -> Vec<Vec<LabelledVehicle>> {
+    let mut frames = vec![Vec::new(); poses.len()];
+    for l in labels {
+        if !matches!(l.object_type, ObjectType::Car | ObjectType::Van)
+            || l.frame >= poses.len()
+            || l.track_id < 0
+        {
+            continue;
+        }
+        let b = l.to_velodyne(rect_from_velo);
+        if !keep(&b) {
+            continue;
+        }
+        let c = poses[l.frame] * b.center;
+        frames[l.frame].push(LabelledVehicle {
+            position: [c.x, c.y],
+            occluded: l.occluded,
+            range: b.center.x.hypot(b.center.y),
+        });
+    }
+    frames
+}
+
+/// Recall of labelled cars and vans (`vehicles`, indexed by frame number) within 40 m by
+/// occlusion level and range, counted per frame of `tracks`: a vehicle is found when a
+/// confirmed cluster track reported as `Car` or `Van` is paired with it by a one-to-one
+/// nearest matching within `gate` metres (horizontal distance; nearest pairs first). The
+/// drive evaluation has no CLEAR matching of its own, so this is the matching of
+/// `kitti-tools objects`, with the OSPA cut-off as the gate.
+pub fn car_van_recall(
+    tracks: &DriveTracks,
+    vehicles: &[Vec<LabelledVehicle>],
+    gate: f64,
+) -> RecallBreakdown {
+    let mut r = RecallBreakdown::default();
+    for f in &tracks.frames {
+        let Some(labelled) = vehicles.get(f.frame) else {
+            continue;
+        };
+        let reported: Vec<[f64; 2]> = f
+            .clusters
+            .iter()
+            .filter(|c| matches!(c.class.as_deref(), Some("Car" | "Van")))
+            .map(|c| [c.position_world[0], c.position_world[1]])
+            .collect();
+        let positions: Vec<[f64; 2]> = labelled.iter().map(|v| v.position).collect();
+        for (v, found) in labelled
+            .iter()
+            .zip(nearest_found(&reported, &positions, gate))
+        {
+            r.add(v.occluded, v.range, found);
+        }
+    }
+    r
+}
+
+/// Which of `labelled` a one-to-one matching with `reported` finds: pairs within `gate`
+/// (horizontal distance), nearest first (ties by index), each side used once.
+fn nearest_found(reported: &[[f64; 2]], labelled: &[[f64; 2]], gate: f64) -> Vec<bool> {
+    let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
+    for (i, p) in reported.iter().enumerate() {
+        for (j, q) in labelled.iter().enumerate() {
+            let d = (p[0] - q[0]).hypot(p[1] - q[1]);
+            if d <= gate {
+                pairs.push((d, i, j));
+            }
+        }
+    }
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
+    let mut used = vec![false; reported.len()];
+    let mut found = vec![false; labelled.len()];
+    for (_, i, j) in pairs {
+        if !used[i] && !found[j] {
+            used[i] = true;
+            found[j] = true;
+        }
+    }
+    found
 }
 
 /// Scores `tracks` against `labels`; `poses` are the recording's sensor poses, which
@@ -325,12 +474,13 @@ pub fn evaluate_labels(
     }
     let mut in_view;
     let mut tracks = tracks;
-    let (frames, walls) = match labels {
+    let (frames, walls, vehicles) = match labels {
         RecordingLabels::Street(t) => (
             street_object_truth(t, options.min_points, options.max_range),
             Some(evaluate_walls(tracks, t)?),
+            Some(street_vehicles(t, options.min_points, options.max_range)),
         ),
-        RecordingLabels::Tracklets(t) => (tracklet_truth(t, need_poses()?), None),
+        RecordingLabels::Tracklets(t) => (tracklet_truth(t, need_poses()?), None, None),
         RecordingLabels::Camera { labels, calib } => {
             if options.camera_view {
                 in_view = tracks.clone();
@@ -343,15 +493,20 @@ pub fn evaluate_labels(
                 b.center.x.hypot(b.center.y) <= options.max_range
                     && (!options.camera_view || calib.in_image2(&b.center))
             };
+            let rect_from_velo = calib.rect_from_velo();
             (
-                label_truth(labels, &calib.rect_from_velo(), need_poses()?, keep),
+                label_truth(labels, &rect_from_velo, need_poses()?, keep),
                 None,
+                Some(label_vehicles(labels, &rect_from_velo, need_poses()?, keep)),
             )
         }
     };
+    let clusters = evaluate_clusters(tracks, &frames, &options.clusters)?;
+    let car_van_recall = vehicles.map(|v| car_van_recall(tracks, &v, options.clusters.cutoff));
     Ok(Evaluation {
-        clusters: evaluate_clusters(tracks, &frames, &options.clusters)?,
+        clusters,
         walls,
+        car_van_recall,
     })
 }
 
@@ -443,9 +598,28 @@ pub fn evaluate_walls(tracks: &DriveTracks, truth: &StreetTruth) -> Result<WallE
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kitti::{ObjectType, TrackingLabel};
+    use crate::kitti::TrackingLabel;
     use nalgebra::{Matrix3, Translation3, UnitQuaternion};
     use std::path::Path;
+
+    #[test]
+    fn nearest_matching_is_one_to_one_nearest_first() {
+        // Tracks at (0, 0) and (2.5, 0); labels at (1, 0), (2, 0) and (10, 0), gate 3 m. The
+        // nearest pair is track 2 – label 2 (0.5 m), then track 1 – label 1 (1 m); label 3
+        // is beyond every gate. With one track at (1.5, 0), equidistant from labels 1 and 2,
+        // the tie goes to the lower index.
+        let labels = [[1.0, 0.0], [2.0, 0.0], [10.0, 0.0]];
+        assert_eq!(
+            nearest_found(&[[0.0, 0.0], [2.5, 0.0]], &labels, 3.0),
+            [true, true, false]
+        );
+        assert_eq!(
+            nearest_found(&[[1.5, 0.0]], &labels, 3.0),
+            [true, false, false]
+        );
+        assert_eq!(nearest_found(&[[0.0, 0.0]], &labels, 0.9), [false; 3]);
+        assert!(nearest_found(&[], &[], 3.0).is_empty());
+    }
 
     #[test]
     fn label_truth_by_hand() {

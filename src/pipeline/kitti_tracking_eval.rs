@@ -25,13 +25,24 @@
 //! 0.25. 3-D results whose image boxes are empty (zero area) are never inside a `DontCare`
 //! region.
 //!
+//! **Recall by occlusion and range.** For the Car+Van group the evaluation also splits the
+//! recall of the scored truth objects within 40 m of the camera (x–z plane, as the range limit)
+//! by KITTI occlusion level and by 10 m range bin ([`RecallBreakdown`]), counted per frame: a
+//! truth object is found when CLEAR's own matching (see
+//! [`crate::metrics::tracking::clear_matches`]) pairs it with a tracker object of the group.
+//! Objects occluded beyond `max_occlusion` (level 3, unknown, by KITTI's rules) are not scored
+//! and so not in it.
+//!
 //! Not for: the metrics themselves, reading files, or scoring `track`'s JSON output (see
 //! [`super::drive_evaluation`]).
 
 use crate::error::{Error, Result};
 use crate::geometry::{iou_3d, Box3};
 use crate::kitti::{ObjectType, TrackingCalib, TrackingLabel};
-use crate::metrics::tracking::{evaluate, ScoreConfig, TrackingFrame, TrackingScores};
+use crate::metrics::recall::RecallBreakdown;
+use crate::metrics::tracking::{
+    clear_matches, evaluate, ScoreConfig, TrackingFrame, TrackingScores,
+};
 use nalgebra::Point3;
 use serde::{Deserialize, Serialize};
 
@@ -279,6 +290,11 @@ pub struct ClassScores {
     pub tracker_removed: usize,
     /// HOTA, CLEAR and identity scores.
     pub scores: TrackingScores,
+    /// Car+Van only: the scored truth objects within 40 m of the camera (horizontally, as
+    /// `max_range`), found or not by CLEAR's matching, in all, by occlusion level and by range
+    /// (see the module notes).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub recall_breakdown: Option<RecallBreakdown>,
 }
 
 /// A whole sequence's evaluation.
@@ -326,6 +342,22 @@ pub fn class_frames(
     config: &KittiEvalConfig,
     camera_view: Option<&TrackingCalib>,
 ) -> Result<(Vec<TrackingFrame>, usize)> {
+    let (f, removed, _) = scored_frames(truth, results, class, frames, config, camera_view)?;
+    Ok((f, removed))
+}
+
+/// The scored truth labels of one frame, in the order of its [`TrackingFrame::gt_ids`].
+type ScoredTruth<'a> = Vec<&'a TrackingLabel>;
+
+/// [`class_frames`], also returning the scored truth labels of each frame.
+fn scored_frames<'a>(
+    truth: &'a [TrackingLabel],
+    results: &[TrackingLabel],
+    class: EvalClass,
+    frames: usize,
+    config: &KittiEvalConfig,
+    camera_view: Option<&TrackingCalib>,
+) -> Result<(Vec<TrackingFrame>, usize, Vec<ScoredTruth<'a>>)> {
     config.check()?;
     let region = Region {
         max_range: config.max_range,
@@ -355,6 +387,7 @@ pub fn class_frames(
             && region.contains(l)
     };
     let mut out = Vec::with_capacity(frames);
+    let mut scored = Vec::with_capacity(frames);
     let mut removed_total = 0;
     for (k, (gts, trs)) in gt_by_frame.iter().zip(&tr_by_frame).enumerate() {
         let (g, t) = (gts.len(), trs.len());
@@ -409,8 +442,27 @@ pub fn class_frames(
         )
         .map_err(|e| Error::invalid(format!("frame {k}, class {class:?}"), e.to_string()))?;
         out.push(frame);
+        scored.push(keep_g.iter().map(|&i| gts[i]).collect());
     }
-    Ok((out, removed_total))
+    Ok((out, removed_total, scored))
+}
+
+/// The recall breakdown of scored truth labels (`scored`, per frame in the frames' truth
+/// order) from CLEAR's matching of `frames` at `threshold`: a label within 40 m of the camera
+/// (x–z plane) counts, found when matched.
+fn recall_breakdown(
+    frames: &[TrackingFrame],
+    scored: &[ScoredTruth],
+    threshold: f64,
+) -> Result<RecallBreakdown> {
+    let matched = clear_matches(frames, threshold)?;
+    let mut r = RecallBreakdown::default();
+    for (labels, found) in scored.iter().zip(&matched) {
+        for (l, &f) in labels.iter().zip(found) {
+            r.add(l.occluded, l.location[0].hypot(l.location[2]), f);
+        }
+    }
+    Ok(r)
 }
 
 /// Scores `results` against `truth` over frames 0 .. `frames`, per class of
@@ -429,13 +481,20 @@ pub fn evaluate_kitti_tracking(
     };
     let mut classes = Vec::new();
     for class in EvalClass::SCORED {
-        let (f, removed) = class_frames(truth, results, class, frames, config, camera_view)?;
+        let (f, removed, scored) =
+            scored_frames(truth, results, class, frames, config, camera_view)?;
+        let recall_breakdown = if class == EvalClass::CarVan {
+            Some(recall_breakdown(&f, &scored, config.match_threshold)?)
+        } else {
+            None
+        };
         classes.push(ClassScores {
             class,
             truth_objects: f.iter().map(|f| f.gt_ids.len()).sum(),
             tracker_objects: f.iter().map(|f| f.tracker_ids.len()).sum(),
             tracker_removed: removed,
             scores: evaluate(&f, &score_config)?,
+            recall_breakdown,
         });
     }
     Ok(KittiTrackingEvaluation {
@@ -450,6 +509,7 @@ pub fn evaluate_kitti_tracking(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::metrics::recall::Tally;
 
     fn label(
         frame: usize,
@@ -686,6 +746,35 @@ mod tests {
         assert!((r.precision - 0.75).abs() < 1e-12 && (r.recall - 1.0).abs() < 1e-12);
         let names: Vec<_> = e.classes.iter().map(|c| c.class.name()).collect();
         assert_eq!(names, ["Car", "Pedestrian", "Car+Van", "Road users"]);
+    }
+
+    #[test]
+    fn car_van_recall_splits_by_occlusion_and_range() {
+        // Frame 0: a visible car at 5 m (found), a largely occluded van at 25 m (missed), a
+        // partly occluded car at 45 m (beyond 40 m) and a car of unknown occlusion (not
+        // scored). Frame 1: the visible car again, now missed (the tracker lies 3 m off).
+        let mut van = label(0, 2, ObjectType::Van, B, 0.0, 25.0);
+        van.occluded = 2;
+        let mut far = car(0, 3, 0.0, 45.0);
+        far.occluded = 1;
+        let mut unknown = car(0, 4, 10.0, 10.0);
+        unknown.occluded = 3;
+        let truth = vec![car(0, 1, 3.0, 4.0), van, far, unknown, car(1, 1, 3.0, 4.0)];
+        let results = vec![car(0, 10, 3.0, 4.5), car(1, 10, 3.0, 7.0)];
+        let e =
+            evaluate_kitti_tracking(&truth, &results, 2, &KittiEvalConfig::bev(2.0), None).unwrap();
+        assert!(class(&e, EvalClass::Car).recall_breakdown.is_none());
+        let r = class(&e, EvalClass::CarVan)
+            .recall_breakdown
+            .clone()
+            .unwrap();
+        assert_eq!(r.recall, Tally { hits: 1, total: 3 });
+        assert_eq!(r.by_occlusion[0], Tally { hits: 1, total: 2 });
+        assert_eq!(r.by_occlusion[2], Tally { hits: 0, total: 1 });
+        assert_eq!(r.by_occlusion[1], Tally::default());
+        // The car is 5 m away (3, 4 in the camera's x–z plane), the van 25 m.
+        assert_eq!(r.by_range[0], Tally { hits: 1, total: 2 });
+        assert_eq!(r.by_range[2], Tally { hits: 0, total: 1 });
     }
 
     #[test]

@@ -84,29 +84,7 @@ pub struct ScoredDetection {
     pub in_view: bool,
 }
 
-/// Found of how many.
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
-pub struct Tally {
-    /// Found (or true).
-    pub hits: usize,
-    /// Of how many.
-    pub total: usize,
-}
-
-impl Tally {
-    /// `hits / total`, `None` when there are none.
-    pub fn ratio(&self) -> Option<f64> {
-        (self.total > 0).then(|| self.hits as f64 / self.total as f64)
-    }
-
-    fn add(&mut self, hit: bool) {
-        self.total += 1;
-        self.hits += usize::from(hit);
-    }
-}
-
-/// Edges of the range bins of [`ObjectFrameReport::recall_by_range`] (m).
-pub const RANGE_BINS: [f64; 5] = [0.0, 10.0, 20.0, 30.0, 40.0];
+pub use crate::metrics::recall::{Tally, RANGE_BINS};
 
 /// One average-precision figure.
 #[derive(Clone, Debug, PartialEq)]

@@ -56,7 +56,26 @@ pub fn clear(frames: &[TrackingFrame], threshold: f64) -> Result<Clear> {
     clear_of(&Sequence::new(frames)?, threshold)
 }
 
+/// Which truth objects CLEAR's matching (as in [`clear`]) pairs with a tracker object: per
+/// frame, one flag per entry of the frame's `gt_ids`.
+pub fn clear_matches(frames: &[TrackingFrame], threshold: f64) -> Result<Vec<Vec<bool>>> {
+    let seq = Sequence::new(frames)?;
+    let mut matched: Vec<Vec<bool>> = frames.iter().map(|f| vec![false; f.gt_ids.len()]).collect();
+    clear_with(&seq, threshold, Some(&mut matched))?;
+    Ok(matched)
+}
+
 pub(crate) fn clear_of(seq: &Sequence, threshold: f64) -> Result<Clear> {
+    clear_with(seq, threshold, None)
+}
+
+/// CLEAR MOT of `seq`; `matched`, when given (one flag per truth object of each frame), gets
+/// the truth objects that are matched.
+fn clear_with(
+    seq: &Sequence,
+    threshold: f64,
+    mut matched: Option<&mut Vec<Vec<bool>>>,
+) -> Result<Clear> {
     check_threshold("CLEAR threshold", threshold)?;
     let mut r = Clear {
         threshold,
@@ -78,7 +97,7 @@ pub(crate) fn clear_of(seq: &Sequence, threshold: f64) -> Result<Clear> {
     let mut last_tracker: Vec<Option<usize>> = vec![None; ng];
     let mut prev_frame_tracker: Vec<Option<usize>> = vec![None; ng];
     let mut motp_sum = 0.0;
-    for ((f, gids), tids) in seq.frames.iter().zip(&seq.gt).zip(&seq.tracker) {
+    for (k, ((f, gids), tids)) in seq.frames.iter().zip(&seq.gt).zip(&seq.tracker).enumerate() {
         let (g, t) = (gids.len(), tids.len());
         if g == 0 {
             r.fp += t as u64;
@@ -115,6 +134,11 @@ pub(crate) fn clear_of(seq: &Sequence, threshold: f64) -> Result<Clear> {
         gids.iter().for_each(|&i| gt_count[i] += 1);
         let was_tracked: Vec<bool> = prev_frame_tracker.iter().map(Option::is_some).collect();
         prev_frame_tracker.iter_mut().for_each(|p| *p = None);
+        if let Some(m) = matched.as_deref_mut() {
+            for &(i, _) in &pairs {
+                m[k][i] = true;
+            }
+        }
         for &(i, j) in &pairs {
             matched_count[gids[i]] += 1;
             last_tracker[gids[i]] = Some(tids[j]);

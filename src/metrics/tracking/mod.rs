@@ -19,7 +19,7 @@ pub mod clear;
 pub mod hota;
 pub mod identity;
 
-pub use clear::{clear, Clear};
+pub use clear::{clear, clear_matches, Clear};
 pub use hota::{hota, Hota, HotaAtAlpha, HOTA_ALPHAS};
 pub use identity::{identity, Identity};
 

@@ -223,3 +223,19 @@ proptest! {
         prop_assert_eq!(s.identity.idtp, idtp);
     }
 }
+
+#[test]
+fn clear_matches_keep_the_previous_match_by_hand() {
+    // Frame 0: one tracker between two truths, nearer truth 1 (0.9 against 0.6): truth 1 is
+    // matched. Frame 1: now nearer truth 2 (0.6 against 0.9), but truth 1 still reaches the
+    // threshold and keeps its match by the continuation bonus. Frame 2: no tracker.
+    let frames = vec![
+        frame(&[1, 2], &[10], &[0.9, 0.6]),
+        frame(&[1, 2], &[10], &[0.6, 0.9]),
+        frame(&[1], &[], &[]),
+    ];
+    let m = clear_matches(&frames, 0.5).unwrap();
+    assert_eq!(m, vec![vec![true, false], vec![true, false], vec![false]]);
+    let c = clear(&frames, 0.5).unwrap();
+    assert_eq!(c.tp, 2);
+}

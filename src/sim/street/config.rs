@@ -10,7 +10,9 @@ use super::clutter::ClutterConfig;
 use super::ego::LegSpec;
 use super::ground::GroundConfig;
 use super::lidar::LidarConfig;
-use crate::error::{ensure_non_negative, ensure_positive, ensure_range, Error, Result};
+use crate::error::{
+    ensure_non_negative, ensure_positive, ensure_probability, ensure_range, Error, Result,
+};
 use crate::kitti::Timestamp;
 use serde::{Deserialize, Serialize};
 
@@ -102,6 +104,77 @@ pub struct TrafficConfig {
     pub corner_clearance: f64,
     /// Objects start within this distance of the ego's path, metres.
     pub spawn_radius: f64,
+    /// Rows of parked cars and vans nose to tail at the kerb, on top of the `parked_cars` and
+    /// `parked_vans` placed one by one; none by default (and then not written).
+    #[serde(skip_serializing_if = "ParkedRows::is_off")]
+    pub parked_rows: ParkedRows,
+}
+
+/// The kerb sides a row of parked vehicles stands on, seen in the ego's direction of travel.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RowSides {
+    /// No rows.
+    #[default]
+    None,
+    /// The ego's (right) kerb.
+    Right,
+    /// The far (left) kerb.
+    Left,
+    /// Both kerbs.
+    Both,
+}
+
+impl RowSides {
+    /// The signed lateral directions (left > 0) of the kerbs with rows.
+    pub fn signs(self) -> &'static [f64] {
+        match self {
+            RowSides::None => &[],
+            RowSides::Right => &[-1.0],
+            RowSides::Left => &[1.0],
+            RowSides::Both => &[-1.0, 1.0],
+        }
+    }
+}
+
+/// Parked cars and vans in rows at the kerb, nose to tail, as along a residential street: from
+/// the road the vehicles farther along a row are largely hidden behind the nearer ones. A row
+/// runs along each street segment between the corner clearances, only where it is within the
+/// spawn radius of the ego's path; vehicle after vehicle, a van with probability `van_share`,
+/// each gap drawn uniformly from `gap`, and, with probability `opening_share`, a longer
+/// opening (a driveway or a crossing) drawn from `opening`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ParkedRows {
+    /// Kerbs with a row.
+    pub sides: RowSides,
+    /// Range of the gaps between consecutive vehicles, metres.
+    pub gap: [f64; 2],
+    /// Probability that a vehicle of a row is a van.
+    pub van_share: f64,
+    /// Probability that a gap is an opening instead.
+    pub opening_share: f64,
+    /// Range of the openings' lengths, metres.
+    pub opening: [f64; 2],
+}
+
+impl Default for ParkedRows {
+    fn default() -> Self {
+        ParkedRows {
+            sides: RowSides::None,
+            gap: [0.5, 2.0],
+            van_share: 0.2,
+            opening_share: 0.1,
+            opening: [4.0, 10.0],
+        }
+    }
+}
+
+impl ParkedRows {
+    /// Whether there are no rows (the default).
+    pub fn is_off(&self) -> bool {
+        self.sides == RowSides::None
+    }
 }
 
 impl Default for TrafficConfig {
@@ -128,6 +201,7 @@ impl Default for TrafficConfig {
             pedestrian_rows: [1.0, 2.0],
             corner_clearance: 20.0,
             spawn_radius: 60.0,
+            parked_rows: ParkedRows::default(),
         }
     }
 }
@@ -255,6 +329,27 @@ impl StreetConfig {
         }
     }
 
+    /// The urban street ([`StreetConfig::urban`]) with its kerbs lined by parked cars and vans
+    /// ([`ParkedRows`]): on both sides vehicle after vehicle with 0.5–2 m gaps, one in five a
+    /// van, one gap in ten a 4–10 m opening, in place of the urban street's 12 cars and 3 vans
+    /// parked one by one. Seen from the road, the vehicles farther along a row are largely
+    /// hidden behind the nearer ones, as along a real street's parked rows.
+    pub fn parked_rows() -> Self {
+        let urban = StreetConfig::urban();
+        StreetConfig {
+            traffic: TrafficConfig {
+                parked_cars: 0,
+                parked_vans: 0,
+                parked_rows: ParkedRows {
+                    sides: RowSides::Both,
+                    ..ParkedRows::default()
+                },
+                ..urban.traffic
+            },
+            ..urban
+        }
+    }
+
     /// Checks every field; errors name the field.
     pub fn validate(&self) -> Result<()> {
         ensure_positive("speed", self.speed)?;
@@ -320,6 +415,12 @@ impl StreetConfig {
         }
         ensure_non_negative("traffic.corner_clearance", t.corner_clearance)?;
         ensure_positive("traffic.spawn_radius", t.spawn_radius)?;
+        let rows = &t.parked_rows;
+        ensure_range("traffic.parked_rows.gap", rows.gap)?;
+        ensure_positive("traffic.parked_rows.gap", rows.gap[0])?;
+        ensure_range("traffic.parked_rows.opening", rows.opening)?;
+        ensure_probability("traffic.parked_rows.van_share", rows.van_share)?;
+        ensure_probability("traffic.parked_rows.opening_share", rows.opening_share)?;
         self.clutter.validate()?;
         // Clutter keeps out of the pedestrians' rows (0.5 m clear of a walker's shoulder).
         let c = &self.clutter;

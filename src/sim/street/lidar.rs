@@ -12,9 +12,16 @@
 //! the other draws of that ray. Reflectance is the surface's value scaled by the cosine
 //! of the incidence angle (0.5 + 0.5·|cos|), with a little noise, clamped to [0, 1].
 //!
+//! **Occlusion.** The caster already intersects every ray with every shape of its column, so
+//! it also counts, per road user, the rays whose line meets it and those of them whose first
+//! hit is another shape nearer the sensor ([`ObjectView`]); [`super::truth`] turns the hidden
+//! share into KITTI's occlusion level.
+//!
 //! **Speed.** Each shape gets its azimuth interval as seen in the sensor frame (the hull of its
 //! corners projected on the sensor's xy plane); a column tests only the shapes whose interval
-//! holds its azimuth. Columns run in parallel (rayon) into one preallocated buffer.
+//! holds its azimuth. Columns run in parallel (rayon) into one preallocated buffer; each
+//! worker keeps its occlusion counts and the counts are summed at the end (integers, so the
+//! sum does not depend on how the columns were split).
 //!
 //! **Determinism.** Column c of a scan draws from `rng::stream(scan_seed, c)`, so the result
 //! does not depend on the number of threads.
@@ -171,6 +178,41 @@ pub struct LidarScan {
     pub cloud: PointCloud,
     /// What point i hit.
     pub surfaces: Vec<Surface>,
+    /// How much of each object the rays see (see [`ObjectView`]), for every object shape
+    /// that at least one ray's line meets, in the order of the shapes.
+    pub objects: Vec<ObjectView>,
+}
+
+/// How much of one object a scan's rays see. A ray *meets* the object when its line enters
+/// the object's shape within the lidar's maximum range; it is *hidden* when its first hit is
+/// another shape (a wall, another road user, clutter) nearer the sensor. Rays that reach the
+/// ground first are left out: the road's relief is not what hides a road user. Geometry only:
+/// dropout and the minimum range do not enter, so the counts do not depend on the scan's seed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ObjectView {
+    /// The object's id (as in [`Surface::Object`]).
+    pub id: u32,
+    /// Rays that meet the object.
+    pub rays: u32,
+    /// Of those, the rays whose first hit is something else nearer the sensor.
+    pub hidden: u32,
+}
+
+impl ObjectView {
+    /// The share of the rays meeting the object that are hidden, in [0, 1]; `None` when no
+    /// ray meets it.
+    pub fn hidden_share(&self) -> Option<f64> {
+        (self.rays > 0).then(|| f64::from(self.hidden) / f64::from(self.rays))
+    }
+}
+
+/// What one worker of [`cast_scan`] keeps between columns: the shapes of the column, the
+/// objects met by the current ray (slot, shape index, ray parameter) and the per-object
+/// (rays, hidden) counts so far.
+struct Scratch {
+    candidates: Vec<usize>,
+    met: Vec<(usize, usize, f64)>,
+    counts: Vec<[u32; 2]>,
 }
 
 /// Azimuth interval of a shape in the sensor frame: centre and half-width, rad.
@@ -398,72 +440,132 @@ pub fn cast_scan(
     let (sin_e, cos_e): (Vec<f64>, Vec<f64>) = elevations.iter().map(|e| e.sin_cos()).unzip();
     let origin = sensor_to_world.translation.vector;
     let rotation = sensor_to_world.rotation.to_rotation_matrix();
+    // Slot of each object shape in the occlusion counts.
+    let mut slots = vec![usize::MAX; shapes.len()];
+    let mut object_shapes = Vec::new();
+    for (i, shape) in shapes.iter().enumerate() {
+        if let Surface::Object(id) = shape.surface {
+            slots[i] = object_shapes.len();
+            object_shapes.push(id);
+        }
+    }
+    let n_objects = object_shapes.len();
     let mut buffer = vec![NO_HIT; lidar.columns * beams];
-    buffer.par_chunks_mut(beams).enumerate().for_each_init(
-        Vec::new,
-        |candidates: &mut Vec<usize>, (c, out)| {
-            let a = 2.0 * PI * c as f64 / lidar.columns as f64;
-            let (sa, ca) = a.sin_cos();
-            candidates.clear();
-            candidates.extend((0..shapes.len()).filter(|&i| intervals[i].contains(a)));
-            let mut rng = stream(seed, c as u64);
-            for b in 0..beams {
-                let local = Vector3::new(cos_e[b] * ca, cos_e[b] * sa, sin_e[b]);
-                let d = rotation * local;
-                let mut best: Option<(f64, f64, usize)> = None;
-                for &i in candidates.iter() {
-                    if let Some((t, cos)) = intersect(&shapes[i].geometry, &origin, &d) {
-                        if best.is_none_or(|(bt, _, _)| t < bt) {
-                            best = Some((t, cos, i));
+    let counts = buffer
+        .par_chunks_mut(beams)
+        .enumerate()
+        .fold(
+            || Scratch {
+                candidates: Vec::new(),
+                met: Vec::new(),
+                counts: vec![[0; 2]; n_objects],
+            },
+            |mut scratch, (c, out)| {
+                let Scratch {
+                    candidates,
+                    met,
+                    counts,
+                } = &mut scratch;
+                let a = 2.0 * PI * c as f64 / lidar.columns as f64;
+                let (sa, ca) = a.sin_cos();
+                candidates.clear();
+                candidates.extend((0..shapes.len()).filter(|&i| intervals[i].contains(a)));
+                let mut rng = stream(seed, c as u64);
+                for b in 0..beams {
+                    let local = Vector3::new(cos_e[b] * ca, cos_e[b] * sa, sin_e[b]);
+                    let d = rotation * local;
+                    let mut best: Option<(f64, f64, usize)> = None;
+                    met.clear();
+                    for &i in candidates.iter() {
+                        if let Some((t, cos)) = intersect(&shapes[i].geometry, &origin, &d) {
+                            if best.is_none_or(|(bt, _, _)| t < bt) {
+                                best = Some((t, cos, i));
+                            }
+                            if slots[i] != usize::MAX && t <= lidar.max_range {
+                                met.push((slots[i], i, t));
+                            }
                         }
                     }
-                }
-                // The ground, if it comes first (searched no farther than the nearest shape).
-                let limit = best.map_or(lidar.max_range, |(bt, _, _)| bt.min(lidar.max_range));
-                let (o, dir) = ([origin.x, origin.y, origin.z], [d.x, d.y, d.z]);
-                if let Some(t) = ground.intersect(o, dir, limit) {
-                    if best.is_none_or(|(bt, _, _)| t < bt) {
-                        best = Some((t, -d.z, usize::MAX));
+                    // The ground, if it comes first (searched no farther than the nearest
+                    // shape).
+                    let limit = best.map_or(lidar.max_range, |(bt, _, _)| bt.min(lidar.max_range));
+                    let (o, dir) = ([origin.x, origin.y, origin.z], [d.x, d.y, d.z]);
+                    if let Some(t) = ground.intersect(o, dir, limit) {
+                        if best.is_none_or(|(bt, _, _)| t < bt) {
+                            best = Some((t, -d.z, usize::MAX));
+                        }
                     }
-                }
-                let Some((t, cos, i)) = best else { continue };
-                if t < lidar.min_range || t > lidar.max_range {
-                    continue;
-                }
-                let keep: f64 = rng.random();
-                let noise: f64 = StandardNormal.sample(&mut rng);
-                let shade: f64 = StandardNormal.sample(&mut rng);
-                if keep < lidar.dropout {
-                    continue;
-                }
-                let mut r = t + lidar.range_noise * noise;
-                let (surface, base) = if i == usize::MAX {
-                    (Surface::Ground, GROUND_REFLECTANCE)
-                } else {
-                    let shape = &shapes[i];
-                    if shape.scatter > 0.0 {
-                        let u: f64 = rng.random();
-                        r += shape.scatter * u;
+                    // Occlusion: every object the ray meets is seen when it is the first hit,
+                    // hidden when a nearer shape is; a ray that reaches the ground first counts
+                    // for none.
+                    if let Some((_, _, first)) = best {
+                        if first != usize::MAX {
+                            for &(slot, i, _) in met.iter() {
+                                counts[slot][0] += 1;
+                                counts[slot][1] += u32::from(i != first);
+                            }
+                        }
                     }
-                    (shape.surface, shape.reflectance as f64)
-                };
-                let refl = (base * (0.5 + 0.5 * cos) + 0.02 * shade).clamp(0.0, 1.0);
-                out[b] = Hit {
-                    point: [
-                        (local.x * r) as f32,
-                        (local.y * r) as f32,
-                        (local.z * r) as f32,
-                        refl as f32,
-                    ],
-                    surface: Some(surface),
-                };
-            }
-        },
-    );
+                    let Some((t, cos, i)) = best else { continue };
+                    if t < lidar.min_range || t > lidar.max_range {
+                        continue;
+                    }
+                    let keep: f64 = rng.random();
+                    let noise: f64 = StandardNormal.sample(&mut rng);
+                    let shade: f64 = StandardNormal.sample(&mut rng);
+                    if keep < lidar.dropout {
+                        continue;
+                    }
+                    let mut r = t + lidar.range_noise * noise;
+                    let (surface, base) = if i == usize::MAX {
+                        (Surface::Ground, GROUND_REFLECTANCE)
+                    } else {
+                        let shape = &shapes[i];
+                        if shape.scatter > 0.0 {
+                            let u: f64 = rng.random();
+                            r += shape.scatter * u;
+                        }
+                        (shape.surface, shape.reflectance as f64)
+                    };
+                    let refl = (base * (0.5 + 0.5 * cos) + 0.02 * shade).clamp(0.0, 1.0);
+                    out[b] = Hit {
+                        point: [
+                            (local.x * r) as f32,
+                            (local.y * r) as f32,
+                            (local.z * r) as f32,
+                            refl as f32,
+                        ],
+                        surface: Some(surface),
+                    };
+                }
+                scratch
+            },
+        )
+        .map(|scratch| scratch.counts)
+        .reduce(
+            || vec![[0; 2]; n_objects],
+            |mut a, b| {
+                for (x, y) in a.iter_mut().zip(&b) {
+                    x[0] += y[0];
+                    x[1] += y[1];
+                }
+                a
+            },
+        );
     let count = buffer.iter().filter(|h| h.surface.is_some()).count();
     let mut scan = LidarScan {
         cloud: PointCloud::with_capacity(count),
         surfaces: Vec::with_capacity(count),
+        objects: object_shapes
+            .iter()
+            .zip(&counts)
+            .filter(|(_, n)| n[0] > 0)
+            .map(|(&id, n)| ObjectView {
+                id,
+                rays: n[0],
+                hidden: n[1],
+            })
+            .collect(),
     };
     for h in &buffer {
         if let Some(s) = h.surface {
@@ -614,6 +716,120 @@ mod tests {
                 (a.min(y), b.max(y))
             });
         assert!(hi - lo > 0.2, "hedge returns from {lo} to {hi} m");
+    }
+
+    fn car_at(id: u32, x: f64, y: f64) -> Shape {
+        Shape {
+            surface: Surface::Object(id),
+            geometry: Geometry::Box {
+                centre: [x, y],
+                yaw: 0.0,
+                half_length: 2.25,
+                half_width: 0.9,
+                height: 1.5,
+            },
+            reflectance: 0.5,
+            scatter: 0.0,
+        }
+    }
+
+    fn view(scan: &LidarScan, id: u32) -> ObjectView {
+        *scan.objects.iter().find(|v| v.id == id).unwrap()
+    }
+
+    #[test]
+    fn a_car_behind_another_is_largely_hidden_and_one_alone_is_not() {
+        // Sensor 1.73 m up at the origin; car 1 centred 10 m ahead, car 2 20 m ahead on the
+        // same line, car 3 alone 15 m to the left, a wall 40 m ahead behind them all. Car 2
+        // spans azimuths ±atan(0.9/17.75) = ±2.9°, inside car 1's ±atan(0.9/7.75) = ±6.6°;
+        // in elevation it spans atan(−1.73/17.75) = −5.6° up to its roof's far edge,
+        // atan(−0.23/22.25) = −0.6°, and car 1's top rear edge hides all below
+        // atan(−0.23/12.25) = −1.1°: about 0.5° of 5°, so some nine tenths are hidden.
+        let wall = Shape {
+            surface: Surface::Wall(0),
+            geometry: Geometry::Wall {
+                base: [40.0, -20.0],
+                along: [0.0, 1.0],
+                length: 40.0,
+                height: 8.0,
+                normal: [-1.0, 0.0],
+            },
+            reflectance: 0.5,
+            scatter: 0.0,
+        };
+        let shapes = [
+            car_at(1, 10.0, 0.0),
+            car_at(2, 20.0, 0.0),
+            car_at(3, 0.0, 15.0),
+            wall,
+        ];
+        let pose = Isometry3::translation(0.0, 0.0, 1.73);
+        let cfg = LidarConfig {
+            columns: 2000,
+            ..small()
+        };
+        let scan = cast_scan(&shapes, &Ground::flat(), &pose, &cfg, 3);
+        let (front, behind, alone) = (view(&scan, 1), view(&scan, 2), view(&scan, 3));
+        assert_eq!(front.hidden, 0, "{front:?}");
+        assert_eq!(alone.hidden, 0, "{alone:?}");
+        assert!(front.rays > 100 && alone.rays > 100, "{front:?} {alone:?}");
+        let share = behind.hidden_share().unwrap();
+        assert!((0.8..0.98).contains(&share), "{behind:?}");
+        use crate::sim::street::truth::occlusion_level;
+        assert_eq!(occlusion_level(front.hidden_share()), 0);
+        assert_eq!(occlusion_level(alone.hidden_share()), 0);
+        assert_eq!(occlusion_level(Some(share)), 2);
+        // The occlusion counts are geometry: dropout and the seed do not change them.
+        let dropped = cast_scan(
+            &shapes,
+            &Ground::flat(),
+            &pose,
+            &LidarConfig {
+                dropout: 0.5,
+                ..cfg
+            },
+            4,
+        );
+        assert_eq!(dropped.objects, scan.objects);
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(24))]
+        #[test]
+        fn hidden_counts_stay_within_the_rays(
+            cars in proptest::collection::vec((-30.0f64..30.0, -30.0f64..30.0), 1..8),
+        ) {
+            let shapes: Vec<Shape> = cars
+                .iter()
+                .enumerate()
+                .map(|(i, &(x, y))| car_at(i as u32, x, y))
+                .collect();
+            let pose = Isometry3::translation(0.0, 0.0, 1.73);
+            let cfg = LidarConfig { columns: 360, ..small() };
+            let scan = cast_scan(&shapes, &Ground::flat(), &pose, &cfg, 5);
+            for v in &scan.objects {
+                proptest::prop_assert!(v.rays > 0 && v.hidden <= v.rays, "{:?}", v);
+                let h = v.hidden_share().unwrap();
+                proptest::prop_assert!((0.0..=1.0).contains(&h));
+            }
+        }
+    }
+
+    #[test]
+    fn occlusion_counts_do_not_depend_on_the_thread_count() {
+        let shapes: Vec<Shape> = (0..12)
+            .map(|i| car_at(i, 6.0 + 5.5 * i as f64, if i % 2 == 0 { 4.0 } else { -4.0 }))
+            .collect();
+        let pose = Isometry3::translation(0.0, 0.0, 1.73);
+        let cfg = LidarConfig::default();
+        let a = cast_scan(&shapes, &Ground::flat(), &pose, &cfg, 9);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let b = pool.install(|| cast_scan(&shapes, &Ground::flat(), &pose, &cfg, 9));
+        assert_eq!(a, b);
+        assert_eq!(a.objects.len(), 12);
     }
 
     #[test]

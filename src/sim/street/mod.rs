@@ -1,7 +1,8 @@
 //! A simulated street drive in the KITTI raw layout: an ego vehicle with an HDL-64E-like lidar
 //! and an OXTS unit drives at about 10 m/s along a street with turns, between building walls,
 //! past parked cars, moving cars and pedestrians (and, on [`StreetConfig::urban`], vans,
-//! trucks, cyclists, poles, tree trunks, hedges and low walls). [`write_drive`] writes it as
+//! trucks, cyclists, poles, tree trunks, hedges and low walls; on
+//! [`StreetConfig::parked_rows`], kerbs lined with parked cars and vans nose to tail). [`write_drive`] writes it as
 //! `DIR/DATE/DATE_drive_NNNN_sync/` that [`crate::kitti::RawDrive`] opens unchanged, plus
 //! `truth.json` ([`StreetTruth`]); [`write_tracking_sequence`] writes it in the KITTI tracking
 //! layout with its road users as `label_02` labels; [`generate`] keeps it in memory
@@ -27,6 +28,10 @@
 //! are placed near the ego's path during the drive). With `ground.relief = []` and zero `body`
 //! amplitudes the scans are those of the flat, level street this simulator first wrote.
 //!
+//! **Occlusion.** Each road user's state in the truth carries how many of the scan's rays meet
+//! it and how many of those first hit something nearer, and from that KITTI's occlusion level
+//! ([`occlusion_level`]); the tracking layout's labels carry the level.
+//!
 //! Not for: reading drives back (see [`crate::kitti`]) or scoring trackers against the truth.
 
 pub mod body;
@@ -43,12 +48,14 @@ pub mod writer;
 
 pub use body::{BodyMotion, BodyMotionConfig};
 pub use clutter::{Clutter, ClutterConfig, ClutterKind};
-pub use config::{Recording, StreetConfig, StreetLayout, TrafficConfig};
+pub use config::{ParkedRows, Recording, RowSides, StreetConfig, StreetLayout, TrafficConfig};
 pub use ego::{EgoState, EgoTrajectory, LegSpec};
 pub use ground::{Ground, GroundConfig, ReliefOctave};
-pub use lidar::{LidarConfig, LidarScan, Surface};
+pub use lidar::{LidarConfig, LidarScan, ObjectView, Surface};
 pub use tracking_writer::{write_tracking_sequence, WrittenSequence};
-pub use truth::{FrameTruth, ObjectState, ObjectTruth, PoseTruth, StreetTruth, WallTruth};
+pub use truth::{
+    occlusion_level, FrameTruth, ObjectState, ObjectTruth, PoseTruth, StreetTruth, WallTruth,
+};
 pub use world::{ObjectKind, Street};
 pub use writer::{write_drive, WrittenDrive, TRUTH_FILE};
 
@@ -274,7 +281,8 @@ impl StreetSimulator {
         )
     }
 
-    /// The truth without point counts (all zero); add them with [`record_scan`](Self::record_scan).
+    /// The truth without point and ray counts (all zero, occlusion unknown); add them with
+    /// [`record_scan`](Self::record_scan).
     pub fn truth(&self) -> StreetTruth {
         let frames = (0..self.frames)
             .map(|k| FrameTruth {
@@ -320,6 +328,9 @@ impl StreetSimulator {
                             velocity: [v[0], v[1], 0.0],
                             yaw: o.yaw,
                             points: 0,
+                            rays: 0,
+                            hidden_rays: 0,
+                            occluded: truth::OCCLUSION_UNKNOWN,
                         })
                     })
                     .collect(),
@@ -338,7 +349,7 @@ impl StreetSimulator {
         }
     }
 
-    /// Adds the point counts of scan k to `truth`.
+    /// Adds the point and ray counts and the occlusion levels of scan k to `truth`.
     pub fn record_scan(&self, truth: &mut StreetTruth, k: usize, scan: &LidarScan) {
         let frame = &mut truth.frames[k];
         frame.points = scan.surfaces.len();
@@ -358,6 +369,10 @@ impl StreetSimulator {
         for (o, n) in truth.objects.iter_mut().zip(objects) {
             if let Some(state) = o.states.iter_mut().find(|s| s.frame == k) {
                 state.points = n;
+                let view = scan.objects.iter().find(|v| v.id == o.id);
+                state.rays = view.map_or(0, |v| v.rays as usize);
+                state.hidden_rays = view.map_or(0, |v| v.hidden as usize);
+                state.occluded = truth::occlusion_level(state.hidden_share());
             }
         }
     }

@@ -259,3 +259,66 @@ fn the_plain_street_has_no_clutter_and_its_objects_do_not_move_when_other_kinds_
     assert_eq!(a.street().walls, b.street().walls);
     assert_eq!(b.street().clutter.len(), a.street().clutter.len() + 2);
 }
+
+#[test]
+fn parked_rows_stand_nose_to_tail_and_hide_one_another() {
+    let config = StreetConfig::parked_rows();
+    config.validate().unwrap();
+    // The preset's config is written with its rows; the others' without the field.
+    let json = serde_json::to_string(&config).unwrap();
+    assert!(json.contains("parked_rows"));
+    assert_eq!(serde_json::from_str::<StreetConfig>(&json).unwrap(), config);
+    for plain in [StreetConfig::default(), StreetConfig::urban()] {
+        assert!(!serde_json::to_string(&plain)
+            .unwrap()
+            .contains("parked_rows"));
+    }
+    let run = generate(&config, 20, 3).unwrap();
+    let sim = StreetSimulator::new(&config, 20, 3).unwrap();
+    let street = sim.street();
+    let parked: Vec<&world::Object> = street
+        .objects
+        .iter()
+        .filter(|o| o.kind.is_parked())
+        .collect();
+    assert!(parked.len() > 20, "{}", parked.len());
+    assert!(parked.iter().any(|o| o.kind == ObjectKind::ParkedVan));
+    // Along each kerb of each segment, the gaps between neighbours' bumpers: never below
+    // 0.5 m, and mostly (bar openings and stretches beyond the spawn radius) within 2 m.
+    let (mut gaps, mut short) = (0, 0);
+    for j in 0..street.segments.len() {
+        for side in [-1.0, 1.0] {
+            let mut row: Vec<(f64, f64)> = parked
+                .iter()
+                .filter(|o| o.segment == j && o.lateral * side > 0.0)
+                .map(|o| (o.s0, o.size[0]))
+                .collect();
+            row.sort_by(|a, b| a.0.total_cmp(&b.0));
+            for w in row.windows(2) {
+                let gap = (w[1].0 - 0.5 * w[1].1) - (w[0].0 + 0.5 * w[0].1);
+                assert!(gap >= 0.5 - 1e-9, "segment {j}: gap {gap}");
+                gaps += 1;
+                short += usize::from(gap <= 2.0 + 1e-9);
+            }
+        }
+    }
+    assert!(
+        gaps > 20 && short * 10 >= gaps * 7,
+        "{short} of {gaps} gaps within 2 m"
+    );
+    // Every level occurs among the parked vehicles seen; the hidden shares lie in [0, 1].
+    let mut levels = [0usize; 4];
+    for o in run.truth.objects.iter().filter(|o| o.kind.is_parked()) {
+        for s in &o.states {
+            assert!(s.hidden_rays <= s.rays, "{s:?}");
+            assert_eq!(s.occluded, occlusion_level(s.hidden_share()));
+            if s.points > 0 {
+                levels[s.occluded as usize] += 1;
+            }
+        }
+    }
+    assert!(
+        levels[0] > 0 && levels[1] > 0 && levels[2] > 0,
+        "{levels:?}"
+    );
+}

@@ -55,8 +55,9 @@ pub fn object_type(kind: ObjectKind) -> ObjectType {
 /// in which at least one lidar point hits it (the point counts come from writing the scans).
 /// Unlike KITTI's, which cover the front camera's view only, these label every object the
 /// lidar sees; an object not wholly in front of camera 2 gets the image box −1 −1 −1 −1 and
-/// alpha −10, KITTI's values for "unset". Truncation and occlusion are 0; the track id is
-/// the object's id.
+/// alpha −10, KITTI's values for "unset". Truncation is 0; the occlusion level is the
+/// truth's, from the lidar's rays ([`super::truth::occlusion_level`]), not the camera's view;
+/// the track id is the object's id.
 pub fn street_labels(truth: &StreetTruth, calib: &TrackingCalib) -> Vec<TrackingLabel> {
     let rect_from_velo = calib.rect_from_velo();
     let mut labels = Vec::new();
@@ -86,7 +87,7 @@ pub fn street_labels(truth: &StreetTruth, calib: &TrackingCalib) -> Vec<Tracking
                 track_id: object.id as i64,
                 object_type: object_type(object.kind),
                 truncated: 0.0,
-                occluded: 0,
+                occluded: state.occluded,
                 alpha: -10.0,
                 bbox: [-1.0; 4],
                 dimensions: [0.0; 3],

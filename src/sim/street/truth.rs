@@ -1,6 +1,7 @@
 //! Ground truth of a simulated street drive, as written to `truth.json` in the drive folder:
 //! per frame the time and the poses, the walls as rectangles and planes, the objects with
-//! their per-frame states, and how many lidar points hit each wall and object.
+//! their per-frame states, how many lidar points hit each wall and object, and how much of
+//! each object the lidar's rays see, as KITTI's occlusion level ([`occlusion_level`]).
 //!
 //! **Frames.** "World" is the simulation frame: x east, y north, z up, ground at z = 0, origin
 //! at the ego vehicle's start (the OXTS unit's ground projection). The *drive frame* is the
@@ -111,6 +112,59 @@ pub struct ObjectState {
     pub yaw: f64,
     /// Lidar points on the object in this frame.
     pub points: usize,
+    /// Lidar rays whose line meets the object within the lidar's range in this frame,
+    /// returned or not (see [`ObjectView`](super::lidar::ObjectView); absent from older files).
+    #[serde(default)]
+    pub rays: usize,
+    /// Of those, the rays whose first hit is another shape nearer the sensor.
+    #[serde(default)]
+    pub hidden_rays: usize,
+    /// KITTI's occlusion level from the hidden share ([`occlusion_level`]): 0 fully visible,
+    /// 1 partly occluded, 2 largely occluded, 3 unknown (no ray meets the object, or a file
+    /// written before the field).
+    #[serde(default = "unknown_occlusion")]
+    pub occluded: i32,
+}
+
+impl ObjectState {
+    /// The share of the rays meeting the object that are hidden, in [0, 1]; `None` without
+    /// rays.
+    pub fn hidden_share(&self) -> Option<f64> {
+        (self.rays > 0).then(|| self.hidden_rays as f64 / self.rays as f64)
+    }
+}
+
+fn unknown_occlusion() -> i32 {
+    OCCLUSION_UNKNOWN
+}
+
+/// KITTI's occlusion level "unknown".
+pub const OCCLUSION_UNKNOWN: i32 = 3;
+
+/// Largest hidden share of a fully visible object (level 0).
+pub const FULLY_VISIBLE_MAX_HIDDEN: f64 = 0.1;
+
+/// Largest hidden share of a partly occluded object (level 1); beyond it, largely occluded.
+pub const PARTLY_OCCLUDED_MAX_HIDDEN: f64 = 0.5;
+
+/// KITTI's occlusion level of an object whose rays are hidden in the share `hidden` (see
+/// [`ObjectView`](super::lidar::ObjectView)): 0 (fully visible) up to
+/// [`FULLY_VISIBLE_MAX_HIDDEN`], 1 (partly occluded) up to [`PARTLY_OCCLUDED_MAX_HIDDEN`],
+/// 2 (largely occluded) above, 3 (unknown) without rays.
+///
+/// KITTI's annotators judged the levels by eye in the image (Geiger et al. 2013 give no
+/// numbers). The cuts follow the plain reading of the words: "largely" is more than half
+/// hidden; "fully visible" allows a tenth, as a label's box is drawn around the whole vehicle
+/// and a pole, a mirror or a neighbour's bumper across a corner does not make a labeller call
+/// it occluded. nuScenes' visibility bins (Caesar et al. 2020), in image area, put their
+/// lowest cut at 40 % visible, near this 50 %.
+pub fn occlusion_level(hidden: Option<f64>) -> i32 {
+    match hidden {
+        None => OCCLUSION_UNKNOWN,
+        Some(h) if h <= FULLY_VISIBLE_MAX_HIDDEN => 0,
+        Some(h) if h <= PARTLY_OCCLUDED_MAX_HIDDEN => 1,
+        Some(_) => 2,
+    }
 }
 
 /// A road user.
@@ -163,5 +217,36 @@ impl StreetTruth {
     pub fn to_json(&self) -> Result<String> {
         serde_json::to_string_pretty(self)
             .map_err(|e| Error::invalid("street truth", e.to_string()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn occlusion_levels_by_hand() {
+        assert_eq!(occlusion_level(None), 3);
+        assert_eq!(occlusion_level(Some(0.0)), 0);
+        assert_eq!(occlusion_level(Some(0.1)), 0);
+        assert_eq!(occlusion_level(Some(0.11)), 1);
+        assert_eq!(occlusion_level(Some(0.5)), 1);
+        assert_eq!(occlusion_level(Some(0.51)), 2);
+        assert_eq!(occlusion_level(Some(1.0)), 2);
+    }
+
+    #[test]
+    fn a_state_written_before_the_ray_counts_reads_as_unknown_occlusion() {
+        let old = r#"{"frame": 4, "position": [1.0, 2.0, 0.0], "velocity": [0.0, 0.0, 0.0],
+                      "yaw": 0.5, "points": 12}"#;
+        let s: ObjectState = serde_json::from_str(old).unwrap();
+        assert_eq!((s.rays, s.hidden_rays, s.occluded), (0, 0, 3));
+        assert_eq!(s.hidden_share(), None);
+        let s = ObjectState {
+            rays: 40,
+            hidden_rays: 30,
+            ..s
+        };
+        assert_eq!(s.hidden_share(), Some(0.75));
     }
 }

@@ -642,5 +642,93 @@ fn place_objects(
             break;
         }
     }
+    place_parked_rows(config, segments, ego, times, rng, &mut objects);
     objects
+}
+
+/// Appends the rows of parked vehicles of `config.traffic.parked_rows` to `objects`: per
+/// segment and kerb with a row, from the first corner clearance on, vehicle after vehicle
+/// nose to tail with drawn gaps (see [`ParkedRows`](super::config::ParkedRows)). A vehicle
+/// is kept only when it starts within the spawn radius of the ego's path, keeps 0.5 m clear of
+/// the objects already parked at that kerb, and never comes near the ego. Draws nothing when
+/// there are no rows, so streets without them are as before.
+fn place_parked_rows(
+    config: &StreetConfig,
+    segments: &[Segment],
+    ego: &[[f64; 2]],
+    times: &[f64],
+    rng: &mut FilterRng,
+    objects: &mut Vec<Object>,
+) {
+    let traffic = &config.traffic;
+    let rows = &traffic.parked_rows;
+    let layout = &config.street;
+    for (j, seg) in segments.iter().enumerate() {
+        let clear = traffic.corner_clearance;
+        let (lo, hi) = (seg.s_start + clear, seg.s_end - clear);
+        let heading = seg.dir[1].atan2(seg.dir[0]);
+        for &side in rows.sides.signs() {
+            // `s` is where the next vehicle's rear (in the ego's direction) may start.
+            let mut s = lo + uniform(rng, rows.gap);
+            loop {
+                let van = rng.random::<f64>() < rows.van_share;
+                let (kind, size) = if van {
+                    (ObjectKind::ParkedVan, traffic.van_size)
+                } else {
+                    (ObjectKind::ParkedCar, traffic.car_size)
+                };
+                let reflectance = rng.random_range(0.1f32..0.9);
+                let gap = if rng.random::<f64>() < rows.opening_share {
+                    uniform(rng, rows.opening)
+                } else {
+                    uniform(rng, rows.gap)
+                };
+                if s + size[0] > hi {
+                    break;
+                }
+                let s0 = s + 0.5 * size[0];
+                s += size[0] + gap;
+                let lateral = side * (layout.road_half_width - 0.5 * size[1] - 0.1);
+                let p0 = seg.at(s0, lateral);
+                if !ego.iter().any(|e| dist(*e, p0) <= traffic.spawn_radius) {
+                    continue;
+                }
+                let crowded = objects.iter().any(|o| {
+                    o.segment == j
+                        && o.speed == 0.0
+                        && (o.lateral - lateral).abs() < 0.5
+                        && (o.s0 - s0).abs() < 0.5 * (o.size[0] + size[0]) + 0.5
+                });
+                if crowded {
+                    continue;
+                }
+                // Parked with the traffic of its kerb: on the right in the ego's direction.
+                let yaw = if side < 0.0 {
+                    heading
+                } else {
+                    crate::geometry::wrap_angle(heading + std::f64::consts::PI)
+                };
+                let object = Object {
+                    id: objects.len() as u32,
+                    kind,
+                    size,
+                    segment: j,
+                    s0,
+                    lateral,
+                    speed: 0.0,
+                    yaw,
+                    s_range: (f64::NEG_INFINITY, f64::INFINITY),
+                    reflectance,
+                };
+                let hits_ego = ego.iter().zip(times).any(|(e, &t)| {
+                    object
+                        .state_at(segments, t)
+                        .is_some_and(|(p, _)| dist(*e, p) < 2.0 + 2.5)
+                });
+                if !hits_ego {
+                    objects.push(object);
+                }
+            }
+        }
+    }
 }
