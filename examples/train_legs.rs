@@ -642,8 +642,10 @@ fn parse_augment(names: &[String]) -> Result<Vec<Augmentation>> {
                     stride: 2,
                     offset: 0,
                 },
-                s if s.starts_with("scale:") => Augmentation::Scale(s[6..].parse()?),
-                s => anyhow::bail!("no augmentation {s} (mirror, scale:F, half)"),
+                s => match s.strip_prefix("scale:") {
+                    Some(f) => Augmentation::Scale(f.parse()?),
+                    None => anyhow::bail!("no augmentation {s} (mirror, scale:F, half)"),
+                },
             };
             aug.validate()?;
             Ok(aug)
@@ -882,16 +884,24 @@ fn run_nested(args: &Args, cfg: &LegDetectorConfig, drop: &[usize]) -> Result<Op
     if args.min_leaf != 1 {
         cmd += &format!(" --min-leaf {}", args.min_leaf);
     }
+    if !args.drop_features.is_empty() {
+        cmd += &format!(" --drop-features {}", args.drop_features.join(","));
+    }
     cmd += &format!(" --max-false {} --out {}`", args.max_false, out.display());
     let augmented = if augs.is_empty() {
         String::new()
     } else {
         format!(" with varied copies ({})", args.augment.join(", "))
     };
+    let dropped = if args.drop_features.is_empty() {
+        String::new()
+    } else {
+        format!(", without {}", args.drop_features.join(", "))
+    };
     let m = LegModel {
         description: format!(
             "AdaBoost, {} decision stumps (learning rate {}, at least {} samples a side) on the leg \
-             candidates of positive_{{1,2,3,4}}_extracted.bag and negative_2.bag (all lasers){augmented}; \
+             candidates of positive_{{1,2,3,4}}_extracted.bag and negative_2.bag (all lasers){augmented}{dropped}; \
              rounds and thresholds chosen by leave-one-bag-out; {cmd}",
             model.stumps.len(),
             args.shrinkage,
