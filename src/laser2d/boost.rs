@@ -10,6 +10,12 @@
 //! feature over the sorted values (weighted error, thresholds midway between distinct values),
 //! so `rounds × features × samples` work after the sort.
 //!
+//! Regularised training ([`Boosted::train_with`], [`BoostConfig`]): each stump's vote is
+//! shrunk by a learning rate `ν ≤ 1` (its weight `ν·α`, and the sample weights updated with
+//! the shrunk vote, as in Friedman's 2001 shrinkage), and a split must leave at least
+//! `min_leaf` samples on each side. [`Boosted::train`] is the plain learner (`ν = 1`, one
+//! sample per side).
+//!
 //! Not for: multi-class problems, missing values (every feature must be finite).
 
 use crate::error::{Error, Result};
@@ -38,6 +44,28 @@ impl Stump {
     }
 }
 
+/// Settings of [`Boosted::train_with`] (see the module documentation).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoostConfig {
+    /// Boosting rounds (stumps at most).
+    pub rounds: usize,
+    /// Learning rate `ν` in `(0, 1]`: each stump's weight is `ν·α`.
+    pub shrinkage: f64,
+    /// Fewest samples on either side of a split (≥ 1).
+    pub min_leaf: usize,
+}
+
+impl BoostConfig {
+    /// The plain learner: `rounds` rounds, no shrinkage, one sample per side.
+    pub fn rounds(rounds: usize) -> Self {
+        BoostConfig {
+            rounds,
+            shrinkage: 1.0,
+            min_leaf: 1,
+        }
+    }
+}
+
 /// A boosted classifier.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Boosted {
@@ -60,8 +88,32 @@ impl Boosted {
     /// rare class is not ignored. Errors on empty or ragged input, non-finite values, or a
     /// single class.
     pub fn train(samples: &[Vec<f64>], positive: &[bool], rounds: usize) -> Result<Boosted> {
+        Boosted::train_with(samples, positive, &BoostConfig::rounds(rounds))
+    }
+
+    /// The first `k` stumps (all of them when there are fewer): the model after `k` rounds.
+    pub fn truncated(&self, k: usize) -> Boosted {
+        Boosted {
+            stumps: self.stumps[..k.min(self.stumps.len())].to_vec(),
+        }
+    }
+
+    /// [`Boosted::train`] with shrinkage and a minimum leaf size. Errors as
+    /// [`Boosted::train`] does, and on a learning rate outside `(0, 1]` or a zero `min_leaf`.
+    pub fn train_with(
+        samples: &[Vec<f64>],
+        positive: &[bool],
+        config: &BoostConfig,
+    ) -> Result<Boosted> {
         let n = samples.len();
         let bad = |r: String| Error::invalid("boosting", r);
+        if !(config.shrinkage > 0.0 && config.shrinkage <= 1.0) || config.min_leaf == 0 {
+            return Err(bad(format!(
+                "learning rate {} (must lie in (0, 1]), min_leaf {} (must be ≥ 1)",
+                config.shrinkage, config.min_leaf
+            )));
+        }
+        let (rounds, min_leaf) = (config.rounds, config.min_leaf);
         if n == 0 || positive.len() != n {
             return Err(bad(format!("{n} samples, {} labels", positive.len())));
         }
@@ -118,6 +170,11 @@ impl Boosted {
                     if k + 1 < n && samples[o[k + 1]][f] == v {
                         continue;
                     }
+                    // k + 1 samples at or below the threshold, n − k − 1 above (the plain
+                    // learner also tries the threshold above everything).
+                    if min_leaf > 1 && (k + 1 < min_leaf || n - k - 1 < min_leaf) {
+                        continue;
+                    }
                     let thr = if k + 1 < n {
                         0.5 * (v + samples[o[k + 1]][f])
                     } else {
@@ -142,7 +199,7 @@ impl Boosted {
                 feature: best.1,
                 threshold: best.2,
                 polarity: best.3,
-                alpha: 0.5 * ((1.0 - err) / err).ln(),
+                alpha: config.shrinkage * 0.5 * ((1.0 - err) / err).ln(),
             };
             let mut sum = 0.0;
             for i in 0..n {
@@ -185,6 +242,54 @@ mod tests {
         for x in &xs {
             assert!((back.score(x) - m.score(x)).abs() < 1e-9);
         }
+    }
+
+    #[test]
+    fn shrinkage_and_leaf_size_regularise() {
+        // One positive outlier among negatives at x = 0.9 and a clean split at 0.5.
+        let mut xs: Vec<Vec<f64>> = (0..40).map(|i| vec![i as f64 / 39.0]).collect();
+        let mut ys: Vec<bool> = xs.iter().map(|x| x[0] < 0.5).collect();
+        xs.push(vec![0.95]);
+        ys.push(true);
+        let plain = Boosted::train(&xs, &ys, 30).unwrap();
+        let same = Boosted::train_with(&xs, &ys, &BoostConfig::rounds(30)).unwrap();
+        assert_eq!(plain, same);
+        // The plain learner isolates the outlier; with 5 samples per leaf it cannot.
+        assert!(plain.score(&[0.95]) > 0.0);
+        let cfg = BoostConfig {
+            rounds: 30,
+            shrinkage: 1.0,
+            min_leaf: 5,
+        };
+        let leafy = Boosted::train_with(&xs, &ys, &cfg).unwrap();
+        assert!(leafy.score(&[0.95]) < 0.0);
+        assert!(leafy.score(&[0.1]) > 0.0 && leafy.score(&[0.8]) < 0.0);
+        // Shrinkage scales the first stump's weight and keeps its split.
+        let slow = Boosted::train_with(
+            &xs,
+            &ys,
+            &BoostConfig {
+                shrinkage: 0.1,
+                ..BoostConfig::rounds(30)
+            },
+        )
+        .unwrap();
+        assert_eq!(slow.stumps[0].threshold, plain.stumps[0].threshold);
+        assert!((slow.stumps[0].alpha - 0.1 * plain.stumps[0].alpha).abs() < 1e-12);
+        assert_eq!(plain.truncated(3).stumps, plain.stumps[..3].to_vec());
+        assert_eq!(plain.truncated(1000), plain);
+        for bad in [0.0, 1.5, f64::NAN] {
+            let c = BoostConfig {
+                shrinkage: bad,
+                ..BoostConfig::rounds(3)
+            };
+            assert!(Boosted::train_with(&xs, &ys, &c).is_err());
+        }
+        let c = BoostConfig {
+            min_leaf: 0,
+            ..BoostConfig::rounds(3)
+        };
+        assert!(Boosted::train_with(&xs, &ys, &c).is_err());
     }
 
     #[test]

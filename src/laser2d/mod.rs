@@ -35,6 +35,7 @@ pub mod csv;
 pub mod features;
 pub mod fuzzy_art;
 pub mod icp;
+pub mod leg_augment;
 pub mod legs;
 pub mod local_map;
 pub mod moving;
