@@ -12,10 +12,17 @@ use smc_lmb::rng::seeded;
 use std::collections::HashSet;
 
 fn filter(assoc: AssociationMethod, pd: f64) -> LmbFilter {
+    filter_detecting(assoc, ConstantDetection(pd))
+}
+
+fn filter_detecting(
+    assoc: AssociationMethod,
+    detection: impl smc_lmb::filter::DetectionModel + 'static,
+) -> LmbFilter {
     LmbFilter::builder()
         .transition(ConstantVelocity::new(2, 1.0).unwrap())
         .measurement(PositionMeasurement::new(2, 1.0).unwrap())
-        .detection(ConstantDetection(pd))
+        .detection(detection)
         .clutter(UniformClutter::rectangle(2.0, [-50.0, 50.0], [-50.0, 50.0]).unwrap())
         .birth(
             AdaptiveBirth::new(
@@ -160,27 +167,7 @@ fn data_handed_with_the_update_reaches_its_models() {
             out[..p.len()].fill(pd);
         }
     }
-    let build = || {
-        LmbFilter::builder()
-            .transition(ConstantVelocity::new(2, 1.0).unwrap())
-            .measurement(PositionMeasurement::new(2, 1.0).unwrap())
-            .detection(ShareDetection)
-            .clutter(UniformClutter::rectangle(2.0, [-50.0, 50.0], [-50.0, 50.0]).unwrap())
-            .birth(
-                AdaptiveBirth::new(
-                    PositionBirthSampler {
-                        position_std: 1.0,
-                        velocity_std: 2.0,
-                    },
-                    0.5,
-                    0.3,
-                    64,
-                )
-                .unwrap(),
-            )
-            .build()
-            .unwrap()
-    };
+    let build = || filter_detecting(AssociationMethod::default(), ShareDetection);
     let z = Measurements::from_rows(2, &[[1.0, 2.0]]).unwrap();
     let none = Measurements::empty(2);
     let mut existence = Vec::new();

@@ -288,7 +288,7 @@ pub fn print_evaluation(run: &str, clusters: &ClusterEvaluation, walls: Option<&
 }
 
 /// A tally as "0.75 (3/4)", or "– (0/0)".
-fn ratio(t: &Tally) -> String {
+pub fn ratio(t: &Tally) -> String {
     match t.ratio() {
         Some(r) => format!("{r:.2} ({}/{})", t.hits, t.total),
         None => "– (0/0)".to_string(),
@@ -298,16 +298,21 @@ fn ratio(t: &Tally) -> String {
 /// Prints a recall breakdown under `title`: in all, by occlusion level, by range.
 pub fn print_breakdown(title: &str, r: &RecallBreakdown) {
     println!("{title}: {}", ratio(&r.recall));
+    print_levels_and_ranges(&r.by_occlusion, &r.by_range);
+}
+
+/// Prints tallies by KITTI occlusion level (0–3) and by [`RANGE_BINS`], one a line.
+pub fn print_levels_and_ranges(by_occlusion: &[Tally], by_range: &[Tally]) {
     let levels = [
         "fully visible",
         "partly occluded",
         "largely occluded",
         "unknown",
     ];
-    for (name, t) in levels.iter().zip(&r.by_occlusion) {
+    for (name, t) in levels.iter().zip(by_occlusion) {
         println!("  {name:<17} {}", ratio(t));
     }
-    for (w, t) in RANGE_BINS.windows(2).zip(&r.by_range) {
+    for (w, t) in RANGE_BINS.windows(2).zip(by_range) {
         println!("  {:>2}–{:<2} m           {}", w[0], w[1], ratio(t));
     }
 }

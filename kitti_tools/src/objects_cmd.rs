@@ -4,6 +4,7 @@
 //! detections reported as vehicles, and KITTI's bird's-eye average precision for Car.
 
 use crate::config_file::tracking_config;
+use crate::eval_cmd::{print_levels_and_ranges, ratio};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use smc_lmb::kitti::object::ObjectFrames;
@@ -39,13 +40,6 @@ pub struct Args {
     quiet: bool,
 }
 
-fn ratio(t: &Tally) -> String {
-    match t.ratio() {
-        Some(r) => format!("{r:.2} ({}/{})", t.hits, t.total),
-        None => "– (0/0)".to_string(),
-    }
-}
-
 fn print_report(r: &ObjectFrameReport, root: &std::path::Path, within: f64) {
     println!(
         "road-user detector on {} object frames of {}",
@@ -60,18 +54,7 @@ fn print_report(r: &ObjectFrameReport, root: &std::path::Path, within: f64) {
         "  by a cluster of any class (what the segmentation finds): {}",
         ratio(&r.cluster_recall)
     );
-    let levels = [
-        "fully visible",
-        "partly occluded",
-        "largely occluded",
-        "unknown",
-    ];
-    for (name, t) in levels.iter().zip(&r.recall_by_occlusion) {
-        println!("  {name:<17} {}", ratio(t));
-    }
-    for (w, t) in RANGE_BINS.windows(2).zip(&r.recall_by_range) {
-        println!("  {:>2}–{:<2} m           {}", w[0], w[1], ratio(t));
-    }
+    print_levels_and_ranges(&r.recall_by_occlusion, &r.recall_by_range);
     println!(
         "detections reported as vehicles within {within} m that are cars or vans: {}",
         ratio(&r.precision)
