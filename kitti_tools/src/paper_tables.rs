@@ -234,7 +234,9 @@ pub fn print(result: &PairPrediction, runs: usize, paper: Option<&PaperTables>) 
         let matched = match_pairs(&result.pairs, p);
         let found = matched.iter().filter(|m| m.is_some()).count();
         println!(
-            "{found} of the paper's 3 walls found and paired (segmented area within a factor of 2)"
+            "{found} of the paper's 3 walls found and paired (segmented area within a factor of \
+             2): {}",
+            found_list(&matched)
         );
         for (i, (theirs, m)) in p.pairs.iter().zip(matched).enumerate() {
             println!(
@@ -242,6 +244,28 @@ pub fn print(result: &PairPrediction, runs: usize, paper: Option<&PaperTables>) 
                 wall_report(i + 1, theirs, m.map(|j| &result.pairs[j]))
             );
         }
+    }
+}
+
+/// Which of the paper's walls are found (`matched` from [`match_pairs`]): "walls 1, 2 found,
+/// wall 3 not found" and the like.
+pub fn found_list(matched: &[Option<usize>]) -> String {
+    let list = |found: bool| {
+        let walls: Vec<String> = (0..matched.len())
+            .filter(|&i| matched[i].is_some() == found)
+            .map(|i| (i + 1).to_string())
+            .collect();
+        match walls.len() {
+            0 => None,
+            1 => Some(format!("wall {}", walls[0])),
+            _ => Some(format!("walls {}", walls.join(", "))),
+        }
+    };
+    match (list(true), list(false)) {
+        (Some(f), Some(n)) => format!("{f} found, {n} not found"),
+        (Some(f), None) => format!("{f} found"),
+        (None, Some(n)) => format!("{n} not found"),
+        (None, None) => "no walls".to_string(),
     }
 }
 
@@ -340,5 +364,22 @@ mod tests {
         let ours = [err(300.0), err(30.0)];
         assert_eq!(match_pairs(&ours, p), [Some(1), None, None]);
         assert_eq!(match_pairs(&[], p), [None, None, None]);
+    }
+
+    #[test]
+    fn the_found_walls_are_named() {
+        assert_eq!(
+            found_list(&[Some(2), Some(1), Some(3)]),
+            "walls 1, 2, 3 found"
+        );
+        assert_eq!(
+            found_list(&[Some(1), None, None]),
+            "wall 1 found, walls 2, 3 not found"
+        );
+        assert_eq!(
+            found_list(&[None, Some(0), None]),
+            "wall 2 found, walls 1, 3 not found"
+        );
+        assert_eq!(found_list(&[None, None, None]), "walls 1, 2, 3 not found");
     }
 }

@@ -83,6 +83,7 @@ fn paper_tables_on_the_papers_drive_find_its_three_walls() {
         text.contains("3 of the paper's 3 walls found and paired"),
         "{text}"
     );
+    assert!(text.contains("walls 1, 2, 3 found"), "{text}");
     // Each of the paper's walls on a line of its own, judged against the targets.
     for n in 1..=3 {
         let line = text

@@ -161,8 +161,8 @@ fn extract_planes<'py>(
     Ok(d)
 }
 
-/// Keyword options of plane prediction: `PlanePredictionConfig`'s `dt`, `max_angle`,
-/// `max_centre_distance`, `use_vehicle_model`, the ECT's `sigma_accel` and
+/// Keyword options of plane prediction: `PlanePredictionConfig`'s `dt`, its association gate's
+/// `max_angle`, `max_plane_gap` and `min_overlap`, `use_vehicle_model`, the ECT's `sigma_accel` and
 /// `sigma_turn_accel`, `vehicle_model` (a built-in model's name, or a callable: see
 /// [`PyVehicleModel`]) and `planes` (a dict of `PlaneConfig` options). The Python vehicle
 /// model, if any, comes back beside the configuration (for its exceptions).
@@ -180,8 +180,9 @@ fn prediction_config(
                 |e: PyErr| PyValueError::new_err(format!("plane prediction option {key}: {e}"));
             match key.as_str() {
                 "dt" => c.dt = v.extract().map_err(bad)?,
-                "max_angle" => c.max_angle = v.extract().map_err(bad)?,
-                "max_centre_distance" => c.max_centre_distance = v.extract().map_err(bad)?,
+                "max_angle" => c.gate.max_angle = v.extract().map_err(bad)?,
+                "max_plane_gap" => c.gate.max_plane_gap = v.extract().map_err(bad)?,
+                "min_overlap" => c.gate.min_overlap = v.extract().map_err(bad)?,
                 "use_vehicle_model" => c.use_vehicle_model = v.is_truthy()?,
                 "sigma_accel" => sa = Some(v.extract::<f64>().map_err(bad)?),
                 "sigma_turn_accel" => st = Some(v.extract::<f64>().map_err(bad)?),

@@ -77,7 +77,7 @@ use crate::error::{Error, Result};
 use crate::geometry::{Plane, PlanePatch};
 use crate::rng::FilterRng;
 use band::BandGrid;
-use pieces::{connected_pieces, hull_candidates, point64, rms};
+use pieces::{connected_pieces, hull_candidates, join_along_wall, point64, rms, JoinGap};
 use plane_f32::PlaneF32;
 use ransac::{fit_chunked, one_round};
 
@@ -134,8 +134,12 @@ fn finite_points(xs: &[f32], ys: &[f32], zs: &[f32]) -> (Vec<[f32; 3]>, Vec<u32>
 /// One segmented plane piece.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PlaneDetection {
-    /// Bounding rectangle of the inliers on the least-squares plane.
+    /// Bounding rectangle of the inliers on the least-squares plane; a wall's spans only its
+    /// facade when [`PlaneConfig::facade_span`] trims low structure off it.
     pub patch: PlanePatch,
+    /// Bounding rectangle of all the inliers (for a wall, lowered to the ground like `patch`):
+    /// `patch` itself unless the facade span trimmed it.
+    pub whole: PlanePatch,
     /// Indices of the inlier points in the input cloud, ascending.
     pub inliers: Vec<u32>,
     /// Root-mean-square point-to-plane distance of the inliers (m).
@@ -331,6 +335,7 @@ fn classify_planes(
                 assigned[i as usize] = true;
             }
             out.ground = Some(PlaneDetection {
+                whole: patch.clone(),
                 patch,
                 inliers: to_orig(inliers),
                 rms: rms(plane, inliers, pts),
@@ -360,26 +365,41 @@ fn classify_planes(
             });
             continue;
         }
-        for piece in connected_pieces(
+        let pieces = connected_pieces(
             plane,
             inliers,
             pts,
             config.grid_cell,
             config.min_cell_points,
-        ) {
+        );
+        let gap = JoinGap {
+            azimuth_step: crate::cloud::HDL64E_AZIMUTH_STEP,
+            spacings: config.join_spacings,
+            least: config.grid_cell,
+            most: config.max_join_gap,
+        };
+        let pieces = if config.join_spacings > 0.0 {
+            join_along_wall(plane, pieces, pts, &gap)
+        } else {
+            pieces
+        };
+        for piece in pieces {
             match judge_piece(plane, &piece, pts, config, &up)? {
                 Err(rejected) => out.rejected.push(rejected),
-                Ok((patch, rms)) => {
+                Ok((patch, whole, rms)) => {
                     for &i in &piece {
                         assigned[i as usize] = true;
                     }
-                    let patch = match ground_plane {
-                        Some(g) if config.walls_to_ground => patch.lowered_to(&g),
-                        _ => patch,
+                    let (patch, whole) = match ground_plane {
+                        Some(g) if config.walls_to_ground => {
+                            (patch.lowered_to(&g), whole.lowered_to(&g))
+                        }
+                        _ => (patch, whole),
                     };
                     out.walls.push(PlaneDetection {
                         rms,
                         patch,
+                        whole,
                         inliers: to_orig(&piece),
                     });
                 }
@@ -402,7 +422,7 @@ fn judge_piece(
     pts: &[[f32; 3]],
     config: &PlaneConfig,
     up: &nalgebra::Vector3<f64>,
-) -> Result<std::result::Result<(PlanePatch, f64), RejectedPlane>> {
+) -> Result<std::result::Result<(PlanePatch, PlanePatch, f64), RejectedPlane>> {
     if piece.len() < config.min_points {
         return Ok(Err(RejectedPlane {
             plane: *plane,
@@ -458,7 +478,55 @@ fn judge_piece(
             patch: Some(patch),
         }));
     }
-    Ok(Ok((patch, rms)))
+    let span = match &config.wall_quality {
+        Some(q) if config.facade_span => facade_span(
+            &piece_plane,
+            &points,
+            q.min_top_above_sensor,
+            config.grid_cell,
+        ),
+        _ => None,
+    };
+    let facade = match span {
+        Some(kept) => PlanePatch::upright_from_points(piece_plane, &kept)?,
+        None => patch.clone(),
+    };
+    Ok(Ok((facade, patch, rms)))
+}
+
+/// The points of a facade piece between its first and last column (`cell` wide along the
+/// wall) whose highest point reaches `min_top` above the sensor, when that leaves points out:
+/// a facade continued in its plane by something low (a fence, a hedge, parked cars along it)
+/// keeps its rectangle on the facade, whose extent does not change from scan to scan as the
+/// sparse low part's cells come and go. `None` when nothing is left out.
+fn facade_span(
+    plane: &Plane,
+    points: &[nalgebra::Point3<f64>],
+    min_top: f64,
+    cell: f64,
+) -> Option<Vec<nalgebra::Point3<f64>>> {
+    let horizontal = plane.normal.cross(&nalgebra::Vector3::z());
+    if horizontal.norm() < std::f64::consts::FRAC_1_SQRT_2 {
+        return None;
+    }
+    let axis = horizontal.normalize();
+    let along = |p: &nalgebra::Point3<f64>| (p.coords.dot(&axis) / cell).floor();
+    let tall: Vec<f64> = points
+        .iter()
+        .filter(|p| p.z >= min_top)
+        .map(along)
+        .collect();
+    let first = tall.iter().copied().fold(f64::INFINITY, f64::min);
+    let last = tall.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if !(first <= last) {
+        return None;
+    }
+    let kept: Vec<nalgebra::Point3<f64>> = points
+        .iter()
+        .filter(|p| (first..=last).contains(&along(p)))
+        .copied()
+        .collect();
+    (kept.len() < points.len()).then_some(kept)
 }
 
 #[cfg(test)]
@@ -756,6 +824,66 @@ mod tests {
                 w.patch.extent
             );
         }
+    }
+
+    #[test]
+    fn a_facade_continued_by_a_low_fence_keeps_its_rectangle_on_the_facade() {
+        // A facade x = 12 from y = −10 to 5, 5 m high (its top 3.27 m above the sensor), and
+        // in its plane, touching it, a fence from y = 5 to 20 whose top (1.2 m over the road)
+        // stays 0.53 m under the sensor.
+        let mut rng = seeded(3);
+        let mut c = PointCloud::new();
+        ground(&mut c, &mut rng, 20_000);
+        add_rect(
+            &mut c,
+            &mut rng,
+            [12.0, -10.0, H],
+            [0.0, 15.0, 0.0],
+            [0.0, 0.0, 5.0],
+            [1.0, 0.0, 0.0],
+            0.02,
+            4000,
+        );
+        let fence_start = c.len();
+        add_rect(
+            &mut c,
+            &mut rng,
+            [12.0, 5.0, H],
+            [0.0, 15.0, 0.0],
+            [0.0, 0.0, 1.2],
+            [1.0, 0.0, 0.0],
+            0.02,
+            1500,
+        );
+        let fence = fence_start as u32..c.len() as u32;
+        let seg = extract_planes(&c, &PlaneConfig::default(), &mut seeded(9)).unwrap();
+        assert_eq!(seg.walls.len(), 1, "{:?}", seg.walls);
+        let w = &seg.walls[0];
+        // The fence's points belong to the wall; its rectangle is the facade's (15 m, within a
+        // grid cell), not facade and fence (30 m).
+        let on_fence = w.inliers.iter().filter(|&&i| fence.contains(&i)).count();
+        assert!(on_fence > 1000, "{on_fence}");
+        assert!(
+            (w.patch.extent.0 - 15.0).abs() < 1.0,
+            "{:?}",
+            w.patch.extent
+        );
+        let ys = w.patch.vertices.map(|v| v.y);
+        let top = ys.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        assert!((top - 5.0).abs() < 1.0, "{ys:?}");
+        // The whole rectangle keeps facade and fence: 30 m along the wall.
+        assert!(
+            (w.whole.extent.0 - 30.0).abs() < 1.0,
+            "{:?}",
+            w.whole.extent
+        );
+        // Without the facade test nothing is cut.
+        let loose = extract_planes(&c, &PlaneConfig::any_vertical(), &mut seeded(9)).unwrap();
+        assert!(
+            loose.walls.iter().any(|w| w.patch.extent.0 > 29.0),
+            "{:?}",
+            loose.walls
+        );
     }
 
     #[test]

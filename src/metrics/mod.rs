@@ -44,7 +44,9 @@ pub use gospa::{gospa, Gospa};
 pub use labels::{LabelConsistency, LabelStats, TruthLabels};
 pub use ospa::{ospa, Ospa};
 pub use ospa2::{ospa2, ospa2_parts, ospa2_series, tracks_from_frames, TrackHistory};
-pub use plane_prediction::{associate_planes, percentile, PlanePairError, PlanePredictionSummary};
+pub use plane_prediction::{
+    associate_planes, percentile, PlanePairError, PlanePredictionSummary, WallGate,
+};
 pub use rmse::{average_nis, chi_square_quantile, rms_error, NisCheck};
 pub use trajectory::{
     path_length, relative_pose_errors, segment_errors, PoseError, SegmentErrors, Spread,

@@ -1,5 +1,5 @@
 //! Plane-prediction errors: how well a plane patch predicted into the next frame matches the
-//! patch segmented there (seed 001, Sec. 5, Tables 1–6).
+//! patch segmented there (Gostar et al. 2019, Sec. 5, Tables 1–6).
 //!
 //! Per associated pair of a predicted and a segmented [`PlanePatch`] the reported quantities
 //! are the two areas, for each predicted vertex the distance to the closest segmented vertex,
@@ -8,10 +8,22 @@
 //!
 //! # Association
 //! [`associate_planes`] pairs predicted and segmented patches by an optimal assignment
-//! ([`crate::assignment::solve`]) on the cost `θ / max_angle + c / max_centre_distance`, where
-//! θ is the angle between the normals and c the distance between the patch centres. Pairs
-//! with `θ > max_angle` or `c > max_centre_distance` are forbidden; a patch may stay
-//! unpaired (at a cost of 2, the largest cost a gated pair can have).
+//! ([`crate::assignment::solve`]) on what describes a wall whatever part of it is seen: its
+//! plane and where along it the two patches lie ([`WallGate`]). For a predicted patch P and a
+//! segmented patch S:
+//!
+//! - θ, the angle between the normals;
+//! - g, the plane gap: the mean of the distance of S's centre from P's plane and of P's
+//!   centre from S's plane;
+//! - o, the overlap along the wall: both patches' vertices projected on the horizontal
+//!   direction of P's plane (n × z; a patch's first side for a near-horizontal plane) give two
+//!   intervals, and o is the length they share over the shorter interval's length.
+//!
+//! Pairs with `θ > max_angle`, `g > max_plane_gap` or `o < min_overlap` are forbidden; the
+//! others cost `θ / max_angle + g / max_plane_gap + (1 − o)`, and a patch may stay unpaired
+//! (at a cost of 3, the largest a gated pair can have). Two views of one long facade whose
+//! centres lie metres apart (its visible stretch moves with the vehicle) are so paired, and two
+//! parallel walls along one street are not.
 //!
 //! # Percentiles
 //! Percentiles use the nearest-rank rule: for `n` sorted values and a percentage `p`, the
@@ -125,36 +137,105 @@ pub fn percentile(values: &[f64], p: f64) -> f64 {
     sorted[rank - 1]
 }
 
+/// The gates of [`associate_planes`] (see the module documentation).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct WallGate {
+    /// Largest angle between the normals (rad).
+    pub max_angle: f64,
+    /// Largest plane gap (m).
+    pub max_plane_gap: f64,
+    /// Smallest overlap along the wall, as a fraction of the shorter patch's length.
+    pub min_overlap: f64,
+}
+
+impl Default for WallGate {
+    /// 10°, 1 m and half the shorter patch.
+    fn default() -> Self {
+        WallGate {
+            max_angle: 10f64.to_radians(),
+            max_plane_gap: 1.0,
+            min_overlap: 0.5,
+        }
+    }
+}
+
+impl WallGate {
+    /// Whether every gate can pass anything: positive, finite angle and gap, an overlap
+    /// fraction in [0, 1].
+    pub fn is_usable(&self) -> bool {
+        self.max_angle > 0.0
+            && self.max_angle.is_finite()
+            && self.max_plane_gap > 0.0
+            && self.max_plane_gap.is_finite()
+            && (0.0..=1.0).contains(&self.min_overlap)
+    }
+
+    /// The cost of pairing `p` (predicted) with `s` (segmented), `None` when a gate forbids it.
+    pub fn cost(&self, p: &PlanePatch, s: &PlanePatch) -> Option<f64> {
+        let angle = p.plane.angle_to(&s.plane);
+        if angle > self.max_angle {
+            return None;
+        }
+        let gap = 0.5 * (p.plane.distance(&s.centre()) + s.plane.distance(&p.centre()));
+        if !(gap <= self.max_plane_gap) {
+            return None;
+        }
+        let overlap = overlap_along(p, s);
+        if !(overlap >= self.min_overlap) {
+            return None;
+        }
+        Some(angle / self.max_angle + gap / self.max_plane_gap + (1.0 - overlap))
+    }
+}
+
+/// The share of the shorter of the two patches' extents along `p`'s wall that the other one
+/// covers (see the module documentation), in [0, 1]; 0 for degenerate patches.
+pub fn overlap_along(p: &PlanePatch, s: &PlanePatch) -> f64 {
+    let horizontal = p.plane.normal.cross(&nalgebra::Vector3::z());
+    let axis = if horizontal.norm() > 0.1 {
+        horizontal.normalize()
+    } else {
+        let side = p.vertices[1] - p.vertices[0];
+        if side.norm() == 0.0 {
+            return 0.0;
+        }
+        side.normalize()
+    };
+    let span = |q: &PlanePatch| {
+        q.vertices
+            .iter()
+            .map(|v| v.coords.dot(&axis))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                (lo.min(x), hi.max(x))
+            })
+    };
+    let ((a0, a1), (b0, b1)) = (span(p), span(s));
+    let shorter = (a1 - a0).min(b1 - b0);
+    if !(shorter > 0.0) {
+        return 0.0;
+    }
+    ((a1.min(b1) - a0.max(b0)) / shorter).clamp(0.0, 1.0)
+}
+
 /// Pairs predicted with segmented patches by a gated optimal assignment (see the module
 /// documentation): returns `(predicted index, segmented index)` pairs, sorted by the
-/// predicted index. `max_angle` is in radians, `max_centre_distance` in metres; a non-positive
-/// or NaN gate pairs nothing.
+/// predicted index. A gate that is not usable ([`WallGate::is_usable`]) pairs nothing.
 pub fn associate_planes(
     predicted: &[PlanePatch],
     segmented: &[PlanePatch],
-    max_angle: f64,
-    max_centre_distance: f64,
+    gate: &WallGate,
 ) -> Vec<(usize, usize)> {
     let (n, m) = (predicted.len(), segmented.len());
-    let usable = |g: f64| g > 0.0;
-    if n == 0 || m == 0 || !usable(max_angle) || !usable(max_centre_distance) {
+    if n == 0 || m == 0 || !gate.is_usable() {
         return Vec::new();
     }
     // Columns: the m segmented patches, then n "unpaired" columns.
-    const MISS: f64 = 2.0 + 1e-9;
+    const MISS: f64 = 3.0 + 1e-9;
     let cols = m + n;
-    let centres: Vec<_> = segmented.iter().map(PlanePatch::centre).collect();
     let mut cost = vec![MISS; n * cols];
     for (i, p) in predicted.iter().enumerate() {
-        let c = p.centre();
         for (j, s) in segmented.iter().enumerate() {
-            let angle = p.plane.angle_to(&s.plane);
-            let dist = (c - centres[j]).norm();
-            cost[i * cols + j] = if angle <= max_angle && dist <= max_centre_distance {
-                angle / max_angle + dist / max_centre_distance
-            } else {
-                f64::INFINITY
-            };
+            cost[i * cols + j] = gate.cost(p, s).unwrap_or(f64::INFINITY);
         }
     }
     match crate::assignment::solve(&cost, n, cols) {
@@ -286,12 +367,76 @@ mod tests {
             wall(0.0, 20.0, std::f64::consts::FRAC_PI_4),
             wall(-0.1, 5.0, 0.0),
         ];
-        let pairs = associate_planes(&predicted, &segmented, 10f64.to_radians(), 3.0);
+        let gate = WallGate::default();
+        let pairs = associate_planes(&predicted, &segmented, &gate);
         assert_eq!(pairs, vec![(0, 2), (1, 0)]);
         // More predictions than segmented patches works too.
-        let pairs = associate_planes(&predicted, &segmented[..1], 10f64.to_radians(), 3.0);
+        let pairs = associate_planes(&predicted, &segmented[..1], &gate);
         assert_eq!(pairs, vec![(1, 0)]);
-        assert!(associate_planes(&predicted, &[], 0.1, 3.0).is_empty());
-        assert!(associate_planes(&predicted, &segmented, f64::NAN, 3.0).is_empty());
+        assert!(associate_planes(&predicted, &[], &gate).is_empty());
+        let unusable = WallGate {
+            max_angle: f64::NAN,
+            ..gate
+        };
+        assert!(associate_planes(&predicted, &segmented, &unusable).is_empty());
+    }
+
+    /// A 6 m high stretch of the wall y = `y` from x = `x0` to `x1`.
+    fn stretch(x0: f64, x1: f64, y: f64) -> PlanePatch {
+        PlanePatch {
+            plane: Plane::new(Vector3::y(), -y).unwrap(),
+            vertices: [
+                Point3::new(x0, y, 0.0),
+                Point3::new(x1, y, 0.0),
+                Point3::new(x1, y, 6.0),
+                Point3::new(x0, y, 6.0),
+            ],
+            area: 6.0 * (x1 - x0),
+            extent: (x1 - x0, 6.0),
+        }
+    }
+
+    #[test]
+    fn overlap_is_the_shared_length_over_the_shorter_stretch() {
+        // [−13, 36] and [−2, 44] share [−2, 36]: 38 m of the shorter 46 m.
+        let o = overlap_along(&stretch(-13.0, 36.0, 8.0), &stretch(-2.0, 44.0, 8.2));
+        assert_abs_diff_eq!(o, 38.0 / 46.0, epsilon = 1e-12);
+        // One inside the other: all of the shorter; end to end: nothing.
+        assert_abs_diff_eq!(
+            overlap_along(&stretch(0.0, 20.0, 8.0), &stretch(5.0, 10.0, 8.0)),
+            1.0,
+            epsilon = 1e-12
+        );
+        assert_eq!(
+            overlap_along(&stretch(0.0, 10.0, 8.0), &stretch(12.0, 20.0, 8.0)),
+            0.0
+        );
+    }
+
+    #[test]
+    fn two_views_of_one_long_wall_pair_and_parallel_or_separate_walls_do_not() {
+        // One 50 m facade, its visible stretch moved on by the vehicle: centres 8 m apart.
+        let seen_before = stretch(-13.0, 36.0, 8.0);
+        let seen_now = stretch(-2.0, 44.0, 8.1);
+        assert!((seen_before.centre() - seen_now.centre()).norm() > 8.0);
+        let gate = WallGate::default();
+        assert_eq!(
+            associate_planes(&[seen_before.clone()], &[seen_now.clone()], &gate),
+            vec![(0, 0)]
+        );
+        // The cost: θ = 0, g = 0.1 m, o = 38/46.
+        let cost = gate.cost(&seen_before, &seen_now).unwrap();
+        assert_abs_diff_eq!(cost, 0.1 + (1.0 - 38.0 / 46.0), epsilon = 1e-9);
+        // A parallel wall 3 m behind, or the next building along the street, is not it.
+        assert!(
+            associate_planes(&[seen_before.clone()], &[stretch(-2.0, 44.0, 11.0)], &gate)
+                .is_empty()
+        );
+        assert!(associate_planes(
+            &[stretch(0.0, 10.0, 8.0)],
+            &[stretch(12.0, 20.0, 8.0)],
+            &gate
+        )
+        .is_empty());
     }
 }

@@ -22,11 +22,11 @@
 //! Not for: tracking planes over many frames (that is the filter with
 //! [`PlaneTransition`](crate::models::PlaneTransition)).
 
-use crate::cloud::planes::{extract_planes, PlaneConfig};
+use crate::cloud::planes::{extract_planes, PlaneConfig, PlaneDetection};
 use crate::cloud::PointCloud;
 use crate::error::{Error, Result};
 use crate::geometry::{FrameChange, PlanePatch};
-use crate::metrics::plane_prediction::{associate_planes, PlanePairError};
+use crate::metrics::plane_prediction::{associate_planes, PlanePairError, WallGate};
 use crate::models::vehicle::check_vehicle_state;
 use crate::models::{ExtendedConstantTurn, SharedVehicleModel, VehicleState};
 use crate::recording::Recording;
@@ -47,10 +47,9 @@ pub struct PlanePredictionConfig {
     pub dt: f64,
     /// Vehicle (IMU) → sensor (Velodyne) transform C: `p_sensor = C p_vehicle`.
     pub vehicle_to_sensor: Isometry3<f64>,
-    /// Association gate on the angle between normals (rad).
-    pub max_angle: f64,
-    /// Association gate on the distance between patch centres (m).
-    pub max_centre_distance: f64,
+    /// How a predicted wall is paired with a segmented one: by plane and overlap along the
+    /// wall ([`WallGate`]).
+    pub gate: WallGate,
     /// Whether the drive functions predict with the vehicle model (Algorithm 1) when vehicle
     /// states are available, instead of with the measured poses.
     pub use_vehicle_model: bool,
@@ -66,8 +65,7 @@ impl Default for PlanePredictionConfig {
             ),
             dt: 0.1,
             vehicle_to_sensor: Isometry3::identity(),
-            max_angle: 10f64.to_radians(),
-            max_centre_distance: 5.0,
+            gate: WallGate::default(),
             use_vehicle_model: true,
         }
     }
@@ -79,8 +77,8 @@ impl PlanePredictionConfig {
         self.planes.validate()?;
         for (name, v) in [
             ("dt", self.dt),
-            ("max_angle", self.max_angle),
-            ("max_centre_distance", self.max_centre_distance),
+            ("gate.max_angle", self.gate.max_angle),
+            ("gate.max_plane_gap", self.gate.max_plane_gap),
         ] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(Error::invalid(
@@ -88,6 +86,12 @@ impl PlanePredictionConfig {
                     format!("must be finite and positive, got {v}"),
                 ));
             }
+        }
+        if !(0.0..=1.0).contains(&self.gate.min_overlap) {
+            return Err(Error::invalid(
+                "plane prediction config field gate.min_overlap",
+                format!("must lie in [0, 1], got {}", self.gate.min_overlap),
+            ));
         }
         Ok(())
     }
@@ -170,21 +174,25 @@ impl PairPrediction {
     }
 }
 
-/// The wall patches of one cloud.
+/// The walls of one cloud.
 pub fn segment_walls(
     cloud: &PointCloud,
     config: &PlaneConfig,
     rng: &mut FilterRng,
-) -> Result<Vec<PlanePatch>> {
-    let seg = extract_planes(cloud, config, rng)?;
-    Ok(seg.walls.into_iter().map(|w| w.patch).collect())
+) -> Result<Vec<PlaneDetection>> {
+    Ok(extract_planes(cloud, config, rng)?.walls)
 }
 
-/// Predicts the wall patches `walls_k` into frame `frame` (= k + 1) `runs` times (at least
-/// once) and scores them against `walls_k1`. A vehicle model's non-finite draw is an error.
+/// Predicts the walls `walls_k` into frame `frame` (= k + 1) `runs` times (at least once) and
+/// scores them against `walls_k1`. A vehicle model's non-finite draw is an error.
+///
+/// The walls' rectangles ([`PlaneDetection::patch`], a facade's span when the segmentation
+/// trims low structure off it) are associated and give the vertex distances and normal
+/// angle; the areas reported are those of the walls' whole rectangles
+/// ([`PlaneDetection::whole`], which move with the same rigid motion and keep their area).
 pub fn predict_walls(
-    walls_k: &[PlanePatch],
-    walls_k1: &[PlanePatch],
+    walls_k: &[PlaneDetection],
+    walls_k1: &[PlaneDetection],
     ego: &EgoMotion,
     frame: usize,
     config: &PlanePredictionConfig,
@@ -194,21 +202,17 @@ pub fn predict_walls(
     let runs = runs.max(1);
     let mut per_pair: BTreeMap<(usize, usize), Vec<PlanePairError>> = BTreeMap::new();
     let mut prediction_ms = Vec::with_capacity(runs);
+    let segmented: Vec<PlanePatch> = walls_k1.iter().map(|w| w.patch.clone()).collect();
     for _ in 0..runs {
         let start = Instant::now();
         let m = ego.draw(rng)?;
-        let predicted: Vec<PlanePatch> = walls_k.iter().map(|p| p.moved_by(&m)).collect();
+        let predicted: Vec<PlanePatch> = walls_k.iter().map(|w| w.patch.moved_by(&m)).collect();
         prediction_ms.push(start.elapsed().as_secs_f64() * 1e3);
-        for (i, j) in associate_planes(
-            &predicted,
-            walls_k1,
-            config.max_angle,
-            config.max_centre_distance,
-        ) {
-            per_pair
-                .entry((i, j))
-                .or_default()
-                .push(PlanePairError::between(frame, &predicted[i], &walls_k1[j]));
+        for (i, j) in associate_planes(&predicted, &segmented, &config.gate) {
+            let mut e = PlanePairError::between(frame, &predicted[i], &segmented[j]);
+            e.predicted_area = walls_k[i].whole.area;
+            e.segmented_area = walls_k1[j].whole.area;
+            per_pair.entry((i, j)).or_default().push(e);
         }
     }
     let pairs = per_pair
@@ -303,7 +307,7 @@ fn predict_sequence(
 ) -> Result<Vec<PairPrediction>> {
     config.validate()?;
     let mut out = Vec::new();
-    let mut previous: Option<(usize, Vec<PlanePatch>)> = None;
+    let mut previous: Option<(usize, Vec<PlaneDetection>)> = None;
     let pairs: Vec<usize> = frames
         .clone()
         .filter(|&k| has_scan(k) && has_scan(k + 1))

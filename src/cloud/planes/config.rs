@@ -66,6 +66,21 @@ pub struct PlaneConfig {
     /// Grid cells with fewer points than this take no part in the pieces (their points stay
     /// unassigned); keeps stray clutter points on the infinite plane from stretching a patch.
     pub min_cell_points: usize,
+    /// Walls: two pieces of one plane are one facade when the gap between them along the
+    /// wall is at most this many expected point spacings there (a wall seen at a grazing
+    /// angle far ahead is sampled so sparsely that its grid cells fall apart); 0 (the
+    /// default) joins nothing. The gap is at least `grid_cell` and at most `max_join_gap`.
+    /// Joining on KITTI drive 0005 made the frame-to-frame vertex distances worse: the
+    /// joined extents come and go with the sparse cells (docs/results/walls_association.md).
+    pub join_spacings: f64,
+    /// Walls: the largest gap along a wall that joins two pieces (m).
+    pub max_join_gap: f64,
+    /// Walls with the facade test: a wall's rectangle spans only the columns (`grid_cell`
+    /// wide along the wall) whose highest point reaches the test's `min_top_above_sensor`,
+    /// when the plane carries low structure beyond them (a fence, a hedge, parked cars in the
+    /// facade's plane); the points stay the wall's. The low part's sparse cells come and go
+    /// from scan to scan, the facade's extent does not.
+    pub facade_span: bool,
     /// Walls: facade test on top of the size limits (default [`WallQuality::BUILDING`];
     /// `None`: every building-scale vertical piece is a wall).
     pub wall_quality: Option<WallQuality>,
@@ -153,6 +168,9 @@ impl Default for PlaneConfig {
             min_wall_height: 2.0,
             grid_cell: 1.0,
             min_cell_points: 3,
+            join_spacings: 0.0,
+            max_join_gap: 5.0,
+            facade_span: true,
             wall_quality: Some(WallQuality::BUILDING),
             walls_to_ground: true,
             ground_outline: true,
@@ -197,6 +215,8 @@ impl PlaneConfig {
             ("max_ground_tilt", self.max_ground_tilt),
             ("min_ground_depth", self.min_ground_depth),
             ("ground_clearance", self.ground_clearance),
+            ("join_spacings", self.join_spacings),
+            ("max_join_gap", self.max_join_gap),
             ("max_wall_tilt", self.max_wall_tilt),
             ("min_wall_area", self.min_wall_area),
             ("min_wall_length", self.min_wall_length),

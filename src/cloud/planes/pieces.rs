@@ -171,6 +171,117 @@ pub(super) fn connected_pieces(
     pieces
 }
 
+/// How far apart along a wall two pieces of it may lie and still be one facade
+/// ([`join_along_wall`]).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub(super) struct JoinGap {
+    /// The scanner's azimuth step (rad).
+    pub azimuth_step: f64,
+    /// The gap allowed, in expected point spacings along the wall where the gap is.
+    pub spacings: f64,
+    /// The gap always allowed (m).
+    pub least: f64,
+    /// The gap never exceeded (m).
+    pub most: f64,
+}
+
+impl JoinGap {
+    /// The gap allowed at the point `at` of a wall of unit normal `normal`, seen from the
+    /// sensor at the origin: `spacings` times the spacing of one scan line's points along the
+    /// wall there, Δφ·r / |sin γ| with r the horizontal range and γ the angle between the
+    /// horizontal ray and the wall (a wall seen at a grazing angle is sampled sparsely, and
+    /// its cells then fall below the grid's point count), within [`least`, `most`].
+    fn allowed(&self, normal: &Vector3<f64>, at: &Point3<f64>) -> f64 {
+        let ray = Vector3::new(at.x, at.y, 0.0);
+        let r = ray.norm();
+        let flat = Vector3::new(normal.x, normal.y, 0.0);
+        let sin_graze = if r > 0.0 && flat.norm() > 0.0 {
+            (ray.dot(&flat) / (r * flat.norm())).abs()
+        } else {
+            1.0
+        };
+        let spacing = self.azimuth_step * r / sin_graze.max(1e-3);
+        (self.spacings * spacing).clamp(self.least, self.most.max(self.least))
+    }
+}
+
+/// Joins the `pieces` of one wall `plane` that are one facade with a gap in it: pieces are
+/// taken in order along the wall's horizontal direction, and a piece joins the facade before
+/// it when the gap between them along the wall is at most what [`JoinGap::allowed`] allows
+/// at the gap and their height ranges overlap. A joined piece's points are in ascending order,
+/// and the pieces are ordered by their first point (as `connected_pieces` gives them for
+/// ascending inliers, so that nothing changes when nothing joins). A plane that is not steep
+/// (its normal within 45° of vertical) is returned as it is.
+pub(super) fn join_along_wall(
+    plane: &Plane,
+    pieces: Vec<Vec<u32>>,
+    pts: &[[f32; 3]],
+    gap: &JoinGap,
+) -> Vec<Vec<u32>> {
+    let n = plane.normal;
+    let horizontal = n.cross(&Vector3::z());
+    if pieces.len() < 2 || horizontal.norm() < std::f64::consts::FRAC_1_SQRT_2 {
+        return pieces;
+    }
+    let axis = horizontal.normalize();
+    // Per piece: (start, end) along the wall, (bottom, top), and the place of its first point.
+    let spans: Vec<((f64, f64), (f64, f64))> = pieces
+        .iter()
+        .map(|piece| {
+            let mut along = (f64::INFINITY, f64::NEG_INFINITY);
+            let mut height = (f64::INFINITY, f64::NEG_INFINITY);
+            for &i in piece {
+                let p = pts[i as usize];
+                let s = axis.x * p[0] as f64 + axis.y * p[1] as f64;
+                along = (along.0.min(s), along.1.max(s));
+                height = (height.0.min(p[2] as f64), height.1.max(p[2] as f64));
+            }
+            (along, height)
+        })
+        .collect();
+    let mut order: Vec<usize> = (0..pieces.len())
+        .filter(|&k| !pieces[k].is_empty())
+        .collect();
+    order.sort_by(|&a, &b| spans[a].0 .0.total_cmp(&spans[b].0 .0).then(a.cmp(&b)));
+    // Groups of piece indices, each growing along the wall.
+    let mut groups: Vec<(Vec<usize>, f64, (f64, f64))> = Vec::new();
+    for k in order {
+        let ((s0, s1), (z0, z1)) = spans[k];
+        if let Some((members, end, (b, t))) = groups.last_mut() {
+            let middle = 0.5 * (*end + s0);
+            // The gap's middle point on the wall, at mid height: the plane's foot point
+            // moved along the wall.
+            let foot = Point3::from(-n * plane.offset);
+            let at = foot + axis * (middle - axis.dot(&foot.coords));
+            let heights_meet = z0.max(*b) <= z1.min(*t);
+            if s0 - *end <= gap.allowed(&n, &at) && heights_meet {
+                members.push(k);
+                *end = end.max(s1);
+                *b = b.min(z0);
+                *t = t.max(z1);
+                continue;
+            }
+        }
+        groups.push((vec![k], s1, (z0, z1)));
+    }
+    let mut joined: Vec<Vec<u32>> = groups
+        .into_iter()
+        .map(|(members, _, _)| {
+            if members.len() == 1 {
+                return pieces[members[0]].clone();
+            }
+            let mut points: Vec<u32> = members
+                .iter()
+                .flat_map(|&k| pieces[k].iter().copied())
+                .collect();
+            points.sort_unstable();
+            points
+        })
+        .collect();
+    joined.sort_by_key(|piece| piece[0]);
+    joined
+}
+
 /// The grid cell (edge `cell`, in the plane's own coordinates) of each point `idx`.
 fn plane_cells(plane: &Plane, idx: &[u32], pts: &[[f32; 3]], cell: f64) -> Vec<(i64, i64)> {
     let (u, v) = plane.basis();
