@@ -2,7 +2,9 @@
 //! split by KITTI occlusion level and by range ([`RecallBreakdown`]), as `kitti-tools
 //! objects` reports its detector's and the tracking evaluation its tracks'.
 //!
-//! Not for: deciding which label was found (the caller's matching).
+//! One way of deciding which label was found is here too: the one-to-one nearest matching of
+//! bird's-eye positions within a gate ([`match_nearest`]) that `kitti-tools objects` and the
+//! drive evaluation count by; the tracking evaluation uses CLEAR's own matching instead.
 
 use serde::{Deserialize, Serialize};
 
@@ -92,9 +94,61 @@ pub fn range_bin(range: f64) -> Option<usize> {
         .position(|w| range >= w[0] && range < w[1])
 }
 
+/// One-to-one matching of `found_by` (detections, tracks) to `labels` by horizontal distance:
+/// pairs within `gate` (m), nearest first (ties by the index in `found_by`, then in
+/// `labels`), each side used once. Returns the label of each of `found_by` and whether each
+/// label was found.
+pub fn match_nearest(
+    found_by: &[[f64; 2]],
+    labels: &[[f64; 2]],
+    gate: f64,
+) -> (Vec<Option<usize>>, Vec<bool>) {
+    let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
+    for (i, p) in found_by.iter().enumerate() {
+        for (j, q) in labels.iter().enumerate() {
+            let d = (p[0] - q[0]).hypot(p[1] - q[1]);
+            if d <= gate {
+                pairs.push((d, i, j));
+            }
+        }
+    }
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
+    let mut label_of = vec![None; found_by.len()];
+    let mut found = vec![false; labels.len()];
+    for (_, i, j) in pairs {
+        if label_of[i].is_none() && !found[j] {
+            label_of[i] = Some(j);
+            found[j] = true;
+        }
+    }
+    (label_of, found)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn nearest_matching_is_one_to_one_nearest_first() {
+        // Tracks at (0, 0) and (2.5, 0); labels at (1, 0), (2, 0) and (10, 0), gate 3 m. The
+        // nearest pair is track 2 – label 2 (0.5 m), then track 1 – label 1 (1 m); label 3
+        // is beyond every gate. With one track at (1.5, 0), equidistant from labels 1 and 2,
+        // the tie goes to the lower index.
+        let labels = [[1.0, 0.0], [2.0, 0.0], [10.0, 0.0]];
+        assert_eq!(
+            match_nearest(&[[0.0, 0.0], [2.5, 0.0]], &labels, 3.0),
+            (vec![Some(0), Some(1)], vec![true, true, false])
+        );
+        assert_eq!(
+            match_nearest(&[[1.5, 0.0]], &labels, 3.0),
+            (vec![Some(0)], vec![true, false, false])
+        );
+        assert_eq!(
+            match_nearest(&[[0.0, 0.0]], &labels, 0.9),
+            (vec![None], vec![false; 3])
+        );
+        assert_eq!(match_nearest(&[], &[], 3.0), (vec![], vec![]));
+    }
 
     #[test]
     fn bins_by_hand() {

@@ -23,10 +23,10 @@ use super::drive_tracking::DriveTracks;
 use crate::error::{Error, Result};
 use crate::kitti::ObjectType;
 use crate::kitti::{TrackingLabel, Tracklets, VelodyneBox};
-use crate::metrics::recall::RecallBreakdown;
+use crate::metrics::recall::{match_nearest, RecallBreakdown};
 use crate::metrics::{gospa, ospa, percentile, LabelConsistency, LabelStats};
 use crate::recording::{Recording, RecordingLabels};
-use crate::sim::street::StreetTruth;
+use crate::sim::street::{ObjectState, ObjectTruth, StreetTruth};
 use nalgebra::{Isometry3, Point3, Vector3};
 
 /// One truth object in one frame: an identity and its horizontal position (world frame of the
@@ -48,26 +48,55 @@ pub type TruthFrames = Vec<Vec<TruthObject>>;
 /// (horizontally) of the sensor: what the sensor cannot see, or the tracker is set not to
 /// look at, no tracker can report.
 pub fn street_object_truth(truth: &StreetTruth, min_points: usize, max_range: f64) -> TruthFrames {
-    let drive_from_world = truth.world_from_drive.to_isometry().inverse();
     let mut frames: TruthFrames = vec![Vec::new(); truth.frames.len()];
-    for object in &truth.objects {
-        for state in &object.states {
-            if state.points < min_points || state.frame >= frames.len() {
-                continue;
+    for c in counted_street_states(truth, min_points, max_range) {
+        frames[c.state.frame].push(TruthObject {
+            id: c.object.id as u64,
+            position: c.position,
+        });
+    }
+    frames
+}
+
+/// One object of a simulated street in one frame that counts ([`counted_street_states`]).
+struct CountedState<'a> {
+    object: &'a ObjectTruth,
+    state: &'a ObjectState,
+    /// Box centre x, y in the world frame of the tracking output (m).
+    position: [f64; 2],
+    /// Horizontal distance from the sensor (m).
+    range: f64,
+}
+
+/// The states of a simulated street's objects that count in [`street_object_truth`]: at least
+/// `min_points` lidar points, the centre within `max_range` of the sensor, a frame of the
+/// truth.
+fn counted_street_states(
+    truth: &StreetTruth,
+    min_points: usize,
+    max_range: f64,
+) -> impl Iterator<Item = CountedState<'_>> {
+    let drive_from_world = truth.world_from_drive.to_isometry().inverse();
+    truth.objects.iter().flat_map(move |object| {
+        object.states.iter().filter_map(move |state| {
+            if state.points < min_points || state.frame >= truth.frames.len() {
+                return None;
             }
             let [x, y, z] = state.position;
             let sensor = truth.frames[state.frame].velodyne_pose.translation;
-            if (x - sensor[0]).hypot(y - sensor[1]) > max_range {
-                continue;
+            let range = (x - sensor[0]).hypot(y - sensor[1]);
+            if range > max_range {
+                return None;
             }
             let centre = drive_from_world * Point3::new(x, y, z + object.size[2] / 2.0);
-            frames[state.frame].push(TruthObject {
-                id: object.id as u64,
+            Some(CountedState {
+                object,
+                state,
                 position: [centre.x, centre.y],
-            });
-        }
-    }
-    frames
+                range,
+            })
+        })
+    })
 }
 
 /// The tracklet boxes of a KITTI raw drive, per frame, moved into the world frame of the
@@ -106,21 +135,36 @@ pub fn label_truth(
     keep: impl Fn(&VelodyneBox) -> bool,
 ) -> TruthFrames {
     let mut frames: TruthFrames = vec![Vec::new(); poses.len()];
-    for l in labels.iter().filter(|l| l.is_object()) {
+    for (l, _, c) in kept_labels(labels, rect_from_velo, poses, keep) {
+        if l.is_object() {
+            frames[l.frame].push(TruthObject {
+                id: l.track_id as u64,
+                position: [c.x, c.y],
+            });
+        }
+    }
+    frames
+}
+
+/// The labels of [`label_truth`] that lie in a frame of `poses`, have a track id and whose
+/// Velodyne-frame box `keep` accepts: each with that box and its centre in the world frame.
+fn kept_labels<'a>(
+    labels: &'a [TrackingLabel],
+    rect_from_velo: &'a Isometry3<f64>,
+    poses: &'a [Isometry3<f64>],
+    keep: impl Fn(&VelodyneBox) -> bool + 'a,
+) -> impl Iterator<Item = (&'a TrackingLabel, VelodyneBox, Point3<f64>)> + 'a {
+    labels.iter().filter_map(move |l| {
         if l.frame >= poses.len() || l.track_id < 0 {
-            continue;
+            return None;
         }
         let b = l.to_velodyne(rect_from_velo);
         if !keep(&b) {
-            continue;
+            return None;
         }
         let c = poses[l.frame] * b.center;
-        frames[l.frame].push(TruthObject {
-            id: l.track_id as u64,
-            position: [c.x, c.y],
-        });
-    }
-    frames
+        Some((l, b, c))
+    })
 }
 
 /// Drops from every frame of `tracks` the cluster tracks that `keep` refuses (given the
@@ -332,30 +376,16 @@ pub fn street_vehicles(
     max_range: f64,
 ) -> Vec<Vec<LabelledVehicle>> {
     use crate::sim::street::ObjectKind;
-    let drive_from_world = truth.world_from_drive.to_isometry().inverse();
     let mut frames = vec![Vec::new(); truth.frames.len()];
-    for object in &truth.objects {
-        if !matches!(
-            object.kind,
+    for c in counted_street_states(truth, min_points, max_range) {
+        if matches!(
+            c.object.kind,
             ObjectKind::Car | ObjectKind::ParkedCar | ObjectKind::Van | ObjectKind::ParkedVan
         ) {
-            continue;
-        }
-        for state in &object.states {
-            if state.points < min_points || state.frame >= frames.len() {
-                continue;
-            }
-            let [x, y, z] = state.position;
-            let sensor = truth.frames[state.frame].velodyne_pose.translation;
-            let range = (x - sensor[0]).hypot(y - sensor[1]);
-            if range > max_range {
-                continue;
-            }
-            let c = drive_from_world * Point3::new(x, y, z + object.size[2] / 2.0);
-            frames[state.frame].push(LabelledVehicle {
-                position: [c.x, c.y],
-                occluded: state.occluded,
-                range,
+            frames[c.state.frame].push(LabelledVehicle {
+                position: c.position,
+                occluded: c.state.occluded,
+                range: c.range,
             });
         }
     }
@@ -371,23 +401,14 @@ pub fn label_vehicles(
     keep: impl Fn(&VelodyneBox) -> bool,
 ) -> Vec<Vec<LabelledVehicle>> {
     let mut frames = vec![Vec::new(); poses.len()];
-    for l in labels {
-        if !matches!(l.object_type, ObjectType::Car | ObjectType::Van)
-            || l.frame >= poses.len()
-            || l.track_id < 0
-        {
-            continue;
+    for (l, b, c) in kept_labels(labels, rect_from_velo, poses, keep) {
+        if matches!(l.object_type, ObjectType::Car | ObjectType::Van) {
+            frames[l.frame].push(LabelledVehicle {
+                position: [c.x, c.y],
+                occluded: l.occluded,
+                range: b.center.x.hypot(b.center.y),
+            });
         }
-        let b = l.to_velodyne(rect_from_velo);
-        if !keep(&b) {
-            continue;
-        }
-        let c = poses[l.frame] * b.center;
-        frames[l.frame].push(LabelledVehicle {
-            position: [c.x, c.y],
-            occluded: l.occluded,
-            range: b.center.x.hypot(b.center.y),
-        });
     }
     frames
 }
@@ -417,36 +438,12 @@ pub fn car_van_recall(
         let positions: Vec<[f64; 2]> = labelled.iter().map(|v| v.position).collect();
         for (v, found) in labelled
             .iter()
-            .zip(nearest_found(&reported, &positions, gate))
+            .zip(match_nearest(&reported, &positions, gate).1)
         {
             r.add(v.occluded, v.range, found);
         }
     }
     r
-}
-
-/// Which of `labelled` a one-to-one matching with `reported` finds: pairs within `gate`
-/// (horizontal distance), nearest first (ties by index), each side used once.
-fn nearest_found(reported: &[[f64; 2]], labelled: &[[f64; 2]], gate: f64) -> Vec<bool> {
-    let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
-    for (i, p) in reported.iter().enumerate() {
-        for (j, q) in labelled.iter().enumerate() {
-            let d = (p[0] - q[0]).hypot(p[1] - q[1]);
-            if d <= gate {
-                pairs.push((d, i, j));
-            }
-        }
-    }
-    pairs.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
-    let mut used = vec![false; reported.len()];
-    let mut found = vec![false; labelled.len()];
-    for (_, i, j) in pairs {
-        if !used[i] && !found[j] {
-            used[i] = true;
-            found[j] = true;
-        }
-    }
-    found
 }
 
 /// Scores `tracks` against `labels`; `poses` are the recording's sensor poses, which
@@ -601,25 +598,6 @@ mod tests {
     use crate::kitti::TrackingLabel;
     use nalgebra::{Matrix3, Translation3, UnitQuaternion};
     use std::path::Path;
-
-    #[test]
-    fn nearest_matching_is_one_to_one_nearest_first() {
-        // Tracks at (0, 0) and (2.5, 0); labels at (1, 0), (2, 0) and (10, 0), gate 3 m. The
-        // nearest pair is track 2 – label 2 (0.5 m), then track 1 – label 1 (1 m); label 3
-        // is beyond every gate. With one track at (1.5, 0), equidistant from labels 1 and 2,
-        // the tie goes to the lower index.
-        let labels = [[1.0, 0.0], [2.0, 0.0], [10.0, 0.0]];
-        assert_eq!(
-            nearest_found(&[[0.0, 0.0], [2.5, 0.0]], &labels, 3.0),
-            [true, true, false]
-        );
-        assert_eq!(
-            nearest_found(&[[1.5, 0.0]], &labels, 3.0),
-            [true, false, false]
-        );
-        assert_eq!(nearest_found(&[[0.0, 0.0]], &labels, 0.9), [false; 3]);
-        assert!(nearest_found(&[], &[], 3.0).is_empty());
-    }
 
     #[test]
     fn label_truth_by_hand() {

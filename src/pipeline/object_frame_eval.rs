@@ -84,6 +84,7 @@ pub struct ScoredDetection {
     pub in_view: bool,
 }
 
+use crate::metrics::recall::match_nearest;
 pub use crate::metrics::recall::{Tally, RANGE_BINS};
 
 /// One average-precision figure.
@@ -224,31 +225,23 @@ fn is_car_or_van(t: ObjectType) -> bool {
 }
 
 /// Detections paired with labels whose bird's-eye centres are within `gate`, nearest pairs
-/// first, each used once: the label of each detection and whether each label was found.
+/// first, each used once ([`match_nearest`]): the label of each detection and whether each
+/// label was found.
 fn match_centres(
     detections: &[&ScoredDetection],
     truth: &FrameTruth,
     gate: f64,
 ) -> (Vec<Option<usize>>, Vec<bool>) {
-    let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
-    for (i, d) in detections.iter().enumerate() {
-        for (j, (_, b)) in truth.objects.iter().enumerate() {
-            let dist = (d.bbox.center.x - b.center.x).hypot(d.bbox.center.y - b.center.y);
-            if dist <= gate {
-                pairs.push((dist, i, j));
-            }
-        }
-    }
-    pairs.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
-    let mut det_match = vec![None; detections.len()];
-    let mut truth_found = vec![false; truth.objects.len()];
-    for (_, i, j) in pairs {
-        if det_match[i].is_none() && !truth_found[j] {
-            det_match[i] = Some(j);
-            truth_found[j] = true;
-        }
-    }
-    (det_match, truth_found)
+    let at: Vec<[f64; 2]> = detections
+        .iter()
+        .map(|d| [d.bbox.center.x, d.bbox.center.y])
+        .collect();
+    let labels: Vec<[f64; 2]> = truth
+        .objects
+        .iter()
+        .map(|(_, b)| [b.center.x, b.center.y])
+        .collect();
+    match_nearest(&at, &labels, gate)
 }
 
 /// The recall and precision counts of one frame, added to `report`.
