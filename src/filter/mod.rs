@@ -16,6 +16,7 @@
 pub mod association;
 pub mod birth;
 pub mod estimate;
+pub mod fusion;
 pub mod groups;
 pub mod label;
 pub mod lmb;
@@ -23,16 +24,19 @@ pub mod measurements;
 pub mod merge;
 pub mod model;
 pub mod particles;
+pub mod sensor;
 pub mod smoothing;
 pub mod step_data;
 pub mod survival;
 pub mod track;
+mod update;
 
 pub use association::{AssociationMethod, Associator};
 pub use birth::{
     AdaptiveBirth, BirthModel, BirthProposal, BirthSampler, BirthTerm, BirthTrack,
     CurrentMeasurements, PositionBirthSampler, StaticBirth,
 };
+pub use fusion::{Fusion, FusionMethod};
 pub use label::Label;
 pub use lmb::{
     Frame, LmbConfig, LmbFilter, LmbFilterBuilder, MostProbableMeasurement, MAX_PARTICLES,
@@ -46,6 +50,7 @@ pub use model::{
     TransitionModel,
 };
 pub use particles::{Jitter, ParticleSet};
+pub use sensor::{Mounting, Scan, Sensor, DEFAULT_SENSOR};
 pub use smoothing::FixedLagSmoother;
 pub use step_data::StepData;
 pub use survival::ConstantSurvival;
