@@ -161,7 +161,7 @@ fn two_sensors_from_one_file_track_the_worked_example() {
         let f: Vec<&str> = line.split(',').collect();
         csv.push_str(&format!("{},{},a,{},{}\n", f[0], f[1], f[2], f[3]));
         let frame: usize = f[0].parse().unwrap();
-        if frame % 2 == 0 && !f[2].is_empty() {
+        if frame.is_multiple_of(2) && !f[2].is_empty() {
             // p = R(π/2)·q + (1, 2), so q = R(−π/2)·(p − (1, 2)) = (y − 2, −(x − 1)).
             let (x, y): (f64, f64) = (f[2].parse().unwrap(), f[3].parse().unwrap());
             csv.push_str(&format!("{},{},b,{},{}\n", f[0], f[1], y - 2.0, 1.0 - x));

@@ -24,7 +24,8 @@
 //! The filter resamples any track whose combined weights collapse (effective sample size
 //! below [`super::LmbConfig::resample_threshold`] of its count), as after any update.
 //!
-//! Not for: the single-sensor update itself (see [`super::update`]), or the sensors' models.
+//! Not for: one sensor's update itself (the filter's private `update` module), or the
+//! sensors' models.
 
 use super::ParticleSet;
 use crate::error::{Error, Result};

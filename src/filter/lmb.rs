@@ -4,7 +4,11 @@
 //!
 //! predict → birth → gate → likelihoods → associate → update → resample → prune → estimate.
 //!
-//! Each stage is one function below (gating is part of `likelihoods`), and what a step keeps
+//! With several sensors the gate → update stages run once per sensor, in turn or on the same
+//! predicted tracks and then combined ([`super::fusion`]).
+//!
+//! Each stage is one function, here or, for one sensor's gate → update, in the private
+//! `update` module beside this one (gating is part of `likelihoods`), and what a step keeps
 //! for inspection afterwards is recorded by one more (`record_diagnostics`). Work per track and
 //! per association group runs in parallel with rayon; every track draws from its own random
 //! stream derived from the step seed and its label, so results are bit-identical whatever the

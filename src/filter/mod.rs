@@ -5,13 +5,17 @@
 //! never knows where they came from. Tracks ([`Track`]) carry a [`Label`], an existence
 //! probability and a [`ParticleSet`].
 //!
+//! A filter may have several [`Sensor`]s, each with its own measurement, detection and clutter
+//! models; a frame carries a [`Scan`] of any of them, and [`Fusion`] says how their updates
+//! combine ([`fusion`]).
+//!
 //! The filter's contract with its models lives here too: the plug-in traits of [`model`]
 //! ([`TransitionModel`], [`SurvivalModel`], [`MeasurementModel`], [`DetectionModel`],
 //! [`ClutterModel`]), [`BirthModel`], [`Associator`] and the duplicate merge's
 //! [`MergeDistance`]. The built-in models implementing them are in [`crate::models`] (and next
 //! to the applications that need their own).
 //!
-//! Not for: sensors, detectors or models of particular objects.
+//! Not for: sensor hardware, detectors or models of particular objects.
 
 pub mod association;
 pub mod birth;
