@@ -9,36 +9,17 @@
 //!   five steps of particle history and handing every step's estimates out smoothed
 //!   (`FixedLagSmoother`), against the run above for the smoother's cost.
 
+mod common;
+
+use common::FirstStepOnly;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use smc_lmb::filter::birth::BirthEvidence;
-use smc_lmb::filter::StepContext;
 use smc_lmb::filter::{
-    AssociationMethod, BirthModel, BirthTrack, FixedLagSmoother, Frame, LmbConfig, LmbFilter,
-    Measurements, StaticBirth,
+    AssociationMethod, FixedLagSmoother, Frame, LmbConfig, LmbFilter, Measurements, StaticBirth,
 };
 use smc_lmb::models::{ConstantDetection, ConstantVelocity, PositionMeasurement, UniformClutter};
 use smc_lmb::rng::seeded;
 use smc_lmb::sim::{Scenario, SimRun};
-use smc_lmb::FilterRng;
 use std::time::Duration;
-
-/// Births only at the first step: the tracks under test, and nothing new afterwards.
-struct FirstStepOnly(StaticBirth);
-
-impl BirthModel for FirstStepOnly {
-    fn birth(
-        &self,
-        ctx: &StepContext,
-        ev: Option<&BirthEvidence<'_>>,
-        rng: &mut FilterRng,
-    ) -> Vec<BirthTrack> {
-        if ctx.step == 0 {
-            self.0.birth(ctx, ev, rng)
-        } else {
-            Vec::new()
-        }
-    }
-}
 
 /// A filter already tracking `targets` objects on a grid 100 m apart, and the next frame.
 fn tracking(targets: usize, particles: usize) -> (LmbFilter, Vec<Frame>) {

@@ -4,37 +4,19 @@
 //! the sensors (one likelihood pass and one association per sensor; the fusion itself is one
 //! pass over the particles per sensor).
 
+mod common;
+
+use common::FirstStepOnly;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use smc_lmb::filter::birth::BirthEvidence;
 use smc_lmb::filter::{
-    BirthModel, BirthTerm, BirthTrack, Frame, Fusion, FusionMethod, LmbConfig, LmbFilter,
-    Measurements, Sensor, StaticBirth, StepContext,
+    BirthTerm, Frame, Fusion, FusionMethod, LmbConfig, LmbFilter, Measurements, Sensor, StaticBirth,
 };
 use smc_lmb::models::{ConstantDetection, ConstantVelocity, PositionMeasurement, UniformClutter};
 use smc_lmb::rng::seeded;
-use smc_lmb::FilterRng;
 use std::time::Duration;
 
 const OBJECTS: usize = 20;
 const PARTICLES: usize = 1000;
-
-/// Births only at the first step: the tracks under test, and nothing new afterwards.
-struct FirstStepOnly(StaticBirth);
-
-impl BirthModel for FirstStepOnly {
-    fn birth(
-        &self,
-        ctx: &StepContext,
-        ev: Option<&BirthEvidence<'_>>,
-        rng: &mut FilterRng,
-    ) -> Vec<BirthTrack> {
-        if ctx.step == 0 {
-            self.0.birth(ctx, ev, rng)
-        } else {
-            Vec::new()
-        }
-    }
-}
 
 /// A filter of `sensors` sensors already tracking the objects, and the next frame.
 fn tracking(sensors: usize, method: FusionMethod) -> (LmbFilter, Frame) {

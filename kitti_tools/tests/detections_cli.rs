@@ -223,18 +223,22 @@ fn two_sensors_from_one_file_track_the_worked_example() {
     // A sensor the configuration does not define: the file, the frame and the sensor named,
     // nothing written.
     let bad = dir.path().join("bad.csv");
-    std::fs::write(&bad, "frame,time,sensor,z0,z1\n0,0.0,a,1,2\n1,0.5,c,1,2\n").unwrap();
     let out = dir.path().join("bad.json");
-    let (ok, _, stderr) = run(&[
-        "detections",
-        "--input",
-        bad.to_str().unwrap(),
-        "--config",
-        dir.path().join("pu.toml").to_str().unwrap(),
-        "--output",
-        out.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let config = dir.path().join("pu.toml");
+    let run_bad = |text: &str| {
+        std::fs::write(&bad, text).unwrap();
+        run(&[
+            "detections",
+            "--input",
+            bad.to_str().unwrap(),
+            "--config",
+            config.to_str().unwrap(),
+            "--output",
+            out.to_str().unwrap(),
+            "--quiet",
+        ])
+    };
+    let (ok, _, stderr) = run_bad("frame,time,sensor,z0,z1\n0,0.0,a,1,2\n1,0.5,c,1,2\n");
     assert!(!ok);
     assert!(
         stderr.contains("bad.csv") && stderr.contains("frame 1") && stderr.contains("\"c\""),
@@ -242,17 +246,7 @@ fn two_sensors_from_one_file_track_the_worked_example() {
     );
     assert!(!out.exists());
     // One sensor twice at one time: the line named.
-    std::fs::write(&bad, "frame,time,sensor,z0,z1\n0,0.0,a,1,2\n1,0.0,a,1,2\n").unwrap();
-    let (ok, _, stderr) = run(&[
-        "detections",
-        "--input",
-        bad.to_str().unwrap(),
-        "--config",
-        dir.path().join("pu.toml").to_str().unwrap(),
-        "--output",
-        out.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let (ok, _, stderr) = run_bad("frame,time,sensor,z0,z1\n0,0.0,a,1,2\n1,0.0,a,1,2\n");
     assert!(!ok);
     assert!(
         stderr.contains("bad.csv:3") && stderr.contains("\"a\""),
