@@ -13,6 +13,8 @@
 //!   [`icp`] (scan matching), [`local_map`] (averaged static points), [`background`]
 //!   (per-beam background map), [`features`] (segment shape features) and [`fuzzy_art`]
 //!   (on-line shape categories); [`moving_rule`] decides which clusters are moving.
+//! * [`mounting`]: the mounting poses of several lasers on one platform, estimated by
+//!   registering their overlapping views of a static scene.
 //! * [`legs`]: people found by their legs, segments classed by a boosted classifier
 //!   ([`boost`]) trained on annotated recordings.
 //!
@@ -38,6 +40,7 @@ pub mod icp;
 pub mod leg_augment;
 pub mod legs;
 pub mod local_map;
+pub mod mounting;
 pub mod moving;
 pub mod moving_rule;
 pub mod nearest;

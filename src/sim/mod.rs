@@ -7,7 +7,8 @@
 //!
 //! [`people2d`] simulates walking people (discs) seen by a planar laser scanner on a moving
 //! robot, in the two scenarios of the ML-RANSAC paper, with exact ray casting, noisy
-//! odometry and per-scan ground truth and visibility.
+//! odometry and per-scan ground truth and visibility; [`people2d::lasers`] puts several lasers
+//! on the robot, each at its own mounting pose, field of view and rate.
 //!
 //! [`street`] simulates a KITTI-style street drive (HDL-64E-like lidar, OXTS) with walls, cars
 //! and pedestrians, written in the KITTI raw layout with a ground-truth file.

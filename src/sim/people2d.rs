@@ -808,13 +808,93 @@ impl PeopleScenario {
         best
     }
 
+    /// One scan's ranges from the true `sensor` pose among the people `present` (and the
+    /// static scene), with the noise of `sc` drawn from `rng` (per beam a bearing, then a range
+    /// error), and the ids of the people at least [`MIN_VISIBLE_BEAMS`] rays ended on.
+    pub(crate) fn cast_scan(
+        &self,
+        sensor: Pose2,
+        sc: &ScannerSpec,
+        present: &[PersonTruth],
+        rng: &mut FilterRng,
+    ) -> (Vec<f32>, Vec<u64>) {
+        let radius_of = |id: u64| {
+            self.people
+                .iter()
+                .find(|p| p.id == id)
+                .map_or(0.0, |p| p.radius)
+        };
+        let discs: Vec<(u64, [f64; 2], f64)> = present
+            .iter()
+            .map(|&(id, pos, _)| (id, pos, radius_of(id)))
+            .collect();
+        let mut hits = vec![0usize; discs.len()];
+        let mut ranges = Vec::with_capacity(sc.beams);
+        let origin = [sensor.x, sensor.y];
+        for i in 0..sc.beams {
+            let bearing_noise = sc.sigma_bearing * normal(rng);
+            let range_noise = sc.sigma_range * normal(rng);
+            let angle =
+                sensor.theta + sc.angle_min() + i as f64 * sc.angle_increment() + bearing_noise;
+            let dir = [angle.cos(), angle.sin()];
+            let range = match self.cast(origin, dir, &discs) {
+                Some((d, hit)) if d < sc.range_max => {
+                    if let Hit::Person(id) = hit {
+                        if let Some(j) = discs.iter().position(|e| e.0 == id) {
+                            hits[j] += 1;
+                        }
+                    }
+                    (d + range_noise).clamp(0.0, sc.range_max)
+                }
+                _ => sc.range_max,
+            };
+            ranges.push(range as f32);
+        }
+        let visible: Vec<u64> = discs
+            .iter()
+            .zip(&hits)
+            .filter(|(_, &h)| h >= MIN_VISIBLE_BEAMS)
+            .map(|(d, _)| d.0)
+            .collect();
+        (ranges, visible)
+    }
+
+    /// The noisy odometry increment from the true pose `prev` to `next` (see the module
+    /// documentation), five draws from `rng`, composed onto `odom`.
+    pub(crate) fn odometry_step(
+        &self,
+        odom: Pose2,
+        prev: Pose2,
+        next: Pose2,
+        rng: &mut FilterRng,
+    ) -> Pose2 {
+        let on = &self.odometry_noise;
+        let (s, c) = prev.theta.sin_cos();
+        let (dxw, dyw) = (next.x - prev.x, next.y - prev.y);
+        let dx = c * dxw + s * dyw;
+        let dy = -s * dxw + c * dyw;
+        let dth = wrap_angle(next.theta - prev.theta);
+        let e_t = on.sigma_trans_rel * normal(rng);
+        let n_x = on.sigma_trans_abs * normal(rng);
+        let n_y = on.sigma_trans_abs * normal(rng);
+        let e_r = on.sigma_rot_rel * normal(rng);
+        let n_th = on.sigma_rot_abs * normal(rng);
+        let (lx, ly) = (dx * (1.0 + e_t) + n_x, dy * (1.0 + e_t) + n_y);
+        let lth = dth * (1.0 + e_r) + n_th;
+        let (so, co) = odom.theta.sin_cos();
+        Pose2::new(
+            odom.x + co * lx - so * ly,
+            odom.y + so * lx + co * ly,
+            wrap_angle(odom.theta + lth),
+        )
+    }
+
     /// Simulates one run (see the module documentation); errors when the scenario is
     /// invalid.
     pub fn generate(&self, seed: u64) -> Result<People2dRun> {
         self.validate()?;
         let n = self.num_scans();
         let sc = &self.scanner;
-        let on = &self.odometry_noise;
         let mut run = People2dRun {
             scans: Vec::with_capacity(n),
             robot_truth: Vec::with_capacity(n),
@@ -829,66 +909,12 @@ impl PeopleScenario {
             let mut rng = stream(seed, k as u64);
             let truth = self.robot.pose_at(t);
             if k > 0 {
-                let (s, c) = prev_truth.theta.sin_cos();
-                let (dxw, dyw) = (truth.x - prev_truth.x, truth.y - prev_truth.y);
-                let dx = c * dxw + s * dyw;
-                let dy = -s * dxw + c * dyw;
-                let dth = wrap_angle(truth.theta - prev_truth.theta);
-                let e_t = on.sigma_trans_rel * normal(&mut rng);
-                let n_x = on.sigma_trans_abs * normal(&mut rng);
-                let n_y = on.sigma_trans_abs * normal(&mut rng);
-                let e_r = on.sigma_rot_rel * normal(&mut rng);
-                let n_th = on.sigma_rot_abs * normal(&mut rng);
-                let (lx, ly) = (dx * (1.0 + e_t) + n_x, dy * (1.0 + e_t) + n_y);
-                let lth = dth * (1.0 + e_r) + n_th;
-                let (so, co) = odom.theta.sin_cos();
-                odom = Pose2::new(
-                    odom.x + co * lx - so * ly,
-                    odom.y + so * lx + co * ly,
-                    wrap_angle(odom.theta + lth),
-                );
+                odom = self.odometry_step(odom, prev_truth, truth, &mut rng);
             }
             prev_truth = truth;
             let sensor = sensor_pose(truth, self.mount);
             let present = self.people_at(t);
-            let radius_of = |id: u64| {
-                self.people
-                    .iter()
-                    .find(|p| p.id == id)
-                    .map_or(0.0, |p| p.radius)
-            };
-            let discs: Vec<(u64, [f64; 2], f64)> = present
-                .iter()
-                .map(|&(id, pos, _)| (id, pos, radius_of(id)))
-                .collect();
-            let mut hits = vec![0usize; discs.len()];
-            let mut ranges = Vec::with_capacity(sc.beams);
-            let origin = [sensor.x, sensor.y];
-            for i in 0..sc.beams {
-                let bearing_noise = sc.sigma_bearing * normal(&mut rng);
-                let range_noise = sc.sigma_range * normal(&mut rng);
-                let angle =
-                    sensor.theta + sc.angle_min() + i as f64 * sc.angle_increment() + bearing_noise;
-                let dir = [angle.cos(), angle.sin()];
-                let range = match self.cast(origin, dir, &discs) {
-                    Some((d, hit)) if d < sc.range_max => {
-                        if let Hit::Person(id) = hit {
-                            if let Some(j) = discs.iter().position(|e| e.0 == id) {
-                                hits[j] += 1;
-                            }
-                        }
-                        (d + range_noise).clamp(0.0, sc.range_max)
-                    }
-                    _ => sc.range_max,
-                };
-                ranges.push(range as f32);
-            }
-            let visible: Vec<u64> = discs
-                .iter()
-                .zip(&hits)
-                .filter(|(_, &h)| h >= MIN_VISIBLE_BEAMS)
-                .map(|(d, _)| d.0)
-                .collect();
+            let (ranges, visible) = self.cast_scan(sensor, sc, &present, &mut rng);
             let mut scan = Scan::new(
                 t,
                 sc.angle_min(),
@@ -908,6 +934,8 @@ impl PeopleScenario {
         Ok(run)
     }
 }
+
+pub mod lasers;
 
 #[cfg(test)]
 mod tests;
