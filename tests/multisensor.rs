@@ -4,8 +4,9 @@
 
 use rand::RngExt;
 use smc_lmb::filter::{
-    AdaptiveBirth, Frame, Fusion, FusionMethod, LmbConfig, LmbFilter, LmbFilterBuilder,
-    Measurements, Mounting, PositionBirthSampler, Sensor,
+    AdaptiveBirth, DetectionModel, Frame, Fusion, FusionMethod, LmbConfig, LmbFilter,
+    LmbFilterBuilder, Measurements, Mounting, ParticleSet, PositionBirthSampler, Scan, Sensor,
+    StepContext, StepData,
 };
 use smc_lmb::metrics::ospa::ospa;
 use smc_lmb::models::{ConstantDetection, ConstantVelocity, PositionMeasurement, UniformClutter};
@@ -293,6 +294,77 @@ fn mounted_sensors_measure_in_their_own_frame() {
             assert!((x.existence - y.existence).abs() < 1e-6, "step {k}");
         }
     }
+}
+
+/// p_D for one step, handed with the step's data.
+struct Pd(f64);
+
+/// p_D from the step's [`Pd`], else [`P_D`].
+struct DataDetection;
+
+impl DetectionModel for DataDetection {
+    fn detection_probability(&self, _: &ParticleSet, ctx: &StepContext, out: &mut [f64]) {
+        out.fill(ctx.data.get::<Pd>().map_or(P_D, |d| d.0));
+    }
+}
+
+/// A scan's own data reaches its sensor's models only, over the frame's data of the same type.
+#[test]
+fn a_scans_own_data_reaches_only_its_sensors_models() {
+    let sc = scenario(7);
+    let build = || {
+        let with = |name: &str| {
+            Sensor::new(
+                name,
+                PositionMeasurement::new(2, SIGMA).unwrap(),
+                DataDetection,
+                UniformClutter::rectangle(CLUTTER, [-50.0, 50.0], [-50.0, 50.0]).unwrap(),
+            )
+        };
+        base()
+            .sensor(with("a"))
+            .sensor(with("b"))
+            .fusion(Fusion::new(FusionMethod::ParallelUpdate))
+            .build()
+            .unwrap()
+    };
+    let k = 15;
+    // The tracks after step `k` of a filter whose last frame is `last`.
+    let run = |last: Frame| {
+        let mut f = build();
+        let mut rng = seeded(3);
+        for j in 0..k {
+            let frame = Frame::at_time(j as f64)
+                .with_sensor(0, rows(&sc.scans[0][j]))
+                .with_sensor(1, rows(&sc.scans[1][j]));
+            f.step(&frame, &mut rng).unwrap();
+        }
+        let before: Vec<_> = f
+            .tracks()
+            .iter()
+            .map(|t| (t.label, t.existence))
+            .collect();
+        f.step(&last, &mut rng).unwrap();
+        // p_D = 0: every track missed for sure, r (1 − p_D) / (1 − r p_D) = r.
+        let unchanged = before.iter().filter(|b| b.1 > 0.5).all(|(l, r)| {
+            f.tracks()
+                .iter()
+                .any(|t| t.label == *l && (t.existence - 0.99 * r).abs() < 1e-12)
+        });
+        assert!(before.iter().filter(|b| b.1 > 0.5).count() >= 3);
+        unchanged
+    };
+    let a = || Scan::new(0, rows(&sc.scans[0][k]));
+    let at = || Frame::at_time(k as f64);
+    // Sensor a blind by its own data: its scan changes no existence (survival only).
+    assert!(run(at().with_scan(a().with_data(StepData::new().with(Pd(0.0))))));
+    // The same data on sensor b's scan does not reach sensor a.
+    let b_blind = Scan::new(1, Measurements::empty(2)).with_data(StepData::new().with(Pd(0.0)));
+    assert!(!run(at().with_scan(a()).with_scan(b_blind)));
+    // A scan's own data replaces the frame's: blind frame, seeing sensor.
+    let frame_blind = at().with_data(StepData::new().with(Pd(0.0)));
+    assert!(run(frame_blind.clone().with_scan(a())));
+    assert!(!run(frame_blind.with_scan(a().with_data(StepData::new().with(Pd(P_D))))));
 }
 
 #[test]

@@ -213,10 +213,13 @@ impl Frame {
     /// The same frame with sensor `sensor`'s `measurements` (its index in the filter's
     /// sensors, see [`LmbFilter::sensor_index`]), in the sensor's own frame.
     pub fn with_sensor(mut self, sensor: usize, measurements: Measurements) -> Self {
-        self.scans.push(Scan {
-            sensor,
-            measurements,
-        });
+        self.scans.push(Scan::new(sensor, measurements));
+        self
+    }
+
+    /// The same frame with `scan` (a sensor's measurements and the data only its models see).
+    pub fn with_scan(mut self, scan: Scan) -> Self {
+        self.scans.push(scan);
         self
     }
 
@@ -479,22 +482,38 @@ struct SensorUpdates {
 
 /// The measurements of `scans` (in sensor order) one after another; borrowed when there is
 /// one scan. `dim` is the dimension of an empty result.
-fn concatenated<'a>(
-    scans: &'a [(usize, Cow<'a, Measurements>)],
-    dim: usize,
-) -> Cow<'a, Measurements> {
+fn concatenated<'a>(scans: &'a [SensorScan<'a>], dim: usize) -> Cow<'a, Measurements> {
     match scans {
         [] => Cow::Owned(Measurements::empty(dim)),
-        [(_, z)] => Cow::Borrowed(z.as_ref()),
+        [one] => Cow::Borrowed(one.z.as_ref()),
         _ => {
             let mut all = Measurements::empty(dim);
-            for z in scans.iter().flat_map(|(_, z)| z.iter()) {
+            for z in scans.iter().flat_map(|s| s.z.iter()) {
                 all.push(z).expect("checked: one dimension, finite");
             }
             Cow::Owned(all)
         }
     }
 }
+
+/// One sensor's scan inside an update: its measurements (moved to the platform frame where
+/// the sensor is mounted) and, when the scan brought data of its own, the context its models
+/// see (the step's with that data added).
+struct SensorScan<'a> {
+    sensor: usize,
+    z: Cow<'a, Measurements>,
+    own: Option<StepContext>,
+}
+
+impl SensorScan<'_> {
+    /// The context this sensor's models see in a step whose context is `step`.
+    fn ctx<'b>(&'b self, step: &'b StepContext) -> &'b StepContext {
+        self.own.as_ref().unwrap_or(step)
+    }
+}
+
+/// A scan as the update takes it: sensor index, measurements, the scan's own data if any.
+type ScanRef<'a> = (usize, &'a Measurements, Option<&'a StepData>);
 
 /// Per-sensor vectors joined in sensor order.
 fn in_sensor_order(mut by_sensor: Vec<(usize, Vec<f64>)>) -> Vec<f64> {
@@ -648,10 +667,10 @@ impl LmbFilter {
     /// random stage derives its own streams from it. The same as [`LmbFilter::predict_step`]
     /// followed by [`LmbFilter::update_step`], with the frame checked whole before either.
     pub fn step(&mut self, frame: &Frame, rng: &mut FilterRng) -> Result<Vec<Estimate>> {
-        let scans: Vec<(usize, &Measurements)> = frame
+        let scans: Vec<ScanRef> = frame
             .scans
             .iter()
-            .map(|s| (s.sensor, &s.measurements))
+            .map(|s| (s.sensor, &s.measurements, Some(&s.data)))
             .collect();
         self.check_scans(&scans)?;
         self.predict_phase(
@@ -659,7 +678,7 @@ impl LmbFilter {
             frame.platform,
             frame.data.clone(),
             rng,
-            scans.iter().any(|(_, z)| !z.is_empty()),
+            scans.iter().any(|(_, z, _)| !z.is_empty()),
         )?;
         self.update_scans(&scans, StepData::new())
     }
@@ -697,18 +716,21 @@ impl LmbFilter {
         measurements: &Measurements,
         data: StepData,
     ) -> Result<Vec<Estimate>> {
-        self.update_step_scans(&[(0, measurements)], data)
+        let scans: [ScanRef; 1] = [(0, measurements, None)];
+        self.check_scans(&scans)?;
+        self.update_scans(&scans, data)
     }
 
-    /// [`LmbFilter::update_step_with`] for a filter with several sensors: `scans` holds
-    /// (sensor index, its measurements) for every sensor that reported, each at most once.
-    pub fn update_step_scans(
-        &mut self,
-        scans: &[(usize, &Measurements)],
-        data: StepData,
-    ) -> Result<Vec<Estimate>> {
-        self.check_scans(scans)?;
-        self.update_scans(scans, data)
+    /// [`LmbFilter::update_step_with`] for a filter with several sensors: `scans` holds a
+    /// scan for every sensor that reported, each at most once (with the data only that
+    /// sensor's models see, [`Scan::data`]).
+    pub fn update_step_scans(&mut self, scans: &[Scan], data: StepData) -> Result<Vec<Estimate>> {
+        let scans: Vec<ScanRef> = scans
+            .iter()
+            .map(|s| (s.sensor, &s.measurements, Some(&s.data)))
+            .collect();
+        self.check_scans(&scans)?;
+        self.update_scans(&scans, data)
     }
 
     /// The filter's sensors, in index order.
@@ -727,11 +749,7 @@ impl LmbFilter {
     }
 
     /// The second half of a step, with scans already checked by [`LmbFilter::check_scans`].
-    fn update_scans(
-        &mut self,
-        scans: &[(usize, &Measurements)],
-        data: StepData,
-    ) -> Result<Vec<Estimate>> {
+    fn update_scans(&mut self, scans: &[ScanRef], data: StepData) -> Result<Vec<Estimate>> {
         let Some(Pending {
             context: mut ctx,
             seed,
@@ -744,15 +762,24 @@ impl LmbFilter {
             ));
         };
         ctx.data.extend(data);
-        // In sensor order, moved to the platform frame where a sensor is mounted.
-        let mut scans: Vec<(usize, Cow<Measurements>)> = scans
+        // In sensor order, moved to the platform frame where a sensor is mounted, each with
+        // the context its models see.
+        let mut scans: Vec<SensorScan> = scans
             .iter()
-            .map(|&(s, z)| match self.models.sensors[s].mounting {
-                Some(m) => (s, Cow::Owned(m.to_platform(z))),
-                None => (s, Cow::Borrowed(z)),
+            .map(|&(sensor, z, own)| SensorScan {
+                sensor,
+                z: match self.models.sensors[sensor].mounting {
+                    Some(m) => Cow::Owned(m.to_platform(z)),
+                    None => Cow::Borrowed(z),
+                },
+                own: own.filter(|d| !d.is_empty()).map(|d| {
+                    let mut c = ctx.clone();
+                    c.data.extend(d.clone());
+                    c
+                }),
             })
             .collect();
-        scans.sort_by_key(|(s, _)| *s);
+        scans.sort_by_key(|s| s.sensor);
         let all = concatenated(&scans, self.models.sensors[0].measurement_dim());
         self.add_births(&ctx, &scans, &all, seed, &summaries)?;
         let predicted = self.predicted_copies();
@@ -818,10 +845,10 @@ impl LmbFilter {
     /// Rejects a scan of a sensor the filter does not have, two scans of one sensor, and
     /// measurements that do not have their sensor's measurement dimension (an empty scan may
     /// have any), naming the sensor.
-    fn check_scans(&self, scans: &[(usize, &Measurements)]) -> Result<()> {
+    fn check_scans(&self, scans: &[ScanRef]) -> Result<()> {
         let sensors = &self.models.sensors;
         let what = || format!("measurements of step {}", self.step);
-        for (k, &(s, z)) in scans.iter().enumerate() {
+        for (k, &(s, z, _)) in scans.iter().enumerate() {
             let Some(sensor) = sensors.get(s) else {
                 return Err(Error::invalid(
                     what(),
@@ -832,7 +859,7 @@ impl LmbFilter {
                     ),
                 ));
             };
-            if scans[..k].iter().any(|&(o, _)| o == s) {
+            if scans[..k].iter().any(|&(o, _, _)| o == s) {
                 return Err(Error::invalid(
                     what(),
                     format!("two scans of sensor {s} ({:?}) in one frame", sensor.name),
@@ -958,7 +985,7 @@ impl LmbFilter {
     fn add_births(
         &mut self,
         ctx: &StepContext,
-        scans: &[(usize, Cow<Measurements>)],
+        scans: &[SensorScan],
         all: &Measurements,
         seed: u64,
         summaries: &[TrackSummary],
@@ -972,8 +999,9 @@ impl LmbFilter {
         let u: Vec<f64> = if m.birth.uses_current_measurements() {
             scans
                 .iter()
-                .flat_map(|(s, z)| {
-                    unexplained(&self.tracks, summaries, z, &*m.sensors[*s].measurement, ctx)
+                .flat_map(|s| {
+                    let sensor = &*m.sensors[s.sensor].measurement;
+                    unexplained(&self.tracks, summaries, &s.z, sensor, s.ctx(ctx))
                 })
                 .collect()
         } else {
@@ -1037,7 +1065,7 @@ impl LmbFilter {
     /// summaries. `summaries` gate the predicted tracks for the first sensor.
     fn update_in_turn(
         &mut self,
-        scans: &[(usize, Cow<Measurements>)],
+        scans: &[SensorScan],
         ctx: &StepContext,
         seed: u64,
         summaries: Vec<TrackSummary>,
@@ -1045,12 +1073,13 @@ impl LmbFilter {
         let order = self
             .models
             .fusion
-            .ordered(&scans.iter().map(|(s, _)| *s).collect::<Vec<_>>());
+            .ordered(&scans.iter().map(|s| s.sensor).collect::<Vec<_>>());
         let mut assigned_by_sensor: Vec<(usize, Vec<f64>)> = Vec::with_capacity(order.len());
         let mut first = None;
         let mut summaries = summaries;
         for (k, &s) in order.iter().enumerate() {
-            let z: &Measurements = &scans.iter().find(|(i, _)| *i == s).expect("present").1;
+            let scan = scans.iter().find(|i| i.sensor == s).expect("present");
+            let (z, ctx) = (&*scan.z, scan.ctx(ctx));
             let sensor = &self.models.sensors[s];
             let lik = likelihoods(&self.tracks, sensor, z, ctx, &summaries)?;
             let marg = associate(
@@ -1098,18 +1127,19 @@ impl LmbFilter {
     fn update_in_parallel(
         &mut self,
         method: FusionMethod,
-        scans: &[(usize, Cow<Measurements>)],
+        scans: &[SensorScan],
         ctx: &StepContext,
         seed: u64,
         summaries: &[TrackSummary],
     ) -> Result<SensorUpdates> {
-        let present: Vec<usize> = scans.iter().map(|(s, _)| *s).collect();
+        let present: Vec<usize> = scans.iter().map(|s| s.sensor).collect();
         let weights = self.models.fusion.weights_of(&present);
         let m = &self.models;
         let tracks = &self.tracks;
         let per_sensor: Vec<Result<(Vec<TrackLikelihoods>, Vec<TrackMarginals>)>> = scans
             .par_iter()
-            .map(|(s, z)| {
+            .map(|scan| {
+                let (s, z, ctx) = (&scan.sensor, &*scan.z, scan.ctx(ctx));
                 let sensor = &m.sensors[*s];
                 let lik = likelihoods(tracks, sensor, z, ctx, summaries)?;
                 let marg = associate(
@@ -1138,7 +1168,7 @@ impl LmbFilter {
         let assigned_by_sensor = per_sensor
             .iter()
             .zip(scans)
-            .map(|((lik, marg), (s, z))| (*s, assigned(lik, marg, z.len())))
+            .map(|((lik, marg), scan)| (scan.sensor, assigned(lik, marg, scan.z.len())))
             .collect();
         let (likelihoods, marginals) = per_sensor.into_iter().next().expect("several scans");
         Ok(SensorUpdates {

@@ -8,7 +8,7 @@
 //!
 //! Not for: the fusion rules (see [`super::fusion`]) or the update itself.
 
-use super::Measurements;
+use super::{Measurements, StepData};
 use crate::error::{Error, Result};
 use crate::filter::{ClutterModel, DetectionModel, MeasurementModel};
 
@@ -142,6 +142,27 @@ pub struct Scan {
     pub sensor: usize,
     /// What it measured, in its own frame.
     pub measurements: Measurements,
+    /// What only this sensor's models are handed with the step (its own beams, say): added to
+    /// the frame's data, replacing values of the same types, for this sensor's measurement,
+    /// detection and clutter models. Empty by default.
+    pub data: StepData,
+}
+
+impl Scan {
+    /// Sensor `sensor`'s `measurements`, with no data of its own.
+    pub fn new(sensor: usize, measurements: Measurements) -> Self {
+        Scan {
+            sensor,
+            measurements,
+            data: StepData::new(),
+        }
+    }
+
+    /// The same scan with `data` for its sensor's models.
+    pub fn with_data(mut self, data: StepData) -> Self {
+        self.data = data;
+        self
+    }
 }
 
 /// Checks a set of sensors for a filter: at least one, names unique and not empty, every
