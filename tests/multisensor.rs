@@ -339,11 +339,7 @@ fn a_scans_own_data_reaches_only_its_sensors_models() {
                 .with_sensor(1, rows(&sc.scans[1][j]));
             f.step(&frame, &mut rng).unwrap();
         }
-        let before: Vec<_> = f
-            .tracks()
-            .iter()
-            .map(|t| (t.label, t.existence))
-            .collect();
+        let before: Vec<_> = f.tracks().iter().map(|t| (t.label, t.existence)).collect();
         f.step(&last, &mut rng).unwrap();
         // p_D = 0: every track missed for sure, r (1 − p_D) / (1 − r p_D) = r.
         let unchanged = before.iter().filter(|b| b.1 > 0.5).all(|(l, r)| {
@@ -357,14 +353,18 @@ fn a_scans_own_data_reaches_only_its_sensors_models() {
     let a = || Scan::new(0, rows(&sc.scans[0][k]));
     let at = || Frame::at_time(k as f64);
     // Sensor a blind by its own data: its scan changes no existence (survival only).
-    assert!(run(at().with_scan(a().with_data(StepData::new().with(Pd(0.0))))));
+    assert!(run(
+        at().with_scan(a().with_data(StepData::new().with(Pd(0.0))))
+    ));
     // The same data on sensor b's scan does not reach sensor a.
     let b_blind = Scan::new(1, Measurements::empty(2)).with_data(StepData::new().with(Pd(0.0)));
     assert!(!run(at().with_scan(a()).with_scan(b_blind)));
     // A scan's own data replaces the frame's: blind frame, seeing sensor.
     let frame_blind = at().with_data(StepData::new().with(Pd(0.0)));
     assert!(run(frame_blind.clone().with_scan(a())));
-    assert!(!run(frame_blind.with_scan(a().with_data(StepData::new().with(Pd(P_D))))));
+    assert!(!run(
+        frame_blind.with_scan(a().with_data(StepData::new().with(Pd(P_D))))
+    ));
 }
 
 #[test]
