@@ -11,16 +11,15 @@ fn example(name: &str) -> PathBuf {
         .join(name)
 }
 
-#[test]
-fn worked_example_tracks_three_objects() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("estimates.json");
-    let (ok, stdout, stderr) = run(&[
+/// `detections` of `input` with `config` into `out`, scored against the worked example's truth
+/// (OSPA cutoff 2 m).
+fn against_truth(input: &Path, config: &Path, out: &Path) -> (bool, String, String) {
+    run(&[
         "detections",
         "--input",
-        example("detections.csv").to_str().unwrap(),
+        input.to_str().unwrap(),
         "--config",
-        example("config.toml").to_str().unwrap(),
+        config.to_str().unwrap(),
         "--output",
         out.to_str().unwrap(),
         "--truth",
@@ -28,14 +27,27 @@ fn worked_example_tracks_three_objects() {
         "--cutoff",
         "2",
         "--quiet",
-    ]);
-    assert!(ok, "{stderr}");
-    let ospa: f64 = stdout
+    ])
+}
+
+/// The mean OSPA line of a `detections` summary.
+fn mean_ospa(stdout: &str) -> f64 {
+    stdout
         .lines()
         .find_map(|l| l.strip_prefix("mean OSPA (c = 2, p = 1): "))
         .expect("OSPA line")
         .parse()
-        .unwrap();
+        .unwrap()
+}
+
+#[test]
+fn worked_example_tracks_three_objects() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("estimates.json");
+    let (ok, stdout, stderr) =
+        against_truth(&example("detections.csv"), &example("config.toml"), &out);
+    assert!(ok, "{stderr}");
+    let ospa = mean_ospa(&stdout);
     // Three objects with 0.3 m noise: after a two-frame confirmation delay per birth (3 births
     // in 40 frames, each costing at most c/n for ~2 frames) the localisation error dominates;
     // anything above 1 m means the tracker is not following them.
@@ -194,28 +206,10 @@ fn two_sensors_from_one_file_track_the_worked_example() {
         )
         .unwrap();
         let out = dir.path().join(format!("{method}.json"));
-        let (ok, stdout, stderr) = run(&[
-            "detections",
-            "--input",
-            input.to_str().unwrap(),
-            "--config",
-            config.to_str().unwrap(),
-            "--output",
-            out.to_str().unwrap(),
-            "--truth",
-            example("truth.csv").to_str().unwrap(),
-            "--cutoff",
-            "2",
-            "--quiet",
-        ]);
+        let (ok, stdout, stderr) = against_truth(&input, &config, &out);
         assert!(ok, "{method}: {stderr}");
         assert!(stdout.starts_with("40 frames"), "{method}: {stdout}");
-        let ospa: f64 = stdout
-            .lines()
-            .find_map(|l| l.strip_prefix("mean OSPA (c = 2, p = 1): "))
-            .expect("OSPA line")
-            .parse()
-            .unwrap();
+        let ospa = mean_ospa(&stdout);
         // The single sensor's bound of the worked example above.
         assert!(ospa < 1.0, "{method}: mean OSPA {ospa}");
     }
