@@ -1,0 +1,187 @@
+//! Our filter on a peer scenario, with one setting for every scenario: the peer's model
+//! (constant velocity with σ_a = the file's process noise, p_S, p_D, σ, clutter rate over the
+//! scene's area) and [`PARTICLES`] particles per track, everything else `LmbConfig::default()`.
+//!
+//! Births: `static` = the peer's 16 birth terms at the file's birth locations, r_B = 0.01,
+//! covariance diag(2500, 2500, 100, 100) in the peer's [x, y, vx, vy] (std 50 m and 10 m/s),
+//! sampled with the measurement-guided proposal (our default for static terms); `static-plain`
+//! = the same terms sampled plainly; `adaptive` = adaptive birth (λ_B = 1, r_B,max = 0.1,
+//! position std σ, velocity std 10 m/s = the static terms' velocity spread).
+
+use crate::{Runner, Scenario, StepOut};
+use smc_lmb::config::{
+    BirthConfig, ClutterConfig, DetectionConfig, MeasurementConfig, RunConfig, TransitionConfig,
+};
+use smc_lmb::filter::{BirthTerm, Frame, LmbConfig, LmbFilter, Measurements};
+use smc_lmb::rng::{seeded, FilterRng};
+use std::time::Instant;
+
+/// Particles per track and per birth track, in every scenario.
+pub const PARTICLES: usize = 1000;
+
+/// Whether this build has the multi-sensor rules.
+pub const MULTI_SENSOR: bool = false;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Rule {
+    /// Today's single-sensor filter on sensor 0's points.
+    Single,
+    IteratedCorrector,
+    ParallelUpdate,
+    GeometricAverage,
+    ArithmeticAverage,
+}
+
+impl Rule {
+    pub const FUSED: [Rule; 4] = [
+        Rule::IteratedCorrector,
+        Rule::ParallelUpdate,
+        Rule::GeometricAverage,
+        Rule::ArithmeticAverage,
+    ];
+
+    pub fn parse(s: &str) -> Option<Rule> {
+        Some(match s {
+            "single" => Rule::Single,
+            "ic" => Rule::IteratedCorrector,
+            "pu" => Rule::ParallelUpdate,
+            "ga" => Rule::GeometricAverage,
+            "aa" => Rule::ArithmeticAverage,
+            _ => return None,
+        })
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Rule::Single => "single",
+            Rule::IteratedCorrector => "ic",
+            Rule::ParallelUpdate => "pu",
+            Rule::GeometricAverage => "ga",
+            Rule::ArithmeticAverage => "aa",
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Birth {
+    Static,
+    StaticPlain,
+    Adaptive,
+}
+
+impl Birth {
+    pub fn parse(s: &str) -> Option<Birth> {
+        Some(match s {
+            "static" => Birth::Static,
+            "static-plain" => Birth::StaticPlain,
+            "adaptive" => Birth::Adaptive,
+            _ => return None,
+        })
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Birth::Static => "static",
+            Birth::StaticPlain => "static-plain",
+            Birth::Adaptive => "adaptive",
+        }
+    }
+}
+
+/// The single-sensor configuration of a scenario (one sensor's models).
+pub fn config(s: &Scenario, birth: Birth, seed: u64) -> RunConfig {
+    let birth = match birth {
+        Birth::Static | Birth::StaticPlain => BirthConfig::Static {
+            // Our state is [x, ẋ, y, ẏ]; the peer's birth locations are [x, y, vx, vy].
+            terms: s
+                .birth_locations
+                .iter()
+                .map(|b| BirthTerm {
+                    existence: 0.01,
+                    mean: vec![b[0], b[2], b[1], b[3]],
+                    std: vec![50.0, 10.0, 50.0, 10.0],
+                })
+                .collect(),
+            particles: PARTICLES,
+            measurement_proposal: birth == Birth::Static,
+        },
+        Birth::Adaptive => BirthConfig::Adaptive {
+            expected_births: 1.0,
+            max_existence: 0.1,
+            particles: PARTICLES,
+            position_std: s.measurement_noise_std,
+            velocity_std: 10.0,
+            turn_rate_std: 0.1,
+        },
+    };
+    RunConfig {
+        seed,
+        survival: s.survival_probability,
+        filter: LmbConfig {
+            particles: PARTICLES,
+            ..LmbConfig::default()
+        },
+        transition: TransitionConfig::ConstantVelocity {
+            dims: 2,
+            sigma_accel: s.process_noise_std,
+        },
+        measurement: MeasurementConfig::Position {
+            sigma: s.measurement_noise_std,
+        },
+        detection: DetectionConfig::Constant {
+            probability: s.detection_probability,
+        },
+        clutter: ClutterConfig {
+            rate: s.clutter_rate,
+            volume: s.area,
+        },
+        birth,
+        association: Default::default(),
+    }
+}
+
+pub struct OurRunner<'a> {
+    scenario: &'a Scenario,
+    rule: Rule,
+    filter: LmbFilter,
+    rng: FilterRng,
+}
+
+impl<'a> OurRunner<'a> {
+    pub fn new(s: &'a Scenario, rule: Rule, birth: Birth, seed: u64) -> Result<Self, String> {
+        let cfg = config(s, birth, seed);
+        let filter = match rule {
+            Rule::Single => cfg.build().map_err(|e| e.to_string())?,
+            _ => return Err("this build of smc-lmb has no multi-sensor filter".into()),
+        };
+        Ok(OurRunner {
+            scenario: s,
+            rule,
+            filter,
+            rng: seeded(seed),
+        })
+    }
+}
+
+impl Runner for OurRunner<'_> {
+    fn step(&mut self, k: usize) -> Result<StepOut, String> {
+        let t = k as f64 * self.scenario.dt;
+        let z = &self.scenario.readings[k];
+        let frame = match self.rule {
+            Rule::Single => {
+                Frame::new(t, Measurements::from_rows(2, &z[0]).map_err(|e| e.to_string())?)
+            }
+            _ => unreachable!(),
+        };
+        let t0 = Instant::now();
+        let est = self
+            .filter
+            .step(&frame, &mut self.rng)
+            .map_err(|e| format!("step {k}: {e}"))?;
+        let ms = t0.elapsed().as_secs_f64() * 1e3;
+        Ok(StepOut {
+            ms,
+            estimates: est.iter().map(|e| [e.state[0], e.state[2]]).collect(),
+        })
+    }
+}
