@@ -176,14 +176,16 @@ fn config(birth: &str, particles: usize, seed: u64) -> Result<RunConfig> {
             dims: 2,
             sigma_accel: 0.5,
         },
-        measurement: MeasurementConfig::Position { sigma: NOISE_STD },
-        detection: DetectionConfig::Constant {
+        measurement: Some(MeasurementConfig::Position { sigma: NOISE_STD }),
+        detection: Some(DetectionConfig::Constant {
             probability: DETECTION,
-        },
-        clutter: ClutterConfig {
+        }),
+        clutter: Some(ClutterConfig {
             rate: f64::from(CLUTTER_MAX) / 2.0,
             volume: (2.0 * HALF_WIDTH).powi(2),
-        },
+        }),
+        sensors: Vec::new(),
+        fusion: None,
         birth,
         association: Default::default(),
     })

@@ -476,7 +476,7 @@ mod recording {
         cfg.filter.seed = args.seed;
         super::apply_lmb_args(args, &mut cfg);
         let min_visibility = cfg.min_visibility;
-        let clutter_volume = cfg.filter.clutter.volume;
+        let clutter_volume = cfg.filter.clutter.as_ref().map_or(0.0, |c| c.volume);
         let t0 = Instant::now();
         let fe = super::front_end(args)?;
         println!("front end {}", fe.name());

@@ -27,7 +27,12 @@ class Track:
 
 class LmbFilter:
     def __init__(self, config: Union[str, Mapping[str, Any]], transition: Optional[Transition] = None) -> None: ...
-    def step(self, time: float, measurements: ArrayLike, sensor_pose: Optional[Sequence[float]] = None) -> list[Estimate]: ...
+    def step(
+        self,
+        time: float,
+        measurements: Union[ArrayLike, Mapping[str, ArrayLike]],
+        sensor_pose: Optional[Sequence[float]] = None,
+    ) -> list[Estimate]: ...
     def run(
         self,
         times: Sequence[float],

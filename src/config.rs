@@ -31,6 +31,33 @@
 //! method = "lbp"                # or "murty" (k, min_weight), "gibbs" (samples)
 //! ```
 //!
+//! Several sensors: one `[[sensors]]` table per sensor, each with a `name` and its own
+//! `measurement`, `detection` and `clutter` tables (the keys above, with the same meaning), an
+//! optional `mounting = [x, y, heading]` on the platform (position measurements only; see
+//! [`crate::filter::Mounting`]), and a `[fusion]` table saying how their updates combine
+//! ([`crate::filter::Fusion`]); the top-level `measurement`, `detection` and `clutter`
+//! tables are then left out. The birth model's measurement-guided sampling follows the first
+//! sensor's measurement model.
+//!
+//! ```toml
+//! [[sensors]]
+//! name = "front"
+//! measurement = { model = "position", sigma = 0.3 }
+//! detection = { model = "constant", probability = 0.8 }
+//! clutter = { rate = 2.0, volume = 400.0 }
+//! mounting = [0.3, 0.0, 0.0]
+//! [[sensors]]
+//! name = "rear"
+//! measurement = { model = "position", sigma = 0.3 }
+//! detection = { model = "constant", probability = 0.8 }
+//! clutter = { rate = 2.0, volume = 400.0 }
+//! mounting = [-0.3, 0.0, 3.14159]
+//! [fusion]
+//! method = "pu"                 # "ic" (default), "pu", "ga" or "aa"
+//! weights = [0.5, 0.5]          # GA and AA; default uniform
+//! order = ["rear", "front"]     # IC's update order; default the tables' order
+//! ```
+//!
 //! Static birth terms (`model = "static"`) are sampled near the step's measurements that no
 //! existing track explains and importance-weighted, which leaves the birth density as written
 //! but puts its particles where a new object is seen ([`crate::filter::BirthProposal`]). This
@@ -52,8 +79,8 @@ mod birth;
 
 use crate::error::{ensure_finite, Error, Result};
 use crate::filter::{
-    AdaptiveBirth, AssociationMethod, BirthProposal, BirthTerm, ConstantSurvival, LmbConfig,
-    LmbFilter, StaticBirth,
+    AdaptiveBirth, AssociationMethod, BirthProposal, BirthTerm, ConstantSurvival, DetectionModel,
+    Fusion, FusionMethod, LmbConfig, LmbFilter, MeasurementModel, Mounting, Sensor, StaticBirth,
 };
 use crate::models::{
     BearingConvention, ConstantDetection, ConstantVelocity, CoordinatedTurn, FieldOfViewDetection,
@@ -77,12 +104,23 @@ pub struct RunConfig {
     pub filter: LmbConfig,
     /// Motion model.
     pub transition: TransitionConfig,
-    /// Measurement model.
-    pub measurement: MeasurementConfig,
-    /// Detection probability.
-    pub detection: DetectionConfig,
-    /// Uniform clutter.
-    pub clutter: ClutterConfig,
+    /// Measurement model of a filter with one sensor (left out with `sensors`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub measurement: Option<MeasurementConfig>,
+    /// Detection probability of a filter with one sensor (left out with `sensors`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub detection: Option<DetectionConfig>,
+    /// Uniform clutter of a filter with one sensor (left out with `sensors`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clutter: Option<ClutterConfig>,
+    /// Several sensors, each with its own models. Default none: one sensor, described by
+    /// `measurement`, `detection` and `clutter`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sensors: Vec<SensorConfig>,
+    /// How several sensors' updates combine. Default: the iterated corrector, sensors in
+    /// table order, uniform weights.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fusion: Option<FusionConfig>,
     /// Birth model.
     pub birth: BirthConfig,
     /// Association method. Default: loopy belief propagation.
@@ -92,6 +130,67 @@ pub struct RunConfig {
 
 fn default_survival() -> f64 {
     0.99
+}
+
+/// One sensor of a filter with several.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SensorConfig {
+    /// The name detections files use for it (their `sensor` column or key).
+    pub name: String,
+    /// Its measurement model.
+    pub measurement: MeasurementConfig,
+    /// Its detection probability.
+    pub detection: DetectionConfig,
+    /// Its clutter.
+    pub clutter: ClutterConfig,
+    /// Where it sits on the platform, `[x, y, heading]` (m, m, rad). Default: at the origin,
+    /// measurements taken as given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mounting: Option<[f64; 3]>,
+}
+
+/// The `[fusion]` table: [`Fusion`] with sensors named.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FusionConfig {
+    /// `"ic"`, `"pu"`, `"ga"` or `"aa"`. Default `"ic"`.
+    pub method: FusionMethod,
+    /// One weight per sensor, in table order, ≥ 0 and summing to one. Default uniform.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub weights: Option<Vec<f64>>,
+    /// IC's update order by sensor name. Default the tables' order.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub order: Option<Vec<String>>,
+}
+
+impl FusionConfig {
+    /// The fusion for sensors named `names` (in table order); an unknown name is an error.
+    pub fn fusion(&self, names: &[&str]) -> Result<Fusion> {
+        let order = match &self.order {
+            None => None,
+            Some(o) => Some(
+                o.iter()
+                    .map(|n| {
+                        names.iter().position(|m| m == n).ok_or_else(|| {
+                            Error::invalid(
+                                "config field `fusion.order`",
+                                format!("names sensor {n:?}, which no [[sensors]] table defines"),
+                            )
+                        })
+                    })
+                    .collect::<Result<Vec<usize>>>()?,
+            ),
+        };
+        let f = Fusion {
+            method: self.method,
+            weights: self.weights.clone(),
+            order,
+        };
+        f.validate(names.len())
+            .map_err(|e| Error::invalid("config field `fusion`", e.to_string()))?;
+        Ok(f)
+    }
 }
 
 /// Built-in motion models.
@@ -266,56 +365,90 @@ impl RunConfig {
         let builder = LmbFilter::builder()
             .survival(ConstantSurvival::new(self.survival)?)
             .config(self.filter.clone())
-            .associator(self.association)
-            .clutter(UniformClutter::new(self.clutter.rate, self.clutter.volume)?);
+            .associator(self.association);
         let builder = builder.transition(self.transition.model()?);
-        let builder = match &self.detection {
-            DetectionConfig::Constant { probability } => {
-                builder.detection(ConstantDetection::new(*probability)?)
-            }
-            DetectionConfig::GaussianRange {
-                peak,
-                scale,
-                center,
-            } => builder.detection(GaussianRangeDetection::new(*peak, *scale, *center)?),
-            DetectionConfig::FieldOfView {
-                p_inside,
-                p_outside,
-                max_range,
-                half_angle,
-                offset,
-            } => builder.detection(
-                FieldOfViewDetection::new(*p_inside, *p_outside, *max_range, *half_angle)?
-                    .with_offset(offset[0], offset[1])?,
-            ),
-        };
-        let range_bearing = match &self.measurement {
-            MeasurementConfig::Position { .. } => None,
-            MeasurementConfig::RangeBearing {
-                sigma_range,
-                sigma_bearing,
-                offset,
-                convention,
-            } => {
-                if axes != 2 {
-                    return Err(Error::invalid(
-                        "config field `measurement`",
-                        "range-bearing needs a planar transition",
-                    ));
-                }
-                Some(
-                    RangeBearing::new(*sigma_range, *sigma_bearing)?
-                        .with_offset(offset[0], offset[1])?
-                        .with_convention(*convention),
+        let (builder, first_measurement, range_bearing) = if self.sensors.is_empty() {
+            let missing = |what: &str| {
+                Error::invalid(
+                    format!("config field `{what}`"),
+                    "missing (give it, or one [[sensors]] table per sensor)",
                 )
+            };
+            let measurement = self
+                .measurement
+                .as_ref()
+                .ok_or_else(|| missing("measurement"))?;
+            let detection = self
+                .detection
+                .as_ref()
+                .ok_or_else(|| missing("detection"))?;
+            let clutter = self.clutter.as_ref().ok_or_else(|| missing("clutter"))?;
+            let (m, rb) = measurement_model(measurement, axes, "measurement")?;
+            let builder = builder
+                .clutter(clutter_model(clutter)?)
+                .detection_box(detection_model(detection)?)
+                .measurement_box(m);
+            (builder, measurement, rb)
+        } else {
+            if let Some(what) = [
+                self.measurement.as_ref().map(|_| "measurement"),
+                self.detection.as_ref().map(|_| "detection"),
+                self.clutter.as_ref().map(|_| "clutter"),
+            ]
+            .into_iter()
+            .flatten()
+            .next()
+            {
+                return Err(Error::invalid(
+                    format!("config field `{what}`"),
+                    "given beside [[sensors]]; each sensor has its own",
+                ));
             }
-        };
-        let builder = match (&self.measurement, range_bearing) {
-            (MeasurementConfig::Position { sigma }, _) => {
-                builder.measurement(PositionMeasurement::new(axes, *sigma)?)
+            let mut builder = builder;
+            let mut first = None;
+            for (i, sc) in self.sensors.iter().enumerate() {
+                let field = |f: &str| format!("sensors[{i}].{f}");
+                let (m, rb) = measurement_model(&sc.measurement, axes, &field("measurement"))?;
+                let mut sensor = Sensor::from_boxes(
+                    sc.name.clone(),
+                    m,
+                    detection_model(&sc.detection).map_err(|e| {
+                        Error::invalid(
+                            format!("config field `{}`", field("detection")),
+                            e.to_string(),
+                        )
+                    })?,
+                    Box::new(clutter_model(&sc.clutter).map_err(|e| {
+                        Error::invalid(
+                            format!("config field `{}`", field("clutter")),
+                            e.to_string(),
+                        )
+                    })?),
+                );
+                if let Some([x, y, h]) = sc.mounting {
+                    if rb.is_some() {
+                        return Err(Error::invalid(
+                            format!("config field `{}`", field("mounting")),
+                            "a mounting moves positions; a range-bearing sensor takes its \
+                             mounting offset in the measurement model's `offset`",
+                        ));
+                    }
+                    sensor = sensor.mounted(Mounting::new(x, y, h).map_err(|e| {
+                        Error::invalid(
+                            format!("config field `{}`", field("mounting")),
+                            e.to_string(),
+                        )
+                    })?);
+                }
+                builder = builder.sensor(sensor);
+                if first.is_none() {
+                    first = Some((&sc.measurement, rb));
+                }
             }
-            (_, Some(rb)) => builder.measurement(rb),
-            (_, None) => unreachable!("range-bearing model built above"),
+            let names: Vec<&str> = self.sensors.iter().map(|s| s.name.as_str()).collect();
+            let builder = builder.fusion(self.fusion.clone().unwrap_or_default().fusion(&names)?);
+            let (m, rb) = first.expect("at least one sensor");
+            (builder, m, rb)
         };
         let builder = match &self.birth {
             BirthConfig::Static {
@@ -339,7 +472,7 @@ impl RunConfig {
                 let birth = StaticBirth::new(terms.clone(), *particles)?;
                 // The built-in layouts keep position in components 0, 2 (and 4).
                 let observed: Vec<usize> = (0..axes).map(|a| 2 * a).collect();
-                match (&self.measurement, &range_bearing, measurement_proposal) {
+                match (first_measurement, &range_bearing, measurement_proposal) {
                     (MeasurementConfig::Position { sigma }, _, true) => builder.birth(
                         birth.with_proposal(BirthProposal::new(observed, vec![*sigma; axes])?)?,
                     ),
@@ -393,6 +526,67 @@ impl RunConfig {
     }
 }
 
+/// The measurement model of `m` for a transition with `axes` position axes, and the
+/// range-bearing model again when it is one (the birth samplers convert with it); `field`
+/// names the table in errors.
+fn measurement_model(
+    m: &MeasurementConfig,
+    axes: usize,
+    field: &str,
+) -> Result<(Box<dyn MeasurementModel>, Option<RangeBearing>)> {
+    Ok(match m {
+        MeasurementConfig::Position { sigma } => {
+            (Box::new(PositionMeasurement::new(axes, *sigma)?), None)
+        }
+        MeasurementConfig::RangeBearing {
+            sigma_range,
+            sigma_bearing,
+            offset,
+            convention,
+        } => {
+            if axes != 2 {
+                return Err(Error::invalid(
+                    format!("config field `{field}`"),
+                    "range-bearing needs a planar transition",
+                ));
+            }
+            let rb = RangeBearing::new(*sigma_range, *sigma_bearing)?
+                .with_offset(offset[0], offset[1])?
+                .with_convention(*convention);
+            (Box::new(rb), Some(rb))
+        }
+    })
+}
+
+/// The detection model of `d`.
+fn detection_model(d: &DetectionConfig) -> Result<Box<dyn DetectionModel>> {
+    Ok(match d {
+        DetectionConfig::Constant { probability } => {
+            Box::new(ConstantDetection::new(*probability)?)
+        }
+        DetectionConfig::GaussianRange {
+            peak,
+            scale,
+            center,
+        } => Box::new(GaussianRangeDetection::new(*peak, *scale, *center)?),
+        DetectionConfig::FieldOfView {
+            p_inside,
+            p_outside,
+            max_range,
+            half_angle,
+            offset,
+        } => Box::new(
+            FieldOfViewDetection::new(*p_inside, *p_outside, *max_range, *half_angle)?
+                .with_offset(offset[0], offset[1])?,
+        ),
+    })
+}
+
+/// The clutter model of `c`.
+fn clutter_model(c: &ClutterConfig) -> Result<UniformClutter> {
+    UniformClutter::new(c.rate, c.volume)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -424,7 +618,7 @@ mod tests {
     #[test]
     fn bad_values_are_named() {
         let mut c = sample();
-        c.clutter.volume = f64::NAN;
+        c.clutter.as_mut().unwrap().volume = f64::NAN;
         assert!(c
             .build()
             .unwrap_err()
@@ -482,12 +676,12 @@ mod tests {
         c.birth = static_birth(r#", "measurement_proposal": false"#);
         assert!(c.build().is_ok());
         // Range-bearing measurements: the guided birth runs through the filter.
-        c.measurement = MeasurementConfig::RangeBearing {
+        c.measurement = Some(MeasurementConfig::RangeBearing {
             sigma_range: 1.0,
             sigma_bearing: 0.01,
             offset: [0.0, 0.0],
             convention: BearingConvention::default(),
-        };
+        });
         c.birth = static_birth("");
         let mut f = c.build().unwrap();
         let z = crate::filter::Measurements::from_rows(2, &[[50.0, 0.3], [20.0, -1.0]]).unwrap();

@@ -7,11 +7,18 @@
 //! the world frame); a truth file may add `"ids": [7, 9, ...]`, one per measurement row.
 //!
 //! **CSV** (`.csv`): a header line, then one measurement per line:
-//! `frame,time,z0,z1[,z2...][,sensor_x,sensor_y,sensor_heading][,id]`. Columns are found by
-//! name in the header (`z0`, `z1`, … for the measurement). A line whose `z` fields are all
-//! empty declares an empty frame. Frames must appear in non-decreasing order of `frame`;
+//! `frame,time[,sensor],z0,z1[,z2...][,sensor_x,sensor_y,sensor_heading][,id]`. Columns are
+//! found by name in the header (`z0`, `z1`, … for the measurement). A line whose `z` fields are
+//! all empty declares an empty frame. Frames must appear in non-decreasing order of `frame`;
 //! missing frame numbers in between are empty frames, their times interpolated between the
 //! neighbouring listed frames' (at most [`MAX_FRAME_GAP`] of them in the whole file).
+//!
+//! **Several sensors**: a JSON entry may name its sensor (`"sensor": "front"`), and several
+//! entries of one time (one per sensor) make one frame of the filter; in CSV the optional
+//! `sensor` column does the same for the lines of one frame number. A line (or entry) with
+//! empty measurement fields and a sensor name declares that the sensor saw nothing; a sensor
+//! without a line in a frame did not report. Two entries of one sensor at one time are an
+//! error. [`filter_frames`] groups the entries into the filter's frames.
 //!
 //! Estimates are written as JSON (`{"frames": [{"frame", "time", "estimates": [{"label":
 //! {"birth_step", "index"}, "existence", "state", "age"}]}]}`) or CSV
@@ -42,6 +49,7 @@ fn push_gap_frames(frames: &mut Vec<DetectionFrame>, frame: usize, time: f64) {
         };
         frames.push(DetectionFrame {
             time: if k == frame { time } else { t },
+            sensor: None,
             measurements: Vec::new(),
             sensor_pose: None,
             ids: None,
@@ -55,6 +63,9 @@ fn push_gap_frames(frames: &mut Vec<DetectionFrame>, frame: usize, time: f64) {
 pub struct DetectionFrame {
     /// Time stamp, seconds.
     pub time: f64,
+    /// The sensor that measured them (files of several sensors).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sensor: Option<String>,
     /// Measurement vectors.
     #[serde(default)]
     pub measurements: Vec<Vec<f64>>,
@@ -158,6 +169,17 @@ fn check_frames(path: &Path, frames: &[DetectionFrame]) -> Result<()> {
                 format!("{} is before the previous frame's {}", f.time, last_time),
             ));
         }
+        if let Some(name) = &f.sensor {
+            let same_time = frames[..k].iter().rev().take_while(|o| o.time == f.time);
+            if same_time.clone().any(|o| o.sensor.as_ref() == Some(name)) {
+                return Err(Error::parse(
+                    path,
+                    0,
+                    field("sensor"),
+                    format!("sensor {name:?} has two frames at time {}", f.time),
+                ));
+            }
+        }
         last_time = f.time;
         for (j, m) in f.measurements.iter().enumerate() {
             if Some(m.len()) != dim || m.is_empty() {
@@ -208,6 +230,7 @@ struct CsvColumns<'a> {
     z: Vec<usize>,
     pose: Option<[usize; 3]>,
     id: Option<usize>,
+    sensor: Option<usize>,
 }
 
 impl<'a> CsvColumns<'a> {
@@ -240,6 +263,7 @@ impl<'a> CsvColumns<'a> {
             }
         };
         let id = col("id");
+        let sensor = col("sensor");
         Ok(CsvColumns {
             names,
             frame,
@@ -247,6 +271,7 @@ impl<'a> CsvColumns<'a> {
             z,
             pose,
             id,
+            sensor,
         })
     }
 }
@@ -325,37 +350,86 @@ fn parse_csv(
         return Err(Error::parse(path, 1, "header", "the file is empty"));
     };
     let columns = CsvColumns::parse(path, header)?;
+    // One entry per frame number, or per (frame number, sensor) with a `sensor` column;
+    // `numbers[k]` is entry k's frame number.
     let mut frames: Vec<DetectionFrame> = Vec::new();
+    let mut numbers: Vec<usize> = Vec::new();
     let mut unlisted = 0usize;
     for (i, line) in lines {
         let row = CsvRow::split(path, i + 1, &columns.names, line)?;
         let frame: usize = row.parsed(columns.frame, "a frame number")?;
         let time = row.num(columns.time)?;
-        if frame < frames.len().saturating_sub(1) {
-            return Err(row.error(
-                "frame",
-                format!("frame {frame} after frame {}", frames.len() - 1),
-            ));
+        let sensor = columns
+            .sensor
+            .map(|c| row.cells[c])
+            .filter(|s| !s.is_empty())
+            .map(str::to_string);
+        let last = numbers.last().copied();
+        if let Some(n) = last.filter(|&n| frame < n) {
+            return Err(row.error("frame", format!("frame {frame} after frame {n}")));
         }
-        let gap = frame.saturating_sub(frames.len());
-        unlisted = unlisted.saturating_add(gap);
-        if unlisted > MAX_FRAME_GAP {
+        if last != Some(frame) {
+            let next = last.map_or(0, |n| n + 1);
+            let gap = frame - next;
+            unlisted = unlisted.saturating_add(gap);
+            if unlisted > MAX_FRAME_GAP {
+                return Err(row.error(
+                    "frame",
+                    format!(
+                        "frame {frame} would leave {gap} empty frames before it, {unlisted} in \
+                         the file so far; at most {MAX_FRAME_GAP} are accepted"
+                    ),
+                ));
+            }
+            let listed = frames.len();
+            let mut padded: Vec<DetectionFrame> =
+                frames.last().map(|f| vec![f.clone()]).unwrap_or_default();
+            let target = frame - next + padded.len();
+            push_gap_frames(&mut padded, target, time);
+            // `padded` is [last listed entry, gap frames.., this frame]; keep the new ones.
+            let skip = usize::from(listed > 0);
+            numbers.extend((next..=frame).take(padded.len() - skip));
+            frames.extend(padded.into_iter().skip(skip));
+            frames.last_mut().expect("just pushed").sensor = sensor.clone();
+        }
+        // This frame number's entries start where its number does.
+        let start = numbers
+            .iter()
+            .rposition(|&n| n != frame)
+            .map_or(0, |k| k + 1);
+        if frames[start].time != time {
             return Err(row.error(
-                "frame",
+                "time",
                 format!(
-                    "frame {frame} would leave {gap} empty frames before it, {unlisted} in the \
-                     file so far; at most {MAX_FRAME_GAP} are accepted"
+                    "{time} differs from {} earlier in frame {frame}",
+                    frames[start].time
                 ),
             ));
         }
-        push_gap_frames(&mut frames, frame, time);
-        let f = frames.last_mut().expect("just pushed");
-        if f.time != time {
-            return Err(row.error(
-                "time",
-                format!("{time} differs from {} earlier in frame {frame}", f.time),
-            ));
+        let k = match (start..frames.len()).find(|&k| frames[k].sensor == sensor) {
+            Some(k) => k,
+            None => {
+                frames.push(DetectionFrame {
+                    time,
+                    sensor: sensor.clone(),
+                    measurements: Vec::new(),
+                    sensor_pose: None,
+                    ids: None,
+                });
+                numbers.push(frame);
+                frames.len() - 1
+            }
+        };
+        if let Some(name) = &sensor {
+            let earlier = frames[..start].iter().rev().take_while(|o| o.time == time);
+            if earlier.clone().any(|o| o.sensor.as_ref() == Some(name)) {
+                return Err(row.error(
+                    "sensor",
+                    format!("sensor {name:?} has two frames at time {time}"),
+                ));
+            }
         }
+        let f = &mut frames[k];
         if let Some(pc) = columns.pose {
             if pc.iter().all(|&c| !row.is_empty(c)) {
                 f.sensor_pose = Some([row.num(pc[0])?, row.num(pc[1])?, row.num(pc[2])?]);
@@ -390,6 +464,26 @@ fn parse_csv(
         }
     }
     Ok(frames)
+}
+
+/// The filter's frames of a detections file's entries, as ranges of entry indices:
+/// consecutive entries of one time that name their sensors make one frame (one scan each);
+/// an entry without a sensor name is a frame of its own.
+pub fn filter_frames(frames: &[DetectionFrame]) -> Vec<std::ops::Range<usize>> {
+    let mut out: Vec<std::ops::Range<usize>> = Vec::new();
+    for (k, f) in frames.iter().enumerate() {
+        match out.last_mut() {
+            Some(r)
+                if f.sensor.is_some()
+                    && frames[r.start].sensor.is_some()
+                    && frames[r.start].time == f.time =>
+            {
+                r.end = k + 1
+            }
+            _ => out.push(k..k + 1),
+        }
+    }
+    out
 }
 
 /// Writes estimates as JSON or CSV (by extension), atomically.
@@ -599,5 +693,50 @@ mod tests {
             "frame,time,birth_step,index,existence,age,x0,x1\n0,0.5,0,1,0.9,0,1,2\n"
         );
         assert!(write_estimates(&tmp("x.txt", ""), &frames).is_err());
+    }
+
+    #[test]
+    fn sensors_share_frames_and_are_grouped() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("d.csv");
+        std::fs::write(
+            &p,
+            "frame,time,sensor,z0,z1\n0,0.0,front,1,2\n0,0.0,rear,3,4\n0,0.0,front,5,6\n\
+             1,0.1,front,,\n3,0.3,rear,7,8\n",
+        )
+        .unwrap();
+        let f = read_frames(&p).unwrap();
+        let got: Vec<(f64, Option<&str>, usize)> = f
+            .iter()
+            .map(|f| (f.time, f.sensor.as_deref(), f.measurements.len()))
+            .collect();
+        assert_eq!(
+            got,
+            vec![
+                (0.0, Some("front"), 2),
+                (0.0, Some("rear"), 1),
+                (0.1, Some("front"), 0),
+                (0.2, None, 0),
+                (0.3, Some("rear"), 1),
+            ]
+        );
+        assert_eq!(filter_frames(&f), vec![0..2, 2..3, 3..4, 4..5]);
+        // One sensor twice at one time, in CSV (line named) and in JSON (entry named).
+        std::fs::write(&p, "frame,time,sensor,z0,z1\n0,0.0,a,1,2\n1,0.0,a,3,4\n").unwrap();
+        let e = read_frames(&p).unwrap_err().to_string();
+        assert!(
+            e.contains(":3:") && e.contains("\"a\" has two frames"),
+            "{e}"
+        );
+        let j = dir.path().join("d.json");
+        std::fs::write(
+            &j,
+            r#"{"frames": [{"time": 0.0, "sensor": "a", "measurements": [[1, 2]]},
+                           {"time": 0.0, "sensor": "b", "measurements": []},
+                           {"time": 0.0, "sensor": "a", "measurements": []}]}"#,
+        )
+        .unwrap();
+        let e = read_frames(&j).unwrap_err().to_string();
+        assert!(e.contains("frames[2].sensor") && e.contains("\"a\""), "{e}");
     }
 }

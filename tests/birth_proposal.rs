@@ -50,12 +50,14 @@ fn config(measurement_proposal: bool, seed: u64) -> RunConfig {
             dims: 2,
             sigma_accel: 0.5,
         },
-        measurement: MeasurementConfig::Position { sigma: 1.0 },
-        detection: DetectionConfig::Constant { probability: 0.98 },
-        clutter: ClutterConfig {
+        measurement: Some(MeasurementConfig::Position { sigma: 1.0 }),
+        detection: Some(DetectionConfig::Constant { probability: 0.98 }),
+        clutter: Some(ClutterConfig {
             rate: 1.0,
             volume: 40_000.0,
-        },
+        }),
+        sensors: Vec::new(),
+        fusion: None,
         birth: BirthConfig::Static {
             terms: vec![BirthTerm {
                 existence: 0.01,

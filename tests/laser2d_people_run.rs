@@ -24,7 +24,8 @@ fn intel_excerpt_runs_end_to_end_and_round_trips_as_json() {
     assert_eq!(scans.len(), 18);
     let cfg = config_for_scans(&scans, 0.03, 0.005, 30.0, [0.0, 0.0]).unwrap();
     // 180 beams of 1° from −90°: a ±90° field of view
-    let smc_lmb::config::DetectionConfig::FieldOfView { half_angle, .. } = cfg.filter.detection
+    let Some(smc_lmb::config::DetectionConfig::FieldOfView { half_angle, .. }) =
+        cfg.filter.detection
     else {
         panic!("field-of-view detection expected");
     };

@@ -5,7 +5,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use nalgebra::{Isometry3, Vector3};
 use smc_lmb::config::{RunConfig, TransitionConfig};
 use smc_lmb::detections::{
-    read_frames, read_frames_with, write_estimates, EstimateFrame, NonFinite,
+    filter_frames, read_frames, read_frames_with, write_estimates, DetectionFrame, EstimateFrame,
+    NonFinite,
 };
 use smc_lmb::filter::{Frame, Measurements};
 use smc_lmb::metrics::{gospa, ospa, LabelConsistency};
@@ -63,10 +64,12 @@ pub fn run(args: Args) -> Result<()> {
     } else {
         NonFinite::Error
     };
-    let (frames, skipped) = read_frames_with(&args.input, policy)?;
+    let (entries, skipped) = read_frames_with(&args.input, policy)?;
     if skipped > 0 {
         eprintln!("skipped {skipped} measurement row(s) with NaN or infinite values");
     }
+    let groups = filter_frames(&entries);
+    let frames: Vec<&[DetectionFrame]> = groups.iter().map(|r| &entries[r.clone()]).collect();
     let truth = match &args.truth {
         Some(p) => {
             let t = read_frames(p)?;
@@ -96,23 +99,49 @@ pub fn run(args: Args) -> Result<()> {
     let mut out = Vec::with_capacity(frames.len());
     let (mut ospa_sum, mut gospa_sum) = (0.0, 0.0);
     let mut labels = LabelConsistency::new(args.cutoff)?;
-    for (k, f) in frames.iter().enumerate() {
-        let dim = f.measurements.first().map_or(0, |m| m.len());
-        let z = Measurements::from_rows(dim, &f.measurements)
-            .with_context(|| format!("{} frame {k}", args.input.display()))?;
-        let platform = f
-            .sensor_pose
+    let multi = !config.sensors.is_empty();
+    for (k, group) in frames.iter().enumerate() {
+        let f = &group[0];
+        let mut frame = Frame::at_time(f.time);
+        for entry in group.iter() {
+            let dim = entry.measurements.first().map_or(0, |m| m.len());
+            let z = Measurements::from_rows(dim, &entry.measurements)
+                .with_context(|| format!("{} frame {k}", args.input.display()))?;
+            let sensor = match (&entry.sensor, multi) {
+                (None, false) => 0,
+                // A frame no sensor reported in (a gap in the frame numbers).
+                (None, true) if z.is_empty() => continue,
+                (None, true) => bail!(
+                    "{}: frame {k} (time {}) names no sensor, but the config has {} sensors; \
+                     give each line (entry) its sensor",
+                    args.input.display(),
+                    entry.time,
+                    config.sensors.len()
+                ),
+                (Some(name), _) => filter.sensor_index(name).with_context(|| {
+                    format!(
+                        "{}: frame {k} (time {}) names sensor {name:?}, which the config {} \
+                         does not define (its sensors: {})",
+                        args.input.display(),
+                        entry.time,
+                        args.config.display(),
+                        filter
+                            .sensors()
+                            .iter()
+                            .map(|s| format!("{:?}", s.name()))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )
+                })?,
+            };
+            frame = frame.with_sensor(sensor, z);
+        }
+        frame.platform = group
+            .iter()
+            .find_map(|e| e.sensor_pose)
             .map(|[x, y, h]| Isometry3::new(Vector3::new(x, y, 0.0), Vector3::new(0.0, 0.0, h)));
         let estimates = filter
-            .step(
-                &Frame {
-                    time: f.time,
-                    measurements: z,
-                    platform,
-                    data: smc_lmb::filter::StepData::new(),
-                },
-                &mut rng,
-            )
+            .step(&frame, &mut rng)
             .with_context(|| format!("{} frame {k}", args.input.display()))?;
         if let Some(t) = &truth {
             let x: Vec<Vec<f64>> = estimates

@@ -11,6 +11,7 @@ use nalgebra::{Isometry3, Vector3};
 use numpy::{PyArray1, PyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 use smc_lmb::config::{RunConfig, TransitionConfig};
 use smc_lmb::filter::{Estimate, Frame, LmbFilter, Measurements};
 use smc_lmb::rng::seeded;
@@ -122,18 +123,18 @@ fn platform(pose: Option<Vec<f64>>) -> PyResult<Option<Isometry3<f64>>> {
     }
 }
 
-fn frame(time: f64, z: &Table, pose: Option<Isometry3<f64>>) -> smc_lmb::Result<Frame> {
-    let measurements = if z.rows == 0 {
-        Measurements::empty(z.cols)
+fn measurements_of(z: &Table) -> smc_lmb::Result<Measurements> {
+    if z.rows == 0 {
+        Ok(Measurements::empty(z.cols))
     } else {
-        Measurements::from_rows(z.cols, &z.row_slices())?
-    };
-    Ok(Frame {
-        time,
-        measurements,
-        platform: pose,
-        data: smc_lmb::filter::StepData::new(),
-    })
+        Measurements::from_rows(z.cols, &z.row_slices())
+    }
+}
+
+fn frame(time: f64, z: &Table, pose: Option<Isometry3<f64>>) -> smc_lmb::Result<Frame> {
+    let mut f = Frame::new(time, measurements_of(z)?);
+    f.platform = pose;
+    Ok(f)
 }
 
 impl PyLmbFilter {
@@ -197,9 +198,11 @@ impl PyLmbFilter {
         })
     }
 
-    /// Runs one frame: `measurements` is `M × d` (an empty array for none), `sensor_pose` the
-    /// platform's planar pose `[x, y, heading]` for range-bearing sensors. Returns the
-    /// estimates (maximum a posteriori cardinality, most likely tracks).
+    /// Runs one frame: `measurements` is `M × d` (an empty array for none) or, for a filter
+    /// configured with several `[[sensors]]`, a dict from sensor name to that sensor's
+    /// `M × d` array (sensors left out did not report); `sensor_pose` the platform's planar
+    /// pose `[x, y, heading]`. Returns the estimates (maximum a posteriori cardinality, most
+    /// likely tracks).
     #[pyo3(signature = (time, measurements, sensor_pose=None))]
     fn step(
         &mut self,
@@ -208,8 +211,33 @@ impl PyLmbFilter {
         measurements: &Bound<'_, PyAny>,
         sensor_pose: Option<Vec<f64>>,
     ) -> PyResult<Vec<PyEstimate>> {
-        let z = table(measurements, "measurements", 0)?;
-        let f = lib(frame(time, &z, platform(sensor_pose)?))?;
+        let f = if let Ok(by_sensor) = measurements.cast::<PyDict>() {
+            let mut f = Frame::at_time(time);
+            f.platform = platform(sensor_pose)?;
+            for (name, z) in by_sensor.iter() {
+                let name: String = name.extract().map_err(|_| {
+                    PyValueError::new_err("measurements: dict keys must be sensor names")
+                })?;
+                let Some(index) = self.filter.sensor_index(&name) else {
+                    let known: Vec<String> = self
+                        .filter
+                        .sensors()
+                        .iter()
+                        .map(|s| format!("{:?}", s.name()))
+                        .collect();
+                    return Err(PyValueError::new_err(format!(
+                        "measurements: no sensor named {name:?} (the filter's sensors: {})",
+                        known.join(", ")
+                    )));
+                };
+                let z = table(&z, &format!("measurements[{name:?}]"), 0)?;
+                f = f.with_sensor(index, lib(measurements_of(&z))?);
+            }
+            f
+        } else {
+            let z = table(measurements, "measurements", 0)?;
+            lib(frame(time, &z, platform(sensor_pose)?))?
+        };
         let mut out = self.run_frames(py, vec![f])?;
         Ok(out
             .pop()

@@ -42,12 +42,14 @@ fn linear_config(sc: &Scenario, seed: u64, particles: usize) -> PyResult<RunConf
             dims: 2,
             sigma_accel,
         },
-        measurement: MeasurementConfig::Position { sigma },
-        detection: DetectionConfig::Constant { probability: p },
-        clutter: ClutterConfig {
+        measurement: Some(MeasurementConfig::Position { sigma }),
+        detection: Some(DetectionConfig::Constant { probability: p }),
+        clutter: Some(ClutterConfig {
             rate,
             volume: (x[1] - x[0]) * (y[1] - y[0]),
-        },
+        }),
+        sensors: Vec::new(),
+        fusion: None,
         // Sampled from the prior, as `rfs_benchmark` (Rust) samples it, so that the two time
         // the same filter.
         birth: BirthConfig::Static {

@@ -306,3 +306,33 @@ def test_range_bearing_measurements_use_the_sensor_pose():
     g = smc_lmb.LmbFilter(cfg)
     with pytest.raises(ValueError, match="sensor_pose"):
         g.step(0.0, np.array([[5.0, 0.1]]), sensor_pose=[1.0, 2.0])
+
+
+def test_two_sensors_fused_from_a_dict_of_measurements():
+    # The scenario seen twice: by a sensor at the origin and by one mounted 1 m ahead and
+    # turned half a turn, which measures in its own frame (p_sensor = R(π)ᵀ(p − (1, 0))).
+    truth, frames = scenario(seed=5)
+    cfg = planar_config()
+    sensor = {
+        "measurement": cfg.pop("measurement"),
+        "detection": cfg.pop("detection"),
+        "clutter": cfg.pop("clutter"),
+    }
+    cfg["sensors"] = [
+        {"name": "front", **sensor},
+        {"name": "back", **sensor, "mounting": [1.0, 0.0, np.pi]},
+    ]
+    cfg["fusion"] = {"method": "pu"}
+    f = smc_lmb.LmbFilter(cfg)
+    history = []
+    for k, z in enumerate(frames):
+        local = np.column_stack([1.0 - z[:, 0], -z[:, 1]])
+        # The back sensor reports every other frame only.
+        by_sensor = {"front": z} if k % 2 else {"front": z, "back": local}
+        history.append(f.step(float(k), by_sensor))
+    assert_finds_the_targets(history, truth)
+    with pytest.raises(ValueError, match=r'no sensor named "side".*"front", "back"'):
+        f.step(float(len(frames)), {"side": frames[0]})
+    cfg["fusion"] = {"method": "ga", "weights": [0.9, 0.9]}
+    with pytest.raises(ValueError, match="sum"):
+        smc_lmb.LmbFilter(cfg)

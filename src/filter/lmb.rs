@@ -4,19 +4,28 @@
 //!
 //! predict → birth → gate → likelihoods → associate → update → resample → prune → estimate.
 //!
-//! Each stage is one function below (gating is part of `likelihoods`), and what a step keeps
+//! With several sensors the gate → update stages run once per sensor, in turn or on the same
+//! predicted tracks and then combined ([`super::fusion`]).
+//!
+//! Each stage is one function, here or, for one sensor's gate → update, in the private
+//! `update` module beside this one (gating is part of `likelihoods`), and what a step keeps
 //! for inspection afterwards is recorded by one more (`record_diagnostics`). Work per track and
 //! per association group runs in parallel with rayon; every track draws from its own random
 //! stream derived from the step seed and its label, so results are bit-identical whatever the
 //! number of threads. Not for: models (see [`crate::models`]), association algorithms (see
 //! [`super::association`]).
 
-use super::association::{AssociationMethod, AssociationProblem, Associator, Marginals};
+use super::association::{AssociationMethod, Associator};
 use super::birth::{unexplained, BirthEvidence, BirthModel, CurrentMeasurements};
 use super::estimate::map_estimates;
-use super::groups::partition;
+use super::fusion::{fuse_track, Fusion, FusionMethod, SensorPosterior};
 use super::merge::{duplicate_pairs, merge_into, MergeDistance, ScaledDistance};
+use super::sensor::{check_sensors, Scan, Sensor, DEFAULT_SENSOR};
 use super::track::{Estimate, Track};
+use super::update::{
+    apply_posterior, assigned, associate, likelihoods, posterior, sensor_key, TrackLikelihoods,
+    TrackMarginals,
+};
 use super::{Jitter, Label, Measurements, ParticleSet, StepData};
 use crate::error::{Error, Result};
 use crate::filter::{
@@ -27,6 +36,7 @@ use crate::rng::{stream, FilterRng};
 use nalgebra::Isometry3;
 use rand::Rng;
 use rayon::prelude::*;
+use std::borrow::Cow;
 use std::collections::HashMap;
 
 /// The most particles per track [`LmbConfig::validate`] accepts: ten million (a 6-component
@@ -172,8 +182,9 @@ impl LmbConfig {
 pub struct Frame {
     /// Time stamp, seconds (must not decrease).
     pub time: f64,
-    /// The frame's measurements.
-    pub measurements: Measurements,
+    /// The measurements of every sensor that reported in the frame, at most one scan per
+    /// sensor (a filter with one sensor: its measurements, sensor 0).
+    pub scans: Vec<Scan>,
     /// Pose of the sensing platform in the world frame, if it moves.
     pub platform: Option<Isometry3<f64>>,
     /// What the frame brings for particular models (a vehicle state, a scan's beams, ...),
@@ -182,14 +193,39 @@ pub struct Frame {
 }
 
 impl Frame {
-    /// A frame from a static sensor.
+    /// A frame of sensor 0's `measurements` (the one sensor of a filter with one), from a
+    /// static platform.
     pub fn new(time: f64, measurements: Measurements) -> Self {
+        Frame::at_time(time).with_sensor(0, measurements)
+    }
+
+    /// A frame at `time` in which no sensor has reported yet (see [`Frame::with_sensor`]); a
+    /// frame with no scan at all predicts the tracks and updates nothing.
+    pub fn at_time(time: f64) -> Self {
         Frame {
             time,
-            measurements,
+            scans: Vec::new(),
             platform: None,
             data: StepData::new(),
         }
+    }
+
+    /// The same frame with sensor `sensor`'s `measurements` (its index in the filter's
+    /// sensors, see [`LmbFilter::sensor_index`]), in the sensor's own frame.
+    pub fn with_sensor(mut self, sensor: usize, measurements: Measurements) -> Self {
+        self.scans.push(Scan {
+            sensor,
+            measurements,
+        });
+        self
+    }
+
+    /// Sensor `sensor`'s measurements in this frame, if it reported.
+    pub fn measurements_of(&self, sensor: usize) -> Option<&Measurements> {
+        self.scans
+            .iter()
+            .find(|s| s.sensor == sensor)
+            .map(|s| &s.measurements)
     }
 
     /// The same frame seen from `platform` (world frame).
@@ -213,6 +249,8 @@ pub struct LmbFilterBuilder {
     measurement: Option<Box<dyn MeasurementModel>>,
     detection: Option<Box<dyn DetectionModel>>,
     clutter: Option<Box<dyn ClutterModel>>,
+    sensors: Vec<Sensor>,
+    fusion: Fusion,
     birth: Option<Box<dyn BirthModel>>,
     associator: Option<Box<dyn Associator>>,
     merge_distance: Option<Box<dyn MergeDistance>>,
@@ -230,19 +268,45 @@ impl LmbFilterBuilder {
         self.survival = Some(Box::new(m));
         self
     }
-    /// The measurement model (required).
+    /// The measurement model of a filter with one sensor (required, unless the sensors are
+    /// given by [`LmbFilterBuilder::sensor`]).
     pub fn measurement(mut self, m: impl MeasurementModel + 'static) -> Self {
         self.measurement = Some(Box::new(m));
         self
     }
-    /// The detection model (required).
+    /// The detection model of a filter with one sensor (required, unless the sensors are given
+    /// by [`LmbFilterBuilder::sensor`]).
     pub fn detection(mut self, m: impl DetectionModel + 'static) -> Self {
         self.detection = Some(Box::new(m));
         self
     }
-    /// The clutter model (required).
+    /// The clutter model of a filter with one sensor (required, unless the sensors are given
+    /// by [`LmbFilterBuilder::sensor`]).
     pub fn clutter(mut self, m: impl ClutterModel + 'static) -> Self {
         self.clutter = Some(Box::new(m));
+        self
+    }
+    /// [`LmbFilterBuilder::measurement`] with a model already boxed.
+    pub(crate) fn measurement_box(mut self, m: Box<dyn MeasurementModel>) -> Self {
+        self.measurement = Some(m);
+        self
+    }
+    /// [`LmbFilterBuilder::detection`] with a model already boxed.
+    pub(crate) fn detection_box(mut self, m: Box<dyn DetectionModel>) -> Self {
+        self.detection = Some(m);
+        self
+    }
+    /// Adds a sensor with its own models; sensors are numbered in the order they are added.
+    /// A filter is built either with sensors or with one set of measurement, detection and
+    /// clutter models, not both.
+    pub fn sensor(mut self, s: Sensor) -> Self {
+        self.sensors.push(s);
+        self
+    }
+    /// How several sensors' updates combine (default: [`Fusion::default`], the iterated
+    /// corrector in sensor order).
+    pub fn fusion(mut self, f: Fusion) -> Self {
+        self.fusion = f;
         self
     }
     /// The birth model (required).
@@ -272,22 +336,49 @@ impl LmbFilterBuilder {
     /// no more components than the transition moves; see [`TransitionModel::state_dim`],
     /// [`BirthModel::state_dim`], [`MeasurementModel::state_dim`]) and that the config is
     /// valid. A disagreement names both models and their dimensions.
+    ///
+    /// With several sensors: the sensors' names are unique, their measurements have one
+    /// dimension, and the fusion's weights and order fit them (see [`Fusion::validate`]).
     pub fn build(self) -> Result<LmbFilter> {
         self.config.validate()?;
         let missing = |what: &str| Error::invalid("filter", format!("no {what} model given"));
         let transition = self.transition.ok_or_else(|| missing("transition"))?;
-        let measurement = self.measurement.ok_or_else(|| missing("measurement"))?;
         let birth = self.birth.ok_or_else(|| missing("birth"))?;
-        check_dimensions(&*transition, &*measurement, &*birth)?;
+        let sensors = if self.sensors.is_empty() {
+            vec![Sensor::from_boxes(
+                DEFAULT_SENSOR.to_string(),
+                self.measurement.ok_or_else(|| missing("measurement"))?,
+                self.detection.ok_or_else(|| missing("detection"))?,
+                self.clutter.ok_or_else(|| missing("clutter"))?,
+            )]
+        } else {
+            if self.measurement.is_some() || self.detection.is_some() || self.clutter.is_some() {
+                return Err(Error::invalid(
+                    "filter",
+                    "both sensors and a filter-wide measurement, detection or clutter model \
+                     given; give each sensor its own",
+                ));
+            }
+            self.sensors
+        };
+        check_sensors(&sensors)?;
+        for s in &sensors {
+            check_dimensions(&*transition, &*s.measurement, &*birth).map_err(|e| match e {
+                Error::InvalidInput { what, reason } if sensors.len() > 1 => {
+                    Error::invalid(what, format!("sensor {:?}: {reason}", s.name))
+                }
+                other => other,
+            })?;
+        }
+        self.fusion.validate(sensors.len())?;
         Ok(LmbFilter {
             models: Models {
                 transition,
                 survival: self
                     .survival
                     .unwrap_or_else(|| Box::new(ConstantSurvival(0.99))),
-                measurement,
-                detection: self.detection.ok_or_else(|| missing("detection"))?,
-                clutter: self.clutter.ok_or_else(|| missing("clutter"))?,
+                sensors,
+                fusion: self.fusion,
                 birth,
                 associator: self
                     .associator
@@ -356,9 +447,9 @@ fn check_dimensions(
 struct Models {
     transition: Box<dyn TransitionModel>,
     survival: Box<dyn SurvivalModel>,
-    measurement: Box<dyn MeasurementModel>,
-    detection: Box<dyn DetectionModel>,
-    clutter: Box<dyn ClutterModel>,
+    /// At least one; every sensor's measurements have the same dimension.
+    sensors: Vec<Sensor>,
+    fusion: Fusion,
     birth: Box<dyn BirthModel>,
     associator: Box<dyn Associator>,
     merge_distance: Box<dyn MergeDistance>,
@@ -372,45 +463,43 @@ struct Previous {
     assigned: Vec<f64>,
 }
 
-/// Per-track quantities of one update: detection probabilities and the likelihood of every
-/// gated measurement, all in the log domain.
-struct TrackLikelihoods {
-    /// p_D(xᵢ), clamped to [0, 1].
-    pd: Vec<f64>,
-    /// η_miss = Σ wᵢ (1 − p_D(xᵢ)) (no underflow risk: a plain sum of probabilities).
-    eta_miss: f64,
-    /// The gated measurements some particle can explain, in the gate's order. One entry per
-    /// pair, so a pair's index and its sums cannot come apart.
-    pairs: Vec<GatedPair>,
+/// What a step's sensor updates leave for the rest of the step.
+struct SensorUpdates {
+    /// The first updating sensor's likelihood rows, one per track (duplicate merge,
+    /// diagnostics).
+    likelihoods: Vec<TrackLikelihoods>,
+    /// Its association marginals, one row per track.
+    marginals: Vec<TrackMarginals>,
+    /// Whether it was the only sensor (the tracks' particles are those its rows saw).
+    only: bool,
+    /// For every measurement of every sensor, in sensor order, the probability that some
+    /// track generated it.
+    assigned: Vec<f64>,
 }
 
-/// One (track, gated measurement) pair with positive likelihood.
-struct GatedPair {
-    /// Index of the measurement in the step's set.
-    measurement: usize,
-    /// ln η = ln Σ wᵢ p_D(xᵢ) g(z | xᵢ) (without κ).
-    log_eta: f64,
-    /// The likelihoods scaled by their largest value, exp(ln g(z | xᵢ) − maxₖ ln g(z | xₖ)),
-    /// so the best particle has 1 whatever the scale.
-    scaled_g: Vec<f64>,
-    /// Σ wᵢ p_D(xᵢ) · scaled_g[i], positive.
-    scaled_eta: f64,
-}
-
-/// A track's row of association marginals, in its own terms.
-struct TrackMarginals {
-    miss: f64,
-    /// (index into `TrackLikelihoods::pairs`, probability).
-    detect: Vec<(usize, f64)>,
-}
-
-impl TrackMarginals {
-    /// The measurement (its index in the step's measurements) this track most probably
-    /// generated, with that probability; `lik` is the same track's row of likelihoods.
-    fn most_probable(&self, lik: &TrackLikelihoods) -> Option<(usize, f64)> {
-        let best = self.detect.iter().max_by(|a, b| a.1.total_cmp(&b.1));
-        best.map(|&(k, p)| (lik.pairs[k].measurement, p))
+/// The measurements of `scans` (in sensor order) one after another; borrowed when there is
+/// one scan. `dim` is the dimension of an empty result.
+fn concatenated<'a>(
+    scans: &'a [(usize, Cow<'a, Measurements>)],
+    dim: usize,
+) -> Cow<'a, Measurements> {
+    match scans {
+        [] => Cow::Owned(Measurements::empty(dim)),
+        [(_, z)] => Cow::Borrowed(z.as_ref()),
+        _ => {
+            let mut all = Measurements::empty(dim);
+            for z in scans.iter().flat_map(|(_, z)| z.iter()) {
+                all.push(z).expect("checked: one dimension, finite");
+            }
+            Cow::Owned(all)
+        }
     }
+}
+
+/// Per-sensor vectors joined in sensor order.
+fn in_sensor_order(mut by_sensor: Vec<(usize, Vec<f64>)>) -> Vec<f64> {
+    by_sensor.sort_by_key(|(s, _)| *s);
+    by_sensor.into_iter().flat_map(|(_, v)| v).collect()
 }
 
 /// A track's most probable measurement in a step, with the association's marginal
@@ -428,7 +517,6 @@ pub struct MostProbableMeasurement {
 /// Stream keys, combined with a label key or group key, for each random stage.
 const KEY_PREDICT: u64 = 0x01 << 60;
 const KEY_BIRTH: u64 = 0x02 << 60;
-const KEY_ASSOCIATE: u64 = 0x03 << 60;
 const KEY_RESAMPLE: u64 = 0x04 << 60;
 
 /// The labelled multi-Bernoulli filter with particle densities.
@@ -560,15 +648,20 @@ impl LmbFilter {
     /// random stage derives its own streams from it. The same as [`LmbFilter::predict_step`]
     /// followed by [`LmbFilter::update_step`], with the frame checked whole before either.
     pub fn step(&mut self, frame: &Frame, rng: &mut FilterRng) -> Result<Vec<Estimate>> {
-        self.check_measurements(&frame.measurements)?;
+        let scans: Vec<(usize, &Measurements)> = frame
+            .scans
+            .iter()
+            .map(|s| (s.sensor, &s.measurements))
+            .collect();
+        self.check_scans(&scans)?;
         self.predict_phase(
             frame.time,
             frame.platform,
             frame.data.clone(),
             rng,
-            !frame.measurements.is_empty(),
+            scans.iter().any(|(_, z)| !z.is_empty()),
         )?;
-        self.update_step(&frame.measurements)
+        self.update_scans(&scans, StepData::new())
     }
 
     /// The first half of a step: the survival and transition of every track to `time`, the
@@ -604,35 +697,86 @@ impl LmbFilter {
         measurements: &Measurements,
         data: StepData,
     ) -> Result<Vec<Estimate>> {
-        if self.pending.is_none() {
-            return Err(Error::invalid(
-                format!("update of step {}", self.step),
-                "the step was not predicted (call predict_step first)",
-            ));
-        }
-        let z = measurements;
-        self.check_measurements(z)?;
+        self.update_step_scans(&[(0, measurements)], data)
+    }
+
+    /// [`LmbFilter::update_step_with`] for a filter with several sensors: `scans` holds
+    /// (sensor index, its measurements) for every sensor that reported, each at most once.
+    pub fn update_step_scans(
+        &mut self,
+        scans: &[(usize, &Measurements)],
+        data: StepData,
+    ) -> Result<Vec<Estimate>> {
+        self.check_scans(scans)?;
+        self.update_scans(scans, data)
+    }
+
+    /// The filter's sensors, in index order.
+    pub fn sensors(&self) -> &[Sensor] {
+        &self.models.sensors
+    }
+
+    /// The index of the sensor called `name`.
+    pub fn sensor_index(&self, name: &str) -> Option<usize> {
+        self.models.sensors.iter().position(|s| s.name == name)
+    }
+
+    /// How the sensors' updates combine.
+    pub fn fusion(&self) -> &Fusion {
+        &self.models.fusion
+    }
+
+    /// The second half of a step, with scans already checked by [`LmbFilter::check_scans`].
+    fn update_scans(
+        &mut self,
+        scans: &[(usize, &Measurements)],
+        data: StepData,
+    ) -> Result<Vec<Estimate>> {
         let Some(Pending {
             context: mut ctx,
             seed,
             summaries,
         }) = self.pending.take()
         else {
-            unreachable!("checked above");
+            return Err(Error::invalid(
+                format!("update of step {}", self.step),
+                "the step was not predicted (call predict_step first)",
+            ));
         };
         ctx.data.extend(data);
-        self.add_births(&ctx, z, seed, &summaries)?;
+        // In sensor order, moved to the platform frame where a sensor is mounted.
+        let mut scans: Vec<(usize, Cow<Measurements>)> = scans
+            .iter()
+            .map(|&(s, z)| match self.models.sensors[s].mounting {
+                Some(m) => (s, Cow::Owned(m.to_platform(z))),
+                None => (s, Cow::Borrowed(z)),
+            })
+            .collect();
+        scans.sort_by_key(|(s, _)| *s);
+        let all = concatenated(&scans, self.models.sensors[0].measurement_dim());
+        self.add_births(&ctx, &scans, &all, seed, &summaries)?;
         let predicted = self.predicted_copies();
-        let likelihoods = self.likelihoods(z, &ctx, &summaries)?;
-        let marginals = self.associate(z, &ctx, &likelihoods, seed);
-        let assigned = self.update(&likelihoods, &marginals, z.len());
-        let merged = self.merge_duplicates(&likelihoods, &marginals);
+        let updated = match (scans.len(), self.models.fusion.method) {
+            (0, _) => None,
+            (1, _) | (_, FusionMethod::IteratedCorrector) => {
+                Some(self.update_in_turn(&scans, &ctx, seed, summaries)?)
+            }
+            (_, method) => Some(self.update_in_parallel(method, &scans, &ctx, seed, &summaries)?),
+        };
+        let (merged, assigned, first) = match updated {
+            None => (vec![false; self.tracks.len()], Vec::new(), None),
+            Some(mut u) => (
+                self.merge_duplicates(&u.likelihoods, &u.marginals),
+                std::mem::take(&mut u.assigned),
+                Some(u),
+            ),
+        };
         let resampled = self.resample(seed, &merged);
-        self.record_diagnostics(predicted, likelihoods, &marginals, &resampled);
+        self.record_diagnostics(predicted, first, &resampled);
         self.prune();
         let estimates = map_estimates(&self.tracks);
 
-        self.carry_over(ctx, z, assigned);
+        self.carry_over(ctx, &all, assigned);
         Ok(estimates)
     }
 
@@ -671,17 +815,44 @@ impl LmbFilter {
         Ok(())
     }
 
-    /// Rejects measurements that do not have the measurement model's dimension.
-    fn check_measurements(&self, z: &Measurements) -> Result<()> {
-        if !z.is_empty() && z.dim() != self.models.measurement.measurement_dim() {
-            return Err(Error::invalid(
-                format!("measurements of step {}", self.step),
-                format!(
-                    "have dimension {}, the measurement model expects {}",
-                    z.dim(),
-                    self.models.measurement.measurement_dim()
-                ),
-            ));
+    /// Rejects a scan of a sensor the filter does not have, two scans of one sensor, and
+    /// measurements that do not have their sensor's measurement dimension (an empty scan may
+    /// have any), naming the sensor.
+    fn check_scans(&self, scans: &[(usize, &Measurements)]) -> Result<()> {
+        let sensors = &self.models.sensors;
+        let what = || format!("measurements of step {}", self.step);
+        for (k, &(s, z)) in scans.iter().enumerate() {
+            let Some(sensor) = sensors.get(s) else {
+                return Err(Error::invalid(
+                    what(),
+                    format!(
+                        "a scan of sensor {s}, but the filter has {} sensor{}",
+                        sensors.len(),
+                        if sensors.len() == 1 { "" } else { "s" }
+                    ),
+                ));
+            };
+            if scans[..k].iter().any(|&(o, _)| o == s) {
+                return Err(Error::invalid(
+                    what(),
+                    format!("two scans of sensor {s} ({:?}) in one frame", sensor.name),
+                ));
+            }
+            if !z.is_empty() && z.dim() != sensor.measurement_dim() {
+                let whose = if sensors.len() == 1 {
+                    String::new()
+                } else {
+                    format!(" of sensor {s} ({:?})", sensor.name)
+                };
+                return Err(Error::invalid(
+                    format!("{}{whose}", what()),
+                    format!(
+                        "have dimension {}, the measurement model expects {}",
+                        z.dim(),
+                        sensor.measurement_dim()
+                    ),
+                ));
+            }
         }
         Ok(())
     }
@@ -780,10 +951,15 @@ impl LmbFilter {
     /// Appends the birth tracks of this step, labelled (step, index). A birth model that
     /// samples near this step's measurements is told how unexplained the predicted tracks
     /// (gated by their `summaries`, empty when `z` is) leave each of them.
+    ///
+    /// The birth model sees the measurements of every sensor that reported, in sensor order
+    /// (`all`, the concatenation of `scans`), each judged unexplained by its own sensor's
+    /// measurement model.
     fn add_births(
         &mut self,
         ctx: &StepContext,
-        z: &Measurements,
+        scans: &[(usize, Cow<Measurements>)],
+        all: &Measurements,
         seed: u64,
         summaries: &[TrackSummary],
     ) -> Result<()> {
@@ -793,13 +969,18 @@ impl LmbFilter {
             context: &p.context,
         });
         let m = &self.models;
-        let u = if m.birth.uses_current_measurements() {
-            unexplained(&self.tracks, summaries, z, &*m.measurement, ctx)
+        let u: Vec<f64> = if m.birth.uses_current_measurements() {
+            scans
+                .iter()
+                .flat_map(|(s, z)| {
+                    unexplained(&self.tracks, summaries, z, &*m.sensors[*s].measurement, ctx)
+                })
+                .collect()
         } else {
             Vec::new()
         };
         let current = CurrentMeasurements {
-            measurements: z,
+            measurements: all,
             unexplained: &u,
         };
         let births = m.birth.birth_guided(
@@ -850,197 +1031,138 @@ impl LmbFilter {
         Ok(())
     }
 
-    /// Gating and the particle sums η_j(ℓ) and η_miss(ℓ) for every track, in parallel; the
-    /// tracks that `summaries` covers (the predicted ones) are gated by them, this step's
-    /// births by their own. A measurement model that returns NaN or +∞ as a log-likelihood is
-    /// an error naming the track and measurement (the first in track order); −∞ is a valid
-    /// "impossible".
-    fn likelihoods(
-        &self,
-        z: &Measurements,
-        ctx: &StepContext,
-        summaries: &[TrackSummary],
-    ) -> Result<Vec<TrackLikelihoods>> {
-        let m = &self.models;
-        let step = self.step;
-        let all: Vec<Result<TrackLikelihoods>> = self
-            .tracks
-            .par_iter()
-            .enumerate()
-            .map(|(k, t)| {
-                let p = &t.particles;
-                let n = p.len();
-                let mut pd = vec![0.0; n];
-                m.detection.detection_probability(p, ctx, &mut pd);
-                pd.iter_mut()
-                    .for_each(|d| *d = if d.is_nan() { 0.0 } else { d.clamp(0.0, 1.0) });
-                let w = p.weights();
-                let eta_miss: f64 = w.iter().zip(&pd).map(|(w, d)| w * (1.0 - d)).sum();
-                let detectable = w.iter().zip(&pd).any(|(w, d)| w * d > 0.0);
-                let mut gated: Vec<usize> = Vec::new();
-                if detectable && !z.is_empty() {
-                    match summaries.get(k) {
-                        Some(s) => m.measurement.gate_all(z, s, ctx, &mut gated),
-                        None => m
-                            .measurement
-                            .gate_all(z, &TrackSummary::of(p), ctx, &mut gated),
-                    }
-                }
-                let zs: Vec<&[f64]> = gated.iter().map(|&j| z.get(j)).collect();
-                let mut scaled_g = vec![vec![0.0; n]; zs.len()];
-                let mut tops = vec![f64::NEG_INFINITY; zs.len()];
-                if let Err(f) =
-                    m.measurement
-                        .relative_likelihood_batch(&zs, p, ctx, &mut scaled_g, &mut tops)
-                {
-                    return Err(Error::invalid(
-                        format!("update of step {step}"),
-                        format!(
-                            "the measurement model's log-likelihood of measurement {} for \
-                             particle {} of track {} is {}",
-                            gated.get(f.measurement).copied().unwrap_or(f.measurement),
-                            f.particle,
-                            t.label,
-                            f.value
-                        ),
-                    ));
-                }
-                let mut pairs = Vec::with_capacity(zs.len());
-                for ((g, measurement), top) in scaled_g.into_iter().zip(gated).zip(tops) {
-                    if !top.is_finite() {
-                        continue; // no particle can explain it
-                    }
-                    let sum: f64 = g.iter().zip(w).zip(&pd).map(|((g, w), d)| g * w * d).sum();
-                    if sum > 0.0 {
-                        pairs.push(GatedPair {
-                            measurement,
-                            log_eta: top + sum.ln(),
-                            scaled_g: g,
-                            scaled_eta: sum,
-                        });
-                    }
-                }
-                Ok(TrackLikelihoods {
-                    pd,
-                    eta_miss,
-                    pairs,
-                })
-            })
-            .collect();
-        all.into_iter().collect()
-    }
-
-    /// Association: independent groups, each solved by the associator, in parallel.
-    fn associate(
-        &self,
-        z: &Measurements,
-        ctx: &StepContext,
-        lik: &[TrackLikelihoods],
-        seed: u64,
-    ) -> Vec<TrackMarginals> {
-        let log_kappa: Vec<f64> = z
-            .iter()
-            .map(|zj| self.models.clutter.log_intensity(zj, ctx))
-            .collect();
-        let gated: Vec<Vec<usize>> = lik
-            .iter()
-            .map(|l| l.pairs.iter().map(|p| p.measurement).collect())
-            .collect();
-        let groups = partition(&gated, z.len());
-        let tracks = &self.tracks;
-        let associator = &self.models.associator;
-        let solved: Vec<Vec<(usize, TrackMarginals)>> = groups
-            .par_iter()
-            .map(|g| {
-                let n = g.tracks.len();
-                let m = g.measurements.len();
-                let mut problem = AssociationProblem {
-                    n_tracks: n,
-                    n_meas: m,
-                    log_miss: Vec::with_capacity(n),
-                    log_detect: vec![f64::NEG_INFINITY; n * m],
-                };
-                for (row, &ti) in g.tracks.iter().enumerate() {
-                    let r = tracks[ti].existence;
-                    let l = &lik[ti];
-                    problem.log_miss.push(log_miss_weight(r, l.eta_miss));
-                    for pair in &l.pairs {
-                        let j = pair.measurement;
-                        let col = g
-                            .measurements
-                            .binary_search(&j)
-                            .expect("gated measurement in its group");
-                        problem.log_detect[row * m + col] = r.ln() + pair.log_eta - log_kappa[j];
-                    }
-                }
-                let marg: Marginals = if m == 0 {
-                    Marginals {
-                        n_tracks: n,
-                        n_meas: 0,
-                        miss: vec![1.0; n],
-                        detect: Vec::new(),
-                    }
-                } else {
-                    let key = tracks[g.tracks[0]].label.key();
-                    associator.marginals(&problem, &mut stream(seed, KEY_ASSOCIATE ^ key))
-                };
-                g.tracks
-                    .iter()
-                    .enumerate()
-                    .map(|(row, &ti)| {
-                        let detect = lik[ti]
-                            .pairs
-                            .iter()
-                            .enumerate()
-                            .map(|(k, pair)| {
-                                let col = g
-                                    .measurements
-                                    .binary_search(&pair.measurement)
-                                    .expect("gated measurement in its group");
-                                (k, marg.detect[row * m + col])
-                            })
-                            .collect();
-                        (
-                            ti,
-                            TrackMarginals {
-                                miss: marg.miss[row],
-                                detect,
-                            },
-                        )
-                    })
-                    .collect()
-            })
-            .collect();
-        let mut out: Vec<Option<TrackMarginals>> = (0..self.tracks.len()).map(|_| None).collect();
-        for (ti, tm) in solved.into_iter().flatten() {
-            out[ti] = Some(tm);
-        }
-        out.into_iter()
-            .map(|o| o.expect("every track is in one group"))
-            .collect()
-    }
-
-    /// The GLMB → LMB update of existence and particle weights, per track. Returns, for every
-    /// measurement, the probability that some track generated it.
-    fn update(
+    /// The update by each sensor of `scans` in turn (IC; with one sensor, the single-sensor
+    /// update): gating, likelihoods, association and the posterior of every track, then, when
+    /// another sensor follows, resampling of the tracks whose weights collapsed and fresh gate
+    /// summaries. `summaries` gate the predicted tracks for the first sensor.
+    fn update_in_turn(
         &mut self,
-        lik: &[TrackLikelihoods],
-        marg: &[TrackMarginals],
-        n_meas: usize,
-    ) -> Vec<f64> {
-        self.tracks
-            .par_iter_mut()
-            .zip(lik.par_iter())
-            .zip(marg.par_iter())
-            .for_each(|((t, l), mg)| update_track(t, l, mg));
-        let mut assigned = vec![0.0; n_meas];
-        for (l, mg) in lik.iter().zip(marg) {
-            for &(k, p) in &mg.detect {
-                assigned[l.pairs[k].measurement] += p;
+        scans: &[(usize, Cow<Measurements>)],
+        ctx: &StepContext,
+        seed: u64,
+        summaries: Vec<TrackSummary>,
+    ) -> Result<SensorUpdates> {
+        let order = self
+            .models
+            .fusion
+            .ordered(&scans.iter().map(|(s, _)| *s).collect::<Vec<_>>());
+        let mut assigned_by_sensor: Vec<(usize, Vec<f64>)> = Vec::with_capacity(order.len());
+        let mut first = None;
+        let mut summaries = summaries;
+        for (k, &s) in order.iter().enumerate() {
+            let z: &Measurements = &scans.iter().find(|(i, _)| *i == s).expect("present").1;
+            let sensor = &self.models.sensors[s];
+            let lik = likelihoods(&self.tracks, sensor, z, ctx, &summaries)?;
+            let marg = associate(
+                &self.tracks,
+                sensor,
+                &*self.models.associator,
+                z,
+                ctx,
+                &lik,
+                seed,
+                sensor_key(s),
+            );
+            self.tracks
+                .par_iter_mut()
+                .zip(lik.par_iter())
+                .zip(marg.par_iter())
+                .for_each(|((t, l), mg)| {
+                    let post = posterior(t.existence, l, mg);
+                    apply_posterior(t, post)
+                });
+            assigned_by_sensor.push((s, assigned(&lik, &marg, z.len())));
+            if k + 1 < order.len() {
+                self.resample_collapsed(seed ^ sensor_key(s + 1));
+                summaries = self
+                    .tracks
+                    .par_iter()
+                    .map(|t| TrackSummary::of(&t.particles))
+                    .collect();
+            }
+            if first.is_none() {
+                first = Some((lik, marg));
             }
         }
-        assigned.iter_mut().for_each(|a| *a = a.min(1.0));
-        assigned
+        let (likelihoods, marginals) = first.expect("at least one scan");
+        Ok(SensorUpdates {
+            likelihoods,
+            marginals,
+            only: order.len() == 1,
+            assigned: in_sensor_order(assigned_by_sensor),
+        })
+    }
+
+    /// The update by every sensor of `scans` from the same predicted tracks (associations in
+    /// parallel across sensors), combined per track by `method` ([`super::fusion`]).
+    fn update_in_parallel(
+        &mut self,
+        method: FusionMethod,
+        scans: &[(usize, Cow<Measurements>)],
+        ctx: &StepContext,
+        seed: u64,
+        summaries: &[TrackSummary],
+    ) -> Result<SensorUpdates> {
+        let present: Vec<usize> = scans.iter().map(|(s, _)| *s).collect();
+        let weights = self.models.fusion.weights_of(&present);
+        let m = &self.models;
+        let tracks = &self.tracks;
+        let per_sensor: Vec<Result<(Vec<TrackLikelihoods>, Vec<TrackMarginals>)>> = scans
+            .par_iter()
+            .map(|(s, z)| {
+                let sensor = &m.sensors[*s];
+                let lik = likelihoods(tracks, sensor, z, ctx, summaries)?;
+                let marg = associate(
+                    tracks,
+                    sensor,
+                    &*m.associator,
+                    z,
+                    ctx,
+                    &lik,
+                    seed,
+                    sensor_key(*s),
+                );
+                Ok((lik, marg))
+            })
+            .collect();
+        let per_sensor = per_sensor.into_iter().collect::<Result<Vec<_>>>()?;
+        self.tracks.par_iter_mut().enumerate().for_each(|(ti, t)| {
+            let posts: Vec<SensorPosterior> = per_sensor
+                .iter()
+                .map(|(lik, marg)| posterior(t.existence, &lik[ti], &marg[ti]))
+                .collect();
+            let r0 = t.existence;
+            t.expected_detections += posts.iter().map(|p| p.detected).sum::<f64>();
+            t.existence = fuse_track(method, &weights, r0, &mut t.particles, &posts);
+        });
+        let assigned_by_sensor = per_sensor
+            .iter()
+            .zip(scans)
+            .map(|((lik, marg), (s, z))| (*s, assigned(lik, marg, z.len())))
+            .collect();
+        let (likelihoods, marginals) = per_sensor.into_iter().next().expect("several scans");
+        Ok(SensorUpdates {
+            likelihoods,
+            marginals,
+            only: false,
+            assigned: in_sensor_order(assigned_by_sensor),
+        })
+    }
+
+    /// Between two sensors' updates: resamples (to its current count, with the configured
+    /// jitter) every track whose effective sample size fell below
+    /// [`LmbConfig::resample_threshold`] of its count.
+    fn resample_collapsed(&mut self, seed: u64) {
+        let cfg = &self.config;
+        self.tracks.par_iter_mut().for_each(|t| {
+            let n = t.particles.len();
+            if t.existence > 0.0
+                && t.particles.effective_sample_size() < cfg.resample_threshold * n as f64
+            {
+                let mut rng = stream(seed, KEY_RESAMPLE ^ t.label.key());
+                t.particles.resample(n, cfg.jitter, &mut rng);
+            }
+        });
     }
 
     /// Resampling, per track: to the track's particle count ([`LmbConfig::particles`], or the
@@ -1129,20 +1251,29 @@ impl LmbFilter {
     }
 
     /// What the step leaves for inspection, recorded before pruning while the tracks still line
-    /// up with `lik`, `marg` and `resampled`: the predicted particle sets (when kept), each
-    /// track's most probable measurement, and the detection probabilities of the tracks whose
-    /// particles did not move in resampling.
+    /// up with the first updating sensor's rows in `first` and with `resampled`: the
+    /// predicted particle sets (when kept), each track's most probable measurement of that
+    /// sensor, and, when that sensor was the only one, the detection probabilities of the
+    /// tracks whose particles did not move in resampling.
     fn record_diagnostics(
         &mut self,
         predicted: Vec<(Label, ParticleSet)>,
-        lik: Vec<TrackLikelihoods>,
-        marg: &[TrackMarginals],
+        first: Option<SensorUpdates>,
         resampled: &[bool],
     ) {
         self.predicted.clear();
         self.predicted.extend(predicted);
         self.most_probable.clear();
-        for ((t, l), mg) in self.tracks.iter().zip(&lik).zip(marg) {
+        self.unmoved_detection.clear();
+        let Some(first) = first else {
+            return;
+        };
+        for ((t, l), mg) in self
+            .tracks
+            .iter()
+            .zip(&first.likelihoods)
+            .zip(&first.marginals)
+        {
             if let Some((measurement, probability)) = mg.most_probable(l) {
                 self.most_probable.push(MostProbableMeasurement {
                     label: t.label,
@@ -1151,8 +1282,10 @@ impl LmbFilter {
                 });
             }
         }
-        self.unmoved_detection.clear();
-        for ((t, l), &moved) in self.tracks.iter().zip(lik).zip(resampled) {
+        if !first.only {
+            return;
+        }
+        for ((t, l), &moved) in self.tracks.iter().zip(first.likelihoods).zip(resampled) {
             if !moved {
                 self.unmoved_detection.push((t.label, l.pd));
             }
@@ -1185,70 +1318,6 @@ impl LmbFilter {
         });
         self.step += 1;
     }
-}
-
-/// ln(1 − r + r·η_miss); −∞ when the track surely exists and is surely detected.
-fn log_miss_weight(r: f64, eta_miss: f64) -> f64 {
-    (1.0 - r + r * eta_miss).max(0.0).ln()
-}
-
-/// Posterior existence and particle weights of one track from its association marginals
-/// (the LMB approximation of the GLMB posterior, Reuter et al. 2014, eqs. 20–21, with the
-/// miss/absence hypotheses split as in the marginal form of the fast LMB update).
-fn update_track(t: &mut Track, l: &TrackLikelihoods, mg: &TrackMarginals) {
-    let r = t.existence;
-    let denom = 1.0 - r + r * l.eta_miss;
-    // Probability that the track exists and was missed.
-    let p_missed = if denom > 0.0 {
-        mg.miss * (r * l.eta_miss / denom)
-    } else {
-        0.0
-    };
-    let p_detected: f64 = mg.detect.iter().map(|(_, p)| p).sum();
-    let r_post = (p_missed + p_detected).clamp(0.0, 1.0);
-    t.existence = r_post;
-    t.expected_detections += p_detected;
-    if r_post <= 0.0 {
-        return;
-    }
-    let detected: Vec<(usize, f64)> = mg
-        .detect
-        .iter()
-        .copied()
-        .filter(|(_, p)| *p > 0.0)
-        .collect();
-    if detected.is_empty() && l.pd.windows(2).all(|w| w[0] == w[1]) {
-        return; // only the miss term, constant over particles: weights unchanged
-    }
-    // Particle i's factor: P_missed·(1 − p_D,i)/η_miss + p_D,i · Σ_j P_j·ĝ_j,i / η̂_j, where ĝ and
-    // η̂ are the likelihoods and sums scaled by the same constant (which cancels). The
-    // particle with ĝ = 1 of any detection term keeps a positive factor, so the set never empties.
-    let miss = if p_missed > 0.0 && l.eta_miss > 0.0 {
-        p_missed / l.eta_miss
-    } else {
-        0.0
-    };
-    let mut factor: Vec<f64> = l.pd.iter().map(|d| miss * (1.0 - d)).collect();
-    if let Some((&(k0, p0), rest)) = detected.split_first() {
-        // Σ_j P_j·ĝ_j,i / η̂_j, started from the first term (no zero-filled buffer).
-        let first = &l.pairs[k0];
-        let c0 = p0 / first.scaled_eta;
-        let mut detect_sum: Vec<f64> = first.scaled_g.iter().map(|g| c0 * g).collect();
-        for &(k, p) in rest {
-            let pair = &l.pairs[k];
-            let c = p / pair.scaled_eta;
-            detect_sum
-                .iter_mut()
-                .zip(&pair.scaled_g)
-                .for_each(|(s, g)| *s += c * g);
-        }
-        factor
-            .iter_mut()
-            .zip(&l.pd)
-            .zip(&detect_sum)
-            .for_each(|((f, d), s)| *f += d * s);
-    }
-    t.particles.reweight(&factor);
 }
 
 #[cfg(test)]

@@ -5,17 +5,22 @@
 //! never knows where they came from. Tracks ([`Track`]) carry a [`Label`], an existence
 //! probability and a [`ParticleSet`].
 //!
+//! A filter may have several [`Sensor`]s, each with its own measurement, detection and clutter
+//! models; a frame carries a [`Scan`] of any of them, and [`Fusion`] says how their updates
+//! combine ([`fusion`]).
+//!
 //! The filter's contract with its models lives here too: the plug-in traits of [`model`]
 //! ([`TransitionModel`], [`SurvivalModel`], [`MeasurementModel`], [`DetectionModel`],
 //! [`ClutterModel`]), [`BirthModel`], [`Associator`] and the duplicate merge's
 //! [`MergeDistance`]. The built-in models implementing them are in [`crate::models`] (and next
 //! to the applications that need their own).
 //!
-//! Not for: sensors, detectors or models of particular objects.
+//! Not for: sensor hardware, detectors or models of particular objects.
 
 pub mod association;
 pub mod birth;
 pub mod estimate;
+pub mod fusion;
 pub mod groups;
 pub mod label;
 pub mod lmb;
@@ -23,16 +28,19 @@ pub mod measurements;
 pub mod merge;
 pub mod model;
 pub mod particles;
+pub mod sensor;
 pub mod smoothing;
 pub mod step_data;
 pub mod survival;
 pub mod track;
+mod update;
 
 pub use association::{AssociationMethod, Associator};
 pub use birth::{
     AdaptiveBirth, BirthModel, BirthProposal, BirthSampler, BirthTerm, BirthTrack,
     CurrentMeasurements, PositionBirthSampler, StaticBirth,
 };
+pub use fusion::{Fusion, FusionMethod};
 pub use label::Label;
 pub use lmb::{
     Frame, LmbConfig, LmbFilter, LmbFilterBuilder, MostProbableMeasurement, MAX_PARTICLES,
@@ -46,6 +54,7 @@ pub use model::{
     TransitionModel,
 };
 pub use particles::{Jitter, ParticleSet};
+pub use sensor::{Mounting, Scan, Sensor, DEFAULT_SENSOR};
 pub use smoothing::FixedLagSmoother;
 pub use step_data::StepData;
 pub use survival::ConstantSurvival;

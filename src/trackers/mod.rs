@@ -163,12 +163,8 @@ impl PointTracker for LmbTracker {
     }
 
     fn step(&mut self, z: &Measurements, ctx: &StepContext) -> Result<Vec<Estimate>> {
-        let frame = Frame {
-            time: ctx.time,
-            measurements: z.clone(),
-            platform: ctx.platform,
-            data: ctx.data.clone(),
-        };
+        let mut frame = Frame::new(ctx.time, z.clone()).with_data(ctx.data.clone());
+        frame.platform = ctx.platform;
         self.filter.step(&frame, &mut self.rng)
     }
 }

@@ -160,7 +160,7 @@ pub enum MovingEvidence {
 /// The sensor's mounting offset on the robot, from the tracker's measurement model.
 pub fn sensor_mount(people: &PeopleTrackerConfig) -> [f64; 2] {
     match people.filter.measurement {
-        MeasurementConfig::RangeBearing { offset, .. } => offset,
+        Some(MeasurementConfig::RangeBearing { offset, .. }) => offset,
         _ => [0.0, 0.0],
     }
 }
@@ -260,7 +260,7 @@ pub const LEGS_PRUNE_THRESHOLD: f64 = 0.01;
 /// keeps the tracker's own settings.
 pub fn adapt_tracker_config(people: &mut PeopleTrackerConfig, kind: FrontEnd) {
     if kind == FrontEnd::Legs {
-        if let crate::config::DetectionConfig::FieldOfView { p_inside, .. } =
+        if let Some(crate::config::DetectionConfig::FieldOfView { p_inside, .. }) =
             &mut people.filter.detection
         {
             *p_inside = LEGS_DETECTION_PROBABILITY;
@@ -273,14 +273,16 @@ pub fn adapt_tracker_config(people: &mut PeopleTrackerConfig, kind: FrontEnd) {
     if kind != FrontEnd::Moving {
         return;
     }
-    if let crate::config::DetectionConfig::FieldOfView { p_inside, .. } =
+    if let Some(crate::config::DetectionConfig::FieldOfView { p_inside, .. }) =
         &mut people.filter.detection
     {
         *p_inside = MOVING_DETECTABLE_PROBABILITY;
     }
     people.detectability = Some(MOVING_DETECTABILITY);
     people.confirm_detections = MOVING_CONFIRM_DETECTIONS;
-    people.filter.clutter.rate = MOVING_CLUTTER_RATE;
+    if let Some(c) = &mut people.filter.clutter {
+        c.rate = MOVING_CLUTTER_RATE;
+    }
 }
 
 impl PersonFrontEnd {
@@ -517,7 +519,7 @@ mod tests {
         assert_eq!(base.confirm_evidence, 0.0);
         assert!(matches!(
             legs.filter.detection,
-            crate::config::DetectionConfig::FieldOfView { p_inside, .. }
+            Some(crate::config::DetectionConfig::FieldOfView { p_inside, .. })
                 if p_inside == LEGS_DETECTION_PROBABILITY
         ));
         assert_eq!(legs.filter.clutter, base.filter.clutter);
@@ -532,10 +534,10 @@ mod tests {
         assert_eq!(seg, base);
         let mut mov = base.clone();
         adapt_tracker_config(&mut mov, FrontEnd::Moving);
-        assert_eq!(mov.filter.clutter.rate, MOVING_CLUTTER_RATE);
+        assert_eq!(mov.filter.clutter.unwrap().rate, MOVING_CLUTTER_RATE);
         assert!(matches!(
             mov.filter.detection,
-            crate::config::DetectionConfig::FieldOfView { p_inside, .. }
+            Some(crate::config::DetectionConfig::FieldOfView { p_inside, .. })
                 if p_inside == MOVING_DETECTABLE_PROBABILITY
         ));
         assert_eq!(mov.detectability, Some(MOVING_DETECTABILITY));

@@ -181,23 +181,25 @@ impl PeopleTrackerConfig {
                     // Walkers change velocity slowly.
                     sigma_accel: 0.3,
                 },
-                measurement: MeasurementConfig::RangeBearing {
+                measurement: Some(MeasurementConfig::RangeBearing {
                     sigma_range: centre_sigma_range,
                     sigma_bearing: centre_sigma_bearing,
                     offset: mount,
                     convention: BearingConvention::FromXAxis,
-                },
-                detection: DetectionConfig::FieldOfView {
+                }),
+                detection: Some(DetectionConfig::FieldOfView {
                     p_inside: 0.9,
                     p_outside: 0.0,
                     max_range,
                     half_angle,
                     offset: mount,
-                },
-                clutter: ClutterConfig {
+                }),
+                clutter: Some(ClutterConfig {
                     rate: 1.0,
                     volume: 2.0 * half_angle * max_range,
-                },
+                }),
+                sensors: Vec::new(),
+                fusion: None,
                 birth: BirthConfig::Adaptive {
                     expected_births: 0.2,
                     max_existence: 0.2,
@@ -281,13 +283,13 @@ pub struct PeopleTracker {
 impl PeopleTracker {
     /// A tracker; the filter's random stream is seeded from `config.filter.seed`.
     pub fn new(config: PeopleTrackerConfig) -> Result<Self> {
-        let DetectionConfig::FieldOfView {
+        let Some(DetectionConfig::FieldOfView {
             p_inside,
             p_outside,
             max_range,
             half_angle,
             offset,
-        } = config.filter.detection
+        }) = config.filter.detection
         else {
             return Err(Error::invalid(
                 "people tracker config field `filter.detection`",
@@ -308,12 +310,12 @@ impl PeopleTracker {
                 "must be Adaptive",
             ));
         };
-        let MeasurementConfig::RangeBearing {
+        let Some(MeasurementConfig::RangeBearing {
             sigma_range,
             sigma_bearing,
             offset: sensor_offset,
             convention,
-        } = config.filter.measurement
+        }) = config.filter.measurement
         else {
             return Err(Error::invalid(
                 "people tracker config field `filter.measurement`",
@@ -954,7 +956,9 @@ mod tests {
 
         let mut independent = moving_front_end_config();
         independent.detectability = None;
-        if let DetectionConfig::FieldOfView { p_inside, .. } = &mut independent.filter.detection {
+        if let Some(DetectionConfig::FieldOfView { p_inside, .. }) =
+            &mut independent.filter.detection
+        {
             *p_inside = crate::pipeline::people_tracking::front_end::MOVING_DETECTION_PROBABILITY;
         }
         let (labels, _) = walk(independent, 64, y, 24..40);
