@@ -81,7 +81,10 @@ impl Scenario {
         let mut truth = Vec::with_capacity(steps.len());
         let mut readings = Vec::with_capacity(steps.len());
         for (k, s) in steps.iter().enumerate() {
-            truth.push(points(&s["ground_truth"], &format!("{ctx}: steps[{k}].ground_truth"))?);
+            truth.push(points(
+                &s["ground_truth"],
+                &format!("{ctx}: steps[{k}].ground_truth"),
+            )?);
             let r = &s["sensor_readings"];
             let per_sensor: Vec<Vec<[f64; 2]>> = if r.is_null() {
                 vec![Vec::new(); sensors]
@@ -131,14 +134,21 @@ impl Scenario {
 fn peer_fixtures() -> Result<PathBuf, String> {
     let manifest = concat!(env!("CARGO_MANIFEST_DIR"), "/Cargo.toml");
     let out = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
-        .args(["metadata", "--format-version", "1", "--manifest-path", manifest])
+        .args([
+            "metadata",
+            "--format-version",
+            "1",
+            "--manifest-path",
+            manifest,
+        ])
         .stderr(Stdio::inherit())
         .output()
         .map_err(err("cargo metadata"))?;
     if !out.status.success() {
         return Err("cargo metadata failed".into());
     }
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).map_err(err("cargo metadata"))?;
+    let v: serde_json::Value =
+        serde_json::from_slice(&out.stdout).map_err(err("cargo metadata"))?;
     let pkg = v["packages"]
         .as_array()
         .and_then(|ps| {
@@ -182,7 +192,10 @@ fn scenario_files(dir: &Path) -> Result<Vec<(usize, usize, String, PathBuf)>, St
 #[derive(Clone, Debug, PartialEq)]
 pub enum Spec {
     Peer(&'static str),
-    Ours { rule: ours::Rule, birth: ours::Birth },
+    Ours {
+        rule: ours::Rule,
+        birth: ours::Birth,
+    },
 }
 
 impl Spec {
@@ -240,7 +253,12 @@ impl Spec {
         if sensors == 1 {
             rules.push(ours::Rule::Single);
         }
-        rules.extend(ours::Rule::FUSED.iter().copied().filter(|_| ours::MULTI_SENSOR));
+        rules.extend(
+            ours::Rule::FUSED
+                .iter()
+                .copied()
+                .filter(|_| ours::MULTI_SENSOR),
+        );
         for birth in [ours::Birth::Static, ours::Birth::Adaptive] {
             for &rule in &rules {
                 v.push(Spec::Ours { rule, birth });
@@ -250,9 +268,35 @@ impl Spec {
     }
 }
 
+/// CPU time of this process so far (all its threads), ms.
+pub fn cpu_ms() -> f64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid timespec to write into; the clock id is a constant of the OS.
+    let rc = unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) };
+    if rc != 0 {
+        return f64::NAN;
+    }
+    ts.tv_sec as f64 * 1e3 + ts.tv_nsec as f64 * 1e-6
+}
+
+/// Wall and CPU time (ms) of `f`.
+pub fn timed<T>(f: impl FnOnce() -> T) -> (T, f64, f64) {
+    let c0 = cpu_ms();
+    let t0 = std::time::Instant::now();
+    let out = f();
+    let wall = t0.elapsed().as_secs_f64() * 1e3;
+    (out, wall, cpu_ms() - c0)
+}
+
 /// What a child reports after each step.
 pub struct StepOut {
+    /// Wall time of the filter's step, ms.
     pub ms: f64,
+    /// CPU time of the process (all threads) during the step, ms.
+    pub cpu_ms: f64,
     pub estimates: Vec<[f64; 2]>,
 }
 
@@ -262,11 +306,13 @@ pub trait Runner {
 }
 
 /// Child mode: run one filter on one scenario, one JSON line per step on stdout.
-fn run_one(path: &Path, spec: &Spec, seed: u64) -> Result<(), String> {
+fn run_one(path: &Path, spec: &Spec, seed: u64, particles: usize) -> Result<(), String> {
     let scenario = Scenario::load(path)?;
     let mut runner: Box<dyn Runner + '_> = match spec {
         Spec::Peer(name) => Box::new(peer::PeerRunner::new(path, name)?),
-        Spec::Ours { rule, birth } => Box::new(ours::OurRunner::new(&scenario, *rule, *birth, seed)?),
+        Spec::Ours { rule, birth } => Box::new(ours::OurRunner::new(
+            &scenario, *rule, *birth, seed, particles,
+        )?),
     };
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
@@ -285,7 +331,7 @@ fn run_one(path: &Path, spec: &Spec, seed: u64) -> Result<(), String> {
             out,
             "{}",
             serde_json::json!({
-                "k": k, "ms": s.ms, "ospa_5_2": o5.distance, "ospa_100_1": o100.distance,
+                "k": k, "ms": s.ms, "cpu_ms": s.cpu_ms, "ospa_5_2": o5.distance, "ospa_100_1": o100.distance,
                 "estimates": s.estimates.len(), "truth": truth.len(),
             })
         )
@@ -304,8 +350,11 @@ struct Summary {
     ospa100: f64,
     ms_mean: f64,
     ms_median: f64,
+    cpu_mean: f64,
     card_err: f64,
     threads: usize,
+    /// Wall time of the whole child process, s.
+    elapsed: f64,
     /// `None` when it finished; otherwise why not.
     stopped: Option<String>,
 }
@@ -313,7 +362,12 @@ struct Summary {
 fn summarise(lines: &[serde_json::Value], total_steps: usize) -> Summary {
     let steps: Vec<&serde_json::Value> = lines.iter().filter(|l| l.get("k").is_some()).collect();
     let n = steps.len().max(1) as f64;
-    let f = |key: &str| -> Vec<f64> { steps.iter().map(|l| l[key].as_f64().unwrap_or(f64::NAN)).collect() };
+    let f = |key: &str| -> Vec<f64> {
+        steps
+            .iter()
+            .map(|l| l[key].as_f64().unwrap_or(f64::NAN))
+            .collect()
+    };
     let mut ms = f("ms");
     let ms_mean = ms.iter().sum::<f64>() / n;
     ms.sort_by(f64::total_cmp);
@@ -324,7 +378,9 @@ fn summarise(lines: &[serde_json::Value], total_steps: usize) -> Summary {
     };
     let card_err = steps
         .iter()
-        .map(|l| (l["estimates"].as_f64().unwrap_or(0.0) - l["truth"].as_f64().unwrap_or(0.0)).abs())
+        .map(|l| {
+            (l["estimates"].as_f64().unwrap_or(0.0) - l["truth"].as_f64().unwrap_or(0.0)).abs()
+        })
         .sum::<f64>()
         / n;
     Summary {
@@ -334,11 +390,13 @@ fn summarise(lines: &[serde_json::Value], total_steps: usize) -> Summary {
         ospa100: f("ospa_100_1").iter().sum::<f64>() / n,
         ms_mean,
         ms_median,
+        cpu_mean: f("cpu_ms").iter().sum::<f64>() / n,
         card_err,
         threads: lines
             .iter()
             .find_map(|l| l.get("threads").and_then(|t| t.as_u64()))
             .unwrap_or(0) as usize,
+        elapsed: f64::NAN,
         stopped: None,
     }
 }
@@ -353,13 +411,18 @@ fn run_child(
     let exe = std::env::current_exe().map_err(err("current_exe"))?;
     let mut cmd = Command::new("sh");
     cmd.arg("-c")
-        .arg(format!("ulimit -v {} && exec \"$0\" \"$@\"", opts.mem_gb * 1024 * 1024))
+        .arg(format!(
+            "ulimit -v {} && exec \"$0\" \"$@\"",
+            opts.mem_gb * 1024 * 1024
+        ))
         .arg(&exe)
         .arg("--one")
         .arg(path)
         .arg(spec.name())
         .arg("--seed")
         .arg(opts.seed.to_string())
+        .arg("--particles")
+        .arg(opts.particles.to_string())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
     if let Some(t) = opts.threads {
@@ -397,12 +460,23 @@ fn run_child(
     let lines = reader.join().unwrap_or_default();
     let stderr_text = err_reader.join().unwrap_or_default();
     let mut s = summarise(&lines, total_steps);
+    s.elapsed = t0.elapsed().as_secs_f64();
     if timed_out {
         s.stopped = Some(format!("timeout ({} s)", opts.timeout));
     } else if !status.success() || s.steps < total_steps {
-        let last = stderr_text.lines().rev().find(|l| !l.trim().is_empty()).unwrap_or("");
-        let why = if stderr_text.contains("memory allocation") || stderr_text.contains("capacity overflow") {
-            format!("out of memory ({} GB limit)", opts.mem_gb)
+        let last = stderr_text
+            .lines()
+            .rev()
+            .find(|l| !l.trim().is_empty())
+            .unwrap_or("");
+        let why = if stderr_text.contains("memory allocation")
+            || stderr_text.contains("capacity overflow")
+        {
+            format!(
+                "out of memory ({} GB limit, after {:.0} s)",
+                opts.mem_gb,
+                t0.elapsed().as_secs_f64()
+            )
         } else {
             format!("failed: {}", last.trim())
         };
@@ -418,8 +492,13 @@ struct Opts {
     mem_gb: u64,
     threads: Option<usize>,
     seed: u64,
+    particles: usize,
     out: Option<PathBuf>,
     fixtures: Option<PathBuf>,
+    /// Results of earlier runs (`--out` files) to put in the table too.
+    from: Vec<PathBuf>,
+    /// Only print the table of the `--from` files.
+    table_only: bool,
 }
 
 fn parse_args() -> Result<(Opts, Option<(PathBuf, String)>), String> {
@@ -430,12 +509,20 @@ fn parse_args() -> Result<(Opts, Option<(PathBuf, String)>), String> {
         mem_gb: 8,
         threads: None,
         seed: 42,
+        particles: ours::PARTICLES,
         out: None,
         fixtures: None,
+        from: Vec::new(),
+        table_only: false,
     };
     let mut one = None;
     let mut args = std::env::args().skip(1);
-    let list = |s: String| s.split(',').map(str::to_string).filter(|s| !s.is_empty()).collect();
+    let list = |s: String| {
+        s.split(',')
+            .map(str::to_string)
+            .filter(|s| !s.is_empty())
+            .collect()
+    };
     while let Some(a) = args.next() {
         let mut val = || args.next().ok_or_else(|| format!("{a} needs a value"));
         match a.as_str() {
@@ -445,8 +532,11 @@ fn parse_args() -> Result<(Opts, Option<(PathBuf, String)>), String> {
             "--mem-gb" => o.mem_gb = val()?.parse().map_err(err("--mem-gb"))?,
             "--threads" => o.threads = Some(val()?.parse().map_err(err("--threads"))?),
             "--seed" => o.seed = val()?.parse().map_err(err("--seed"))?,
+            "--particles" => o.particles = val()?.parse().map_err(err("--particles"))?,
             "--out" => o.out = Some(val()?.into()),
             "--fixtures" => o.fixtures = Some(val()?.into()),
+            "--from" => o.from.push(val()?.into()),
+            "--table-only" => o.table_only = true,
             "--one" => {
                 let p = val()?;
                 let f = args.next().ok_or("--one needs a scenario and a filter")?;
@@ -456,7 +546,7 @@ fn parse_args() -> Result<(Opts, Option<(PathBuf, String)>), String> {
                 println!(
                     "multisensor-compare [--scenarios n5_s2,...] [--filters peer-ic,ours-pu-static,...]\n\
                      \x20   [--timeout SECONDS (60)] [--mem-gb GB (8)] [--threads N (RAYON_NUM_THREADS of our filter)]\n\
-                     \x20   [--seed 42] [--out results.jsonl] [--fixtures DIR]\n\
+                     \x20   [--seed 42] [--particles 1000] [--out results.jsonl] [--fixtures DIR] [--from earlier.jsonl ...] [--table-only]\n\
                      filters: peer-{{lmb,ic,pu,ga,aa}}, ours-{{single,ic,pu,ga,aa}}-{{static,static-plain,adaptive}}"
                 );
                 std::process::exit(0);
@@ -472,12 +562,16 @@ fn cell(s: &Summary) -> (String, String, String) {
         None => (
             format!("{:.3}", s.ospa5),
             format!("{:.2}", s.ospa100),
-            format!("{:.2}", s.ms_mean),
+            format!("{:.1} / {:.1}", s.ms_mean, s.cpu_mean),
         ),
         Some(why) => (
             why.clone(),
             format!("({}/{} steps)", s.steps, s.total_steps),
-            if s.steps > 0 { format!("({:.0} over those)", s.ms_mean) } else { "–".into() },
+            if s.steps > 0 {
+                format!("({:.0} / {:.0} over those)", s.ms_mean, s.cpu_mean)
+            } else {
+                "–".into()
+            },
         ),
     }
 }
@@ -492,7 +586,41 @@ fn main() {
 fn real_main() -> Result<(), String> {
     let (opts, one) = parse_args()?;
     if let Some((path, filter)) = one {
-        return run_one(&path, &Spec::parse(&filter)?, opts.seed);
+        return run_one(&path, &Spec::parse(&filter)?, opts.seed, opts.particles);
+    }
+    let mut results: BTreeMap<(usize, usize), Vec<(Spec, Summary)>> = BTreeMap::new();
+    for p in &opts.from {
+        let text = std::fs::read_to_string(p).map_err(err(&p.display().to_string()))?;
+        for line in text.lines().filter(|l| !l.trim().is_empty()) {
+            let v: serde_json::Value =
+                serde_json::from_str(line).map_err(err(&p.display().to_string()))?;
+            let g = |k: &str| v[k].as_f64().unwrap_or(f64::NAN);
+            let key = (
+                v["sensors"].as_u64().unwrap_or(0) as usize,
+                v["objects"].as_u64().unwrap_or(0) as usize,
+            );
+            let spec = Spec::parse(v["filter"].as_str().unwrap_or(""))?;
+            let s = Summary {
+                steps: g("steps") as usize,
+                total_steps: g("total_steps") as usize,
+                ospa5: g("ospa_5_2"),
+                ospa100: g("ospa_100_1"),
+                ms_mean: g("ms_per_step_mean"),
+                ms_median: g("ms_per_step_median"),
+                cpu_mean: g("cpu_ms_per_step_mean"),
+                card_err: g("card_abs_err"),
+                threads: g("threads") as usize,
+                elapsed: g("elapsed_s"),
+                stopped: v["stopped"].as_str().map(str::to_string),
+            };
+            let runs = results.entry(key).or_default();
+            runs.retain(|(sp, _)| sp != &spec);
+            runs.push((spec, s));
+        }
+    }
+    if opts.table_only {
+        print_table(&results);
+        return Ok(());
     }
     let dir = match &opts.fixtures {
         Some(d) => d.clone(),
@@ -517,7 +645,6 @@ fn real_main() -> Result<(), String> {
         Some(p) => Some(std::fs::File::create(p).map_err(err(&p.display().to_string()))?),
         None => None,
     };
-    let mut results: BTreeMap<(usize, usize), Vec<(Spec, Summary)>> = BTreeMap::new();
     for (sensors, objects, name, path) in &files {
         let scenario = Scenario::load(path)?;
         let specs = wanted.clone().unwrap_or_else(|| Spec::defaults(*sensors));
@@ -525,7 +652,7 @@ fn real_main() -> Result<(), String> {
             let (s, _) = run_child(path, &spec, scenario.truth.len(), &opts)?;
             let (a, b, c) = cell(&s);
             eprintln!(
-                "{name} {:<22} OSPA(5,2) {a}  OSPA(100,1) {b}  ms/step {c} (median {:.2})  |n̂−n| {:.2}  threads {}",
+                "{name} {:<26} OSPA(5,2) {a}  OSPA(100,1) {b}  ms/step wall/CPU {c} (wall median {:.2})  |n̂−n| {:.2}  threads {}",
                 spec.name(),
                 s.ms_median,
                 s.card_err,
@@ -540,14 +667,17 @@ fn real_main() -> Result<(), String> {
                         "filter": spec.name(), "steps": s.steps, "total_steps": s.total_steps,
                         "ospa_5_2": s.ospa5, "ospa_100_1": s.ospa100,
                         "ms_per_step_mean": s.ms_mean, "ms_per_step_median": s.ms_median,
-                        "card_abs_err": s.card_err, "threads": s.threads,
+                        "cpu_ms_per_step_mean": s.cpu_mean,
+                        "card_abs_err": s.card_err, "threads": s.threads, "elapsed_s": s.elapsed,
                         "stopped": s.stopped, "seed": opts.seed,
-                        "particles": ours::PARTICLES,
+                        "particles": opts.particles,
                     })
                 )
                 .map_err(err("--out"))?;
             }
-            results.entry((*sensors, *objects)).or_default().push((spec, s));
+            let runs = results.entry((*sensors, *objects)).or_default();
+            runs.retain(|(sp, _)| sp != &spec);
+            runs.push((spec, s));
         }
     }
     print_table(&results);
@@ -559,7 +689,7 @@ fn real_main() -> Result<(), String> {
 fn print_table(results: &BTreeMap<(usize, usize), Vec<(Spec, Summary)>>) {
     use ours::{Birth, Rule};
     println!(
-        "| objects | sensors | rule | peer OSPA₅,₂ | peer OSPA₁₀₀,₁ | peer ms | ours static OSPA₅,₂ | OSPA₁₀₀,₁ | ms | ours adaptive OSPA₅,₂ | OSPA₁₀₀,₁ | ms |"
+        "| objects | sensors | rule | peer OSPA₅,₂ | peer OSPA₁₀₀,₁ | peer ms wall / CPU | ours static OSPA₅,₂ | OSPA₁₀₀,₁ | ms wall / CPU | ours adaptive OSPA₅,₂ | OSPA₁₀₀,₁ | ms wall / CPU |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
     let rules: [(&str, Option<&str>, Option<Rule>); 5] = [
@@ -573,13 +703,27 @@ fn print_table(results: &BTreeMap<(usize, usize), Vec<(Spec, Summary)>>) {
         for (label, peer, rule) in rules {
             let find = |want: &Spec| runs.iter().find(|(s, _)| s == want).map(|(_, r)| cell(r));
             let p = peer.and_then(|p| find(&Spec::Peer(p)));
-            let st = rule.and_then(|rule| find(&Spec::Ours { rule, birth: Birth::Static }));
-            let ad = rule.and_then(|rule| find(&Spec::Ours { rule, birth: Birth::Adaptive }));
+            let st = rule.and_then(|rule| {
+                find(&Spec::Ours {
+                    rule,
+                    birth: Birth::Static,
+                })
+            });
+            let ad = rule.and_then(|rule| {
+                find(&Spec::Ours {
+                    rule,
+                    birth: Birth::Adaptive,
+                })
+            });
             if p.is_none() && st.is_none() && ad.is_none() {
                 continue;
             }
             let dash = || ("–".to_string(), "–".to_string(), "–".to_string());
-            let (p, st, ad) = (p.unwrap_or_else(dash), st.unwrap_or_else(dash), ad.unwrap_or_else(dash));
+            let (p, st, ad) = (
+                p.unwrap_or_else(dash),
+                st.unwrap_or_else(dash),
+                ad.unwrap_or_else(dash),
+            );
             println!(
                 "| {objects} | {sensors} | {label} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
                 p.0, p.1, p.2, st.0, st.1, st.2, ad.0, ad.1, ad.2

@@ -8,19 +8,20 @@
 //! = the same terms sampled plainly; `adaptive` = adaptive birth (λ_B = 1, r_B,max = 0.1,
 //! position std σ, velocity std 10 m/s = the static terms' velocity spread).
 
-use crate::{Runner, Scenario, StepOut};
+use crate::{timed, Runner, Scenario, StepOut};
 use smc_lmb::config::{
-    BirthConfig, ClutterConfig, DetectionConfig, MeasurementConfig, RunConfig, TransitionConfig,
+    BirthConfig, ClutterConfig, DetectionConfig, FusionConfig, MeasurementConfig, RunConfig,
+    SensorConfig, TransitionConfig,
 };
-use smc_lmb::filter::{BirthTerm, Frame, LmbConfig, LmbFilter, Measurements};
+use smc_lmb::filter::{BirthTerm, Frame, FusionMethod, LmbConfig, LmbFilter, Measurements};
 use smc_lmb::rng::{seeded, FilterRng};
-use std::time::Instant;
 
-/// Particles per track and per birth track, in every scenario.
+/// Particles per track and per birth track, in every scenario (`--particles` changes it for
+/// a whole run).
 pub const PARTICLES: usize = 1000;
 
 /// Whether this build has the multi-sensor rules.
-pub const MULTI_SENSOR: bool = false;
+pub const MULTI_SENSOR: bool = true;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Rule {
@@ -88,8 +89,11 @@ impl Birth {
     }
 }
 
-/// The single-sensor configuration of a scenario (one sensor's models).
-pub fn config(s: &Scenario, birth: Birth, seed: u64) -> RunConfig {
+/// The configuration of a scenario: with [`Rule::Single`] today's single-sensor form (one set
+/// of models, fed sensor 0's points), otherwise one `[[sensors]]` entry per sensor of the
+/// scenario (named `s0`, `s1`, ...; the same models) and `[fusion] method = rule`, uniform
+/// weights, IC in sensor order.
+pub fn config(s: &Scenario, rule: Rule, birth: Birth, seed: u64, particles: usize) -> RunConfig {
     let birth = match birth {
         Birth::Static | Birth::StaticPlain => BirthConfig::Static {
             // Our state is [x, ẋ, y, ẏ]; the peer's birth locations are [x, y, vx, vy].
@@ -102,39 +106,70 @@ pub fn config(s: &Scenario, birth: Birth, seed: u64) -> RunConfig {
                     std: vec![50.0, 10.0, 50.0, 10.0],
                 })
                 .collect(),
-            particles: PARTICLES,
+            particles,
             measurement_proposal: birth == Birth::Static,
         },
         Birth::Adaptive => BirthConfig::Adaptive {
             expected_births: 1.0,
             max_existence: 0.1,
-            particles: PARTICLES,
+            particles,
             position_std: s.measurement_noise_std,
             velocity_std: 10.0,
             turn_rate_std: 0.1,
         },
     };
+    let measurement = MeasurementConfig::Position {
+        sigma: s.measurement_noise_std,
+    };
+    let detection = DetectionConfig::Constant {
+        probability: s.detection_probability,
+    };
+    let clutter = ClutterConfig {
+        rate: s.clutter_rate,
+        volume: s.area,
+    };
+    let method = match rule {
+        Rule::Single => None,
+        Rule::IteratedCorrector => Some(FusionMethod::IteratedCorrector),
+        Rule::ParallelUpdate => Some(FusionMethod::ParallelUpdate),
+        Rule::GeometricAverage => Some(FusionMethod::GeometricAverage),
+        Rule::ArithmeticAverage => Some(FusionMethod::ArithmeticAverage),
+    };
+    let (one, sensors, fusion) = match method {
+        None => (Some((measurement, detection, clutter)), Vec::new(), None),
+        Some(method) => (
+            None,
+            (0..s.sensors)
+                .map(|i| SensorConfig {
+                    name: format!("s{i}"),
+                    measurement: measurement.clone(),
+                    detection: detection.clone(),
+                    clutter: clutter.clone(),
+                    mounting: None,
+                })
+                .collect(),
+            Some(FusionConfig {
+                method,
+                ..FusionConfig::default()
+            }),
+        ),
+    };
     RunConfig {
         seed,
         survival: s.survival_probability,
         filter: LmbConfig {
-            particles: PARTICLES,
+            particles,
             ..LmbConfig::default()
         },
         transition: TransitionConfig::ConstantVelocity {
             dims: 2,
             sigma_accel: s.process_noise_std,
         },
-        measurement: MeasurementConfig::Position {
-            sigma: s.measurement_noise_std,
-        },
-        detection: DetectionConfig::Constant {
-            probability: s.detection_probability,
-        },
-        clutter: ClutterConfig {
-            rate: s.clutter_rate,
-            volume: s.area,
-        },
+        measurement: one.as_ref().map(|o| o.0.clone()),
+        detection: one.as_ref().map(|o| o.1.clone()),
+        clutter: one.map(|o| o.2),
+        sensors,
+        fusion,
         birth,
         association: Default::default(),
     }
@@ -148,12 +183,16 @@ pub struct OurRunner<'a> {
 }
 
 impl<'a> OurRunner<'a> {
-    pub fn new(s: &'a Scenario, rule: Rule, birth: Birth, seed: u64) -> Result<Self, String> {
-        let cfg = config(s, birth, seed);
-        let filter = match rule {
-            Rule::Single => cfg.build().map_err(|e| e.to_string())?,
-            _ => return Err("this build of smc-lmb has no multi-sensor filter".into()),
-        };
+    pub fn new(
+        s: &'a Scenario,
+        rule: Rule,
+        birth: Birth,
+        seed: u64,
+        particles: usize,
+    ) -> Result<Self, String> {
+        let filter = config(s, rule, birth, seed, particles)
+            .build()
+            .map_err(|e| e.to_string())?;
         Ok(OurRunner {
             scenario: s,
             rule,
@@ -168,19 +207,26 @@ impl Runner for OurRunner<'_> {
         let t = k as f64 * self.scenario.dt;
         let z = &self.scenario.readings[k];
         let frame = match self.rule {
-            Rule::Single => {
-                Frame::new(t, Measurements::from_rows(2, &z[0]).map_err(|e| e.to_string())?)
+            Rule::Single => Frame::new(
+                t,
+                Measurements::from_rows(2, &z[0]).map_err(|e| e.to_string())?,
+            ),
+            _ => {
+                let mut f = Frame::at_time(t);
+                for (i, zi) in z.iter().enumerate() {
+                    f = f.with_sensor(
+                        i,
+                        Measurements::from_rows(2, zi).map_err(|e| e.to_string())?,
+                    );
+                }
+                f
             }
-            _ => unreachable!(),
         };
-        let t0 = Instant::now();
-        let est = self
-            .filter
-            .step(&frame, &mut self.rng)
-            .map_err(|e| format!("step {k}: {e}"))?;
-        let ms = t0.elapsed().as_secs_f64() * 1e3;
+        let (est, ms, cpu_ms) = timed(|| self.filter.step(&frame, &mut self.rng));
+        let est = est.map_err(|e| format!("step {k}: {e}"))?;
         Ok(StepOut {
             ms,
+            cpu_ms,
             estimates: est.iter().map(|e| [e.state[0], e.state[2]]).collect(),
         })
     }

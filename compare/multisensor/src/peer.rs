@@ -3,14 +3,13 @@
 //! (`SimpleRng::new(42)`; single-sensor LMB on sensor 0's points with the file's step index,
 //! the multi-sensor filters on every sensor's points with the step's position as time).
 
-use crate::{Runner, StepOut};
+use crate::{timed, Runner, StepOut};
 use multisensor_lmb_filters_rs::bench_utils::{
     create_filter, load_scenario, preprocess, AnyFilter, PreprocessedScenario,
 };
 use multisensor_lmb_filters_rs::lmb::{SimpleRng, StateEstimate};
 use multisensor_lmb_filters_rs::Filter;
 use std::path::Path;
-use std::time::Instant;
 
 /// The peer crate's version this runner is written against.
 pub const VERSION: &str = "0.3.2";
@@ -44,19 +43,21 @@ impl Runner for PeerRunner {
         let rng = &mut self.rng;
         let single = &self.prep.steps;
         let multi = &self.prep.multi_steps;
-        let t0 = Instant::now();
-        let est = match &mut self.filter {
-            AnyFilter::Lmb(f) => f.step(rng, &single[k].1, single[k].0),
-            AnyFilter::IcLmb(f) => f.step(rng, &multi[k], k),
-            AnyFilter::PuLmb(f) => f.step(rng, &multi[k], k),
-            AnyFilter::GaLmb(f) => f.step(rng, &multi[k], k),
-            AnyFilter::AaLmb(f) => f.step(rng, &multi[k], k),
-            _ => return Err("only the LMB filters are compared".into()),
-        };
-        let ms = t0.elapsed().as_secs_f64() * 1e3;
-        let est = est.map_err(|e| format!("peer step {k}: {e:?}"))?;
+        let filter = &mut self.filter;
+        let (est, ms, cpu_ms) = timed(|| match filter {
+            AnyFilter::Lmb(f) => Some(f.step(rng, &single[k].1, single[k].0)),
+            AnyFilter::IcLmb(f) => Some(f.step(rng, &multi[k], k)),
+            AnyFilter::PuLmb(f) => Some(f.step(rng, &multi[k], k)),
+            AnyFilter::GaLmb(f) => Some(f.step(rng, &multi[k], k)),
+            AnyFilter::AaLmb(f) => Some(f.step(rng, &multi[k], k)),
+            _ => None,
+        });
+        let est = est
+            .ok_or("only the LMB filters are compared")?
+            .map_err(|e| format!("peer step {k}: {e:?}"))?;
         Ok(StepOut {
             ms,
+            cpu_ms,
             estimates: positions(est),
         })
     }
