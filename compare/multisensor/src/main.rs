@@ -306,12 +306,12 @@ pub trait Runner {
 }
 
 /// Child mode: run one filter on one scenario, one JSON line per step on stdout.
-fn run_one(path: &Path, spec: &Spec, seed: u64, particles: usize) -> Result<(), String> {
+fn run_one(path: &Path, spec: &Spec, seed: u64, tuning: ours::Tuning) -> Result<(), String> {
     let scenario = Scenario::load(path)?;
     let mut runner: Box<dyn Runner + '_> = match spec {
         Spec::Peer(name) => Box::new(peer::PeerRunner::new(path, name)?),
         Spec::Ours { rule, birth } => Box::new(ours::OurRunner::new(
-            &scenario, *rule, *birth, seed, particles,
+            &scenario, *rule, *birth, seed, tuning,
         )?),
     };
     let stdout = std::io::stdout();
@@ -422,9 +422,14 @@ fn run_child(
         .arg("--seed")
         .arg(opts.seed.to_string())
         .arg("--particles")
-        .arg(opts.particles.to_string())
+        .arg(opts.tuning.particles.to_string())
+        .arg("--estimate")
+        .arg(opts.tuning.estimator.name())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
+    if let Some(m) = opts.tuning.min_particles {
+        cmd.arg("--min-particles").arg(m.to_string());
+    }
     if let Some(t) = opts.threads {
         cmd.env("RAYON_NUM_THREADS", t.to_string());
     }
@@ -492,13 +497,15 @@ struct Opts {
     mem_gb: u64,
     threads: Option<usize>,
     seed: u64,
-    particles: usize,
+    tuning: ours::Tuning,
     out: Option<PathBuf>,
     fixtures: Option<PathBuf>,
     /// Results of earlier runs (`--out` files) to put in the table too.
     from: Vec<PathBuf>,
     /// Only print the table of the `--from` files.
     table_only: bool,
+    /// Print one row per (scenario, filter) instead of one per (scenario, rule).
+    rows: bool,
 }
 
 fn parse_args() -> Result<(Opts, Option<(PathBuf, String)>), String> {
@@ -509,11 +516,16 @@ fn parse_args() -> Result<(Opts, Option<(PathBuf, String)>), String> {
         mem_gb: 8,
         threads: None,
         seed: 42,
-        particles: ours::PARTICLES,
+        tuning: ours::Tuning {
+            particles: ours::PARTICLES,
+            min_particles: None,
+            estimator: ours::Estimator::Mean,
+        },
         out: None,
         fixtures: None,
         from: Vec::new(),
         table_only: false,
+        rows: false,
     };
     let mut one = None;
     let mut args = std::env::args().skip(1);
@@ -532,7 +544,16 @@ fn parse_args() -> Result<(Opts, Option<(PathBuf, String)>), String> {
             "--mem-gb" => o.mem_gb = val()?.parse().map_err(err("--mem-gb"))?,
             "--threads" => o.threads = Some(val()?.parse().map_err(err("--threads"))?),
             "--seed" => o.seed = val()?.parse().map_err(err("--seed"))?,
-            "--particles" => o.particles = val()?.parse().map_err(err("--particles"))?,
+            "--particles" => o.tuning.particles = val()?.parse().map_err(err("--particles"))?,
+            "--min-particles" => {
+                o.tuning.min_particles = Some(val()?.parse().map_err(err("--min-particles"))?)
+            }
+            "--estimate" => {
+                let v = val()?;
+                o.tuning.estimator = ours::Estimator::parse(&v)
+                    .ok_or_else(|| format!("--estimate: `{v}` is not mean or mode"))?
+            }
+            "--rows" => o.rows = true,
             "--out" => o.out = Some(val()?.into()),
             "--fixtures" => o.fixtures = Some(val()?.into()),
             "--from" => o.from.push(val()?.into()),
@@ -546,7 +567,8 @@ fn parse_args() -> Result<(Opts, Option<(PathBuf, String)>), String> {
                 println!(
                     "multisensor-compare [--scenarios n5_s2,...] [--filters peer-ic,ours-pu-static,...]\n\
                      \x20   [--timeout SECONDS (60)] [--mem-gb GB (8)] [--threads N (RAYON_NUM_THREADS of our filter)]\n\
-                     \x20   [--seed 42] [--particles 1000] [--out results.jsonl] [--fixtures DIR] [--from earlier.jsonl ...] [--table-only]\n\
+                     \x20   [--seed 42] [--particles 1000] [--min-particles N] [--estimate mean|mode]\n\
+                     \x20   [--out results.jsonl] [--fixtures DIR] [--from earlier.jsonl ...] [--table-only] [--rows]\n\
                      filters: peer-{{lmb,ic,pu,ga,aa}}, ours-{{single,ic,pu,ga,aa}}-{{static,static-plain,adaptive}}"
                 );
                 std::process::exit(0);
@@ -586,7 +608,7 @@ fn main() {
 fn real_main() -> Result<(), String> {
     let (opts, one) = parse_args()?;
     if let Some((path, filter)) = one {
-        return run_one(&path, &Spec::parse(&filter)?, opts.seed, opts.particles);
+        return run_one(&path, &Spec::parse(&filter)?, opts.seed, opts.tuning);
     }
     let mut results: BTreeMap<(usize, usize), Vec<(Spec, Summary)>> = BTreeMap::new();
     for p in &opts.from {
@@ -619,7 +641,7 @@ fn real_main() -> Result<(), String> {
         }
     }
     if opts.table_only {
-        print_table(&results);
+        print(&results, opts.rows);
         return Ok(());
     }
     let dir = match &opts.fixtures {
@@ -670,7 +692,9 @@ fn real_main() -> Result<(), String> {
                         "cpu_ms_per_step_mean": s.cpu_mean,
                         "card_abs_err": s.card_err, "threads": s.threads, "elapsed_s": s.elapsed,
                         "stopped": s.stopped, "seed": opts.seed,
-                        "particles": opts.particles,
+                        "particles": opts.tuning.particles,
+                        "min_particles": opts.tuning.min_particles,
+                        "estimate": opts.tuning.estimator.name(),
                     })
                 )
                 .map_err(err("--out"))?;
@@ -680,8 +704,74 @@ fn real_main() -> Result<(), String> {
             runs.push((spec, s));
         }
     }
-    print_table(&results);
+    print(&results, opts.rows);
     Ok(())
+}
+
+fn print(results: &BTreeMap<(usize, usize), Vec<(Spec, Summary)>>, rows: bool) {
+    if rows {
+        print_rows(results)
+    } else {
+        print_table(results)
+    }
+}
+
+/// The order of the rows of a scenario: the peer's filters, then ours by birth and rule.
+fn row_order(s: &Spec) -> (usize, usize, usize) {
+    use ours::{Birth, Rule};
+    let rule = |r: Rule| match r {
+        Rule::Single => 0,
+        Rule::IteratedCorrector => 1,
+        Rule::ParallelUpdate => 2,
+        Rule::GeometricAverage => 3,
+        Rule::ArithmeticAverage => 4,
+    };
+    match s {
+        Spec::Peer(p) => (
+            0,
+            0,
+            ["LMB-LBP", "IC-LMB-LBP", "PU-LMB-LBP", "GA-LMB-LBP", "AA-LMB-LBP"]
+                .iter()
+                .position(|q| q == p)
+                .unwrap_or(5),
+        ),
+        Spec::Ours { rule: r, birth } => (
+            1,
+            match birth {
+                Birth::Static => 0,
+                Birth::StaticPlain => 1,
+                Birth::Adaptive => 2,
+            },
+            rule(*r),
+        ),
+    }
+}
+
+/// One row per (scenario, filter): mean OSPA (5 m, p 2), mean OSPA (100 m, p 1), mean
+/// |cardinality error|, wall and CPU ms per step, status (a stopped run's means are over the
+/// steps it finished).
+fn print_rows(results: &BTreeMap<(usize, usize), Vec<(Spec, Summary)>>) {
+    println!("| scenario | filter | OSPA (5 m, p 2) | OSPA (100 m, p 1) | mean abs. cardinality error | wall ms/step | CPU ms/step | status |");
+    println!("|---|---|---|---|---|---|---|---|");
+    for (&(sensors, objects), runs) in results {
+        let mut runs: Vec<&(Spec, Summary)> = runs.iter().collect();
+        runs.sort_by_key(|(s, _)| row_order(s));
+        for (spec, s) in runs {
+            let status = match &s.stopped {
+                None => "done".to_string(),
+                Some(why) => format!("{why}, {}/{} steps", s.steps, s.total_steps),
+            };
+            println!(
+                "| n{objects}_s{sensors} | {} | {:.3} | {:.2} | {:.2} | {:.1} | {:.1} | {status} |",
+                spec.name(),
+                s.ospa5,
+                s.ospa100,
+                s.card_err,
+                s.ms_mean,
+                s.cpu_mean
+            );
+        }
+    }
 }
 
 /// One row per (scenario, rule): the peer's filter, ours with static birth, ours with adaptive

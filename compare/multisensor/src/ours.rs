@@ -13,7 +13,9 @@ use smc_lmb::config::{
     BirthConfig, ClutterConfig, DetectionConfig, FusionConfig, MeasurementConfig, RunConfig,
     SensorConfig, TransitionConfig,
 };
-use smc_lmb::filter::{BirthTerm, Frame, FusionMethod, LmbConfig, LmbFilter, Measurements};
+use smc_lmb::filter::{
+    BirthTerm, Frame, FusionMethod, LmbConfig, LmbFilter, Measurements, ParticleSet,
+};
 use smc_lmb::rng::{seeded, FilterRng};
 
 /// Particles per track and per birth track, in every scenario (`--particles` changes it for
@@ -22,6 +24,96 @@ pub const PARTICLES: usize = 1000;
 
 /// Whether this build has the multi-sensor rules.
 pub const MULTI_SENSOR: bool = true;
+
+/// How a reported track's state is read from its particles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Estimator {
+    /// The filter's own estimate: the weighted mean of all the track's particles.
+    Mean,
+    /// The weighted mean of the particles in the heaviest 3 × 3 block of square position
+    /// cells of side 2σ (σ = measurement noise): the mean of the track's main mode, as the
+    /// peer reports the mean of a track's heaviest Gaussian component. For a one-peaked
+    /// density (σ/√2 spread or less after an update) the block holds practically every
+    /// particle and this is the mean; it differs where a new track's density is split
+    /// between several measurements, whose mean lies between the objects.
+    Mode,
+}
+
+impl Estimator {
+    pub fn parse(s: &str) -> Option<Estimator> {
+        Some(match s {
+            "mean" => Estimator::Mean,
+            "mode" => Estimator::Mode,
+            _ => return None,
+        })
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Estimator::Mean => "mean",
+            Estimator::Mode => "mode",
+        }
+    }
+}
+
+/// The settings of our filter in a run (the same for every scenario).
+#[derive(Clone, Copy, Debug)]
+pub struct Tuning {
+    /// Particles per track and per birth track.
+    pub particles: usize,
+    /// `LmbConfig::min_particles`: particles follow existence when set.
+    pub min_particles: Option<usize>,
+    pub estimator: Estimator,
+}
+
+/// [`Estimator::Mode`] of one particle set with position components 0 and 2.
+fn mode_mean(p: &ParticleSet, cell: f64) -> Vec<f64> {
+    use std::collections::BTreeMap;
+    let (x, y, w) = (p.component(0), p.component(2), p.weights());
+    let key = |i: usize| ((x[i] / cell).floor() as i64, (y[i] / cell).floor() as i64);
+    let mut cells: BTreeMap<(i64, i64), f64> = BTreeMap::new();
+    for i in 0..p.len() {
+        *cells.entry(key(i)).or_default() += w[i];
+    }
+    let block = |(a, b): (i64, i64)| -> f64 {
+        let mut s = 0.0;
+        for da in -1..=1 {
+            for db in -1..=1 {
+                s += cells.get(&(a + da, b + db)).copied().unwrap_or(0.0);
+            }
+        }
+        s
+    };
+    // The heaviest block (the first in cell order on ties).
+    let mut best = None;
+    for &c in cells.keys() {
+        let s = block(c);
+        if best.is_none_or(|(_, bs)| s > bs) {
+            best = Some((c, s));
+        }
+    }
+    let Some(((a, b), _)) = best else {
+        return p.mean();
+    };
+    let mut mean = vec![0.0; p.dim()];
+    let mut total = 0.0;
+    let mut state = vec![0.0; p.dim()];
+    for i in 0..p.len() {
+        let (ka, kb) = key(i);
+        if (ka - a).abs() <= 1 && (kb - b).abs() <= 1 {
+            p.state_into(i, &mut state);
+            for (m, v) in mean.iter_mut().zip(&state) {
+                *m += w[i] * v;
+            }
+            total += w[i];
+        }
+    }
+    if total <= 0.0 {
+        return p.mean();
+    }
+    mean.iter_mut().for_each(|m| *m /= total);
+    mean
+}
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Rule {
@@ -93,7 +185,8 @@ impl Birth {
 /// of models, fed sensor 0's points), otherwise one `[[sensors]]` entry per sensor of the
 /// scenario (named `s0`, `s1`, ...; the same models) and `[fusion] method = rule`, uniform
 /// weights, IC in sensor order.
-pub fn config(s: &Scenario, rule: Rule, birth: Birth, seed: u64, particles: usize) -> RunConfig {
+pub fn config(s: &Scenario, rule: Rule, birth: Birth, seed: u64, tuning: Tuning) -> RunConfig {
+    let particles = tuning.particles;
     let birth = match birth {
         Birth::Static | Birth::StaticPlain => BirthConfig::Static {
             // Our state is [x, ẋ, y, ẏ]; the peer's birth locations are [x, y, vx, vy].
@@ -159,6 +252,7 @@ pub fn config(s: &Scenario, rule: Rule, birth: Birth, seed: u64, particles: usiz
         survival: s.survival_probability,
         filter: LmbConfig {
             particles,
+            min_particles: tuning.min_particles,
             ..LmbConfig::default()
         },
         transition: TransitionConfig::ConstantVelocity {
@@ -180,6 +274,7 @@ pub struct OurRunner<'a> {
     rule: Rule,
     filter: LmbFilter,
     rng: FilterRng,
+    estimator: Estimator,
 }
 
 impl<'a> OurRunner<'a> {
@@ -188,9 +283,9 @@ impl<'a> OurRunner<'a> {
         rule: Rule,
         birth: Birth,
         seed: u64,
-        particles: usize,
+        tuning: Tuning,
     ) -> Result<Self, String> {
-        let filter = config(s, rule, birth, seed, particles)
+        let filter = config(s, rule, birth, seed, tuning)
             .build()
             .map_err(|e| e.to_string())?;
         Ok(OurRunner {
@@ -198,6 +293,7 @@ impl<'a> OurRunner<'a> {
             rule,
             filter,
             rng: seeded(seed),
+            estimator: tuning.estimator,
         })
     }
 }
@@ -222,12 +318,30 @@ impl Runner for OurRunner<'_> {
                 f
             }
         };
-        let (est, ms, cpu_ms) = timed(|| self.filter.step(&frame, &mut self.rng));
+        let cell = 2.0 * self.scenario.measurement_noise_std;
+        let (filter, rng, estimator) = (&mut self.filter, &mut self.rng, self.estimator);
+        // The mode estimate is part of the step's time.
+        let (est, ms, cpu_ms) = timed(|| {
+            let est = filter.step(&frame, rng)?;
+            Ok::<_, smc_lmb::Error>(match estimator {
+                Estimator::Mean => est.into_iter().map(|e| e.state).collect::<Vec<_>>(),
+                Estimator::Mode => est
+                    .iter()
+                    .map(|e| {
+                        filter
+                            .tracks()
+                            .iter()
+                            .find(|t| t.label == e.label)
+                            .map_or_else(|| e.state.clone(), |t| mode_mean(&t.particles, cell))
+                    })
+                    .collect(),
+            })
+        });
         let est = est.map_err(|e| format!("step {k}: {e}"))?;
         Ok(StepOut {
             ms,
             cpu_ms,
-            estimates: est.iter().map(|e| [e.state[0], e.state[2]]).collect(),
+            estimates: est.iter().map(|x| [x[0], x[2]]).collect(),
         })
     }
 }
