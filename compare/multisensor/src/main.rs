@@ -425,8 +425,13 @@ fn run_child(
         .arg(opts.tuning.particles.to_string())
         .arg("--estimate")
         .arg(opts.tuning.estimator.name())
+        .arg("--motion")
+        .arg(opts.tuning.motion.name())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
+    if let Some(m) = opts.tuning.birth_particles {
+        cmd.arg("--birth-particles").arg(m.to_string());
+    }
     if let Some(m) = opts.tuning.min_particles {
         cmd.arg("--min-particles").arg(m.to_string());
     }
@@ -520,6 +525,8 @@ fn parse_args() -> Result<(Opts, Option<(PathBuf, String)>), String> {
             particles: ours::PARTICLES,
             min_particles: None,
             estimator: ours::Estimator::Mean,
+            motion: ours::Motion::Discrete,
+            birth_particles: None,
         },
         out: None,
         fixtures: None,
@@ -553,6 +560,15 @@ fn parse_args() -> Result<(Opts, Option<(PathBuf, String)>), String> {
                 o.tuning.estimator = ours::Estimator::parse(&v)
                     .ok_or_else(|| format!("--estimate: `{v}` is not mean or mode"))?
             }
+            "--motion" => {
+                let v = val()?;
+                o.tuning.motion = ours::Motion::parse(&v)
+                    .ok_or_else(|| format!("--motion: `{v}` is not discrete or continuous"))?
+            }
+            "--birth-particles" => {
+                o.tuning.birth_particles =
+                    Some(val()?.parse().map_err(err("--birth-particles"))?)
+            }
             "--rows" => o.rows = true,
             "--out" => o.out = Some(val()?.into()),
             "--fixtures" => o.fixtures = Some(val()?.into()),
@@ -567,7 +583,7 @@ fn parse_args() -> Result<(Opts, Option<(PathBuf, String)>), String> {
                 println!(
                     "multisensor-compare [--scenarios n5_s2,...] [--filters peer-ic,ours-pu-static,...]\n\
                      \x20   [--timeout SECONDS (60)] [--mem-gb GB (8)] [--threads N (RAYON_NUM_THREADS of our filter)]\n\
-                     \x20   [--seed 42] [--particles 1000] [--min-particles N] [--estimate mean|mode]\n\
+                     \x20   [--seed 42] [--particles 1000] [--min-particles N] [--birth-particles N] [--estimate mean|mode] [--motion discrete|continuous]\n\
                      \x20   [--out results.jsonl] [--fixtures DIR] [--from earlier.jsonl ...] [--table-only] [--rows]\n\
                      filters: peer-{{lmb,ic,pu,ga,aa}}, ours-{{single,ic,pu,ga,aa}}-{{static,static-plain,adaptive}}"
                 );
@@ -695,6 +711,8 @@ fn real_main() -> Result<(), String> {
                         "particles": opts.tuning.particles,
                         "min_particles": opts.tuning.min_particles,
                         "estimate": opts.tuning.estimator.name(),
+                        "motion": opts.tuning.motion.name(),
+                        "birth_particles": opts.tuning.birth_particles,
                     })
                 )
                 .map_err(err("--out"))?;

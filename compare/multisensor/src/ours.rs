@@ -13,8 +13,10 @@ use smc_lmb::config::{
     BirthConfig, ClutterConfig, DetectionConfig, FusionConfig, MeasurementConfig, RunConfig,
     SensorConfig, TransitionConfig,
 };
+use rand_distr::{Distribution, StandardNormal};
 use smc_lmb::filter::{
-    BirthTerm, Frame, FusionMethod, LmbConfig, LmbFilter, Measurements, ParticleSet,
+    check_state_dim, BirthTerm, Frame, FusionMethod, LmbConfig, LmbFilter, Measurements,
+    ParticleSet, StepContext, TransitionModel,
 };
 use smc_lmb::rng::{seeded, FilterRng};
 
@@ -56,6 +58,70 @@ impl Estimator {
     }
 }
 
+/// How σ_a of the scenario file becomes the process noise of the constant-velocity model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Motion {
+    /// Our built-in model: a constant acceleration a ~ N(0, σ_a²) per step and axis
+    /// (Q = σ_a² [dt⁴/4, dt³/2; dt³/2, dt²], rank one per axis).
+    Discrete,
+    /// The peer's model: continuous white-noise acceleration of spectral density σ_a²
+    /// (Q = σ_a² [dt³/3, dt²/2; dt²/2, dt] per axis, full rank), the Q its Kalman filters use.
+    Continuous,
+}
+
+impl Motion {
+    pub fn parse(s: &str) -> Option<Motion> {
+        Some(match s {
+            "discrete" => Motion::Discrete,
+            "continuous" => Motion::Continuous,
+            _ => return None,
+        })
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Motion::Discrete => "discrete",
+            Motion::Continuous => "continuous",
+        }
+    }
+}
+
+/// Constant velocity in 2 axes (state [x, ẋ, y, ẏ]) with continuous white-noise acceleration
+/// of spectral density σ²: per axis (Δp, Δv) ~ N(0, σ² [dt³/3, dt²/2; dt²/2, dt]), drawn as
+/// Δp = σ√(dt³/3)·e₁, Δv = σ√dt·(√3/2·e₁ + ½·e₂) (the Cholesky factor).
+struct ContinuousWhiteNoiseCv {
+    sigma: f64,
+}
+
+impl TransitionModel for ContinuousWhiteNoiseCv {
+    fn state_dim(&self) -> usize {
+        4
+    }
+
+    fn predict(
+        &self,
+        particles: &mut ParticleSet,
+        ctx: &StepContext,
+        rng: &mut FilterRng,
+    ) -> smc_lmb::Result<()> {
+        check_state_dim(&self.name(), 4, particles)?;
+        let dt = ctx.dt;
+        let (sp, sv) = (self.sigma * (dt * dt * dt / 3.0).sqrt(), self.sigma * dt.sqrt());
+        let half_sqrt3 = 0.5 * 3f64.sqrt();
+        let mut comps = particles.components_mut();
+        for axis in 0..2 {
+            let (head, tail) = comps.split_at_mut(2 * axis + 1);
+            for (p, v) in head[2 * axis].iter_mut().zip(tail[0].iter_mut()) {
+                let e1: f64 = StandardNormal.sample(rng);
+                let e2: f64 = StandardNormal.sample(rng);
+                *p += dt * *v + sp * e1;
+                *v += sv * (half_sqrt3 * e1 + 0.5 * e2);
+            }
+        }
+        Ok(())
+    }
+}
+
 /// The settings of our filter in a run (the same for every scenario).
 #[derive(Clone, Copy, Debug)]
 pub struct Tuning {
@@ -64,6 +130,9 @@ pub struct Tuning {
     /// `LmbConfig::min_particles`: particles follow existence when set.
     pub min_particles: Option<usize>,
     pub estimator: Estimator,
+    pub motion: Motion,
+    /// Particles of each birth track (static and adaptive); `None`: `particles`.
+    pub birth_particles: Option<usize>,
 }
 
 /// [`Estimator::Mode`] of one particle set with position components 0 and 2.
@@ -187,6 +256,7 @@ impl Birth {
 /// weights, IC in sensor order.
 pub fn config(s: &Scenario, rule: Rule, birth: Birth, seed: u64, tuning: Tuning) -> RunConfig {
     let particles = tuning.particles;
+    let birth_particles = tuning.birth_particles.unwrap_or(particles);
     let birth = match birth {
         Birth::Static | Birth::StaticPlain => BirthConfig::Static {
             // Our state is [x, ẋ, y, ẏ]; the peer's birth locations are [x, y, vx, vy].
@@ -199,13 +269,13 @@ pub fn config(s: &Scenario, rule: Rule, birth: Birth, seed: u64, tuning: Tuning)
                     std: vec![50.0, 10.0, 50.0, 10.0],
                 })
                 .collect(),
-            particles,
+            particles: birth_particles,
             measurement_proposal: birth == Birth::Static,
         },
         Birth::Adaptive => BirthConfig::Adaptive {
             expected_births: 1.0,
             max_existence: 0.1,
-            particles,
+            particles: birth_particles,
             position_std: s.measurement_noise_std,
             velocity_std: 10.0,
             turn_rate_std: 0.1,
@@ -285,9 +355,16 @@ impl<'a> OurRunner<'a> {
         seed: u64,
         tuning: Tuning,
     ) -> Result<Self, String> {
-        let filter = config(s, rule, birth, seed, tuning)
-            .build()
+        let builder = config(s, rule, birth, seed, tuning)
+            .builder()
             .map_err(|e| e.to_string())?;
+        let builder = match tuning.motion {
+            Motion::Discrete => builder,
+            Motion::Continuous => builder.transition(ContinuousWhiteNoiseCv {
+                sigma: s.process_noise_std,
+            }),
+        };
+        let filter = builder.build().map_err(|e| e.to_string())?;
         Ok(OurRunner {
             scenario: s,
             rule,
