@@ -357,6 +357,9 @@ struct Summary {
     elapsed: f64,
     /// `None` when it finished; otherwise why not.
     stopped: Option<String>,
+    /// Our filter's settings where they differ from the defaults (e.g. `mode, continuous`);
+    /// empty for the defaults and for the peer.
+    variant: String,
 }
 
 fn summarise(lines: &[serde_json::Value], total_steps: usize) -> Summary {
@@ -398,6 +401,7 @@ fn summarise(lines: &[serde_json::Value], total_steps: usize) -> Summary {
             .unwrap_or(0) as usize,
         elapsed: f64::NAN,
         stopped: None,
+        variant: String::new(),
     }
 }
 
@@ -650,9 +654,13 @@ fn real_main() -> Result<(), String> {
                 threads: g("threads") as usize,
                 elapsed: g("elapsed_s"),
                 stopped: v["stopped"].as_str().map(str::to_string),
+                variant: match spec {
+                    Spec::Peer(_) => String::new(),
+                    Spec::Ours { .. } => variant_of(&v),
+                },
             };
             let runs = results.entry(key).or_default();
-            runs.retain(|(sp, _)| sp != &spec);
+            runs.retain(|(sp, r)| sp != &spec || r.variant != s.variant);
             runs.push((spec, s));
         }
     }
@@ -687,7 +695,16 @@ fn real_main() -> Result<(), String> {
         let scenario = Scenario::load(path)?;
         let specs = wanted.clone().unwrap_or_else(|| Spec::defaults(*sensors));
         for spec in specs {
-            let (s, _) = run_child(path, &spec, scenario.truth.len(), &opts)?;
+            let (mut s, _) = run_child(path, &spec, scenario.truth.len(), &opts)?;
+            if let Spec::Ours { .. } = spec {
+                s.variant = variant_of(&serde_json::json!({
+                    "particles": opts.tuning.particles,
+                    "min_particles": opts.tuning.min_particles,
+                    "estimate": opts.tuning.estimator.name(),
+                    "motion": opts.tuning.motion.name(),
+                    "birth_particles": opts.tuning.birth_particles,
+                }));
+            }
             let (a, b, c) = cell(&s);
             eprintln!(
                 "{name} {:<26} OSPA(5,2) {a}  OSPA(100,1) {b}  ms/step wall/CPU {c} (wall median {:.2})  |n̂−n| {:.2}  threads {}",
@@ -718,12 +735,37 @@ fn real_main() -> Result<(), String> {
                 .map_err(err("--out"))?;
             }
             let runs = results.entry((*sensors, *objects)).or_default();
-            runs.retain(|(sp, _)| sp != &spec);
+            runs.retain(|(sp, r)| sp != &spec || r.variant != s.variant);
             runs.push((spec, s));
         }
     }
     print(&results, opts.rows);
     Ok(())
+}
+
+/// Our settings of a result line (`--out` file) that differ from the defaults, for the name
+/// of its row: `mode`, `continuous`, `N particles`, `min N`, `birth N`.
+fn variant_of(v: &serde_json::Value) -> String {
+    let mut parts = Vec::new();
+    if let Some(e) = v["estimate"].as_str().filter(|e| *e != "mean") {
+        parts.push(e.to_string());
+    }
+    if let Some(m) = v["motion"].as_str().filter(|m| *m != "discrete") {
+        parts.push(m.to_string());
+    }
+    if let Some(p) = v["particles"]
+        .as_u64()
+        .filter(|&p| p != ours::PARTICLES as u64)
+    {
+        parts.push(format!("{p} particles"));
+    }
+    if let Some(m) = v["min_particles"].as_u64() {
+        parts.push(format!("min {m}"));
+    }
+    if let Some(b) = v["birth_particles"].as_u64() {
+        parts.push(format!("birth {b}"));
+    }
+    parts.join(", ")
 }
 
 fn print(results: &BTreeMap<(usize, usize), Vec<(Spec, Summary)>>, rows: bool) {
@@ -773,15 +815,23 @@ fn print_rows(results: &BTreeMap<(usize, usize), Vec<(Spec, Summary)>>) {
     println!("|---|---|---|---|---|---|---|---|");
     for (&(sensors, objects), runs) in results {
         let mut runs: Vec<&(Spec, Summary)> = runs.iter().collect();
-        runs.sort_by_key(|(s, _)| row_order(s));
+        runs.sort_by_key(|(s, r)| (row_order(s), r.variant.clone()));
         for (spec, s) in runs {
             let status = match &s.stopped {
                 None => "done".to_string(),
                 Some(why) => format!("{why}, {}/{} steps", s.steps, s.total_steps),
             };
+            let name = if s.variant.is_empty() {
+                spec.name()
+            } else {
+                format!("{} ({})", spec.name(), s.variant)
+            };
+            if s.steps == 0 {
+                println!("| n{objects}_s{sensors} | {name} | – | – | – | – | – | {status} |");
+                continue;
+            }
             println!(
-                "| n{objects}_s{sensors} | {} | {:.3} | {:.2} | {:.2} | {:.1} | {:.1} | {status} |",
-                spec.name(),
+                "| n{objects}_s{sensors} | {name} | {:.3} | {:.2} | {:.2} | {:.1} | {:.1} | {status} |",
                 s.ospa5,
                 s.ospa100,
                 s.card_err,
@@ -809,7 +859,13 @@ fn print_table(results: &BTreeMap<(usize, usize), Vec<(Spec, Summary)>>) {
     ];
     for (&(sensors, objects), runs) in results {
         for (label, peer, rule) in rules {
-            let find = |want: &Spec| runs.iter().find(|(s, _)| s == want).map(|(_, r)| cell(r));
+            // The defaults' run when there is one, else the first of the variants.
+            let find = |want: &Spec| {
+                runs.iter()
+                    .filter(|(s, _)| s == want)
+                    .min_by_key(|(_, r)| !r.variant.is_empty())
+                    .map(|(_, r)| cell(r))
+            };
             let p = peer.and_then(|p| find(&Spec::Peer(p)));
             let st = rule.and_then(|rule| {
                 find(&Spec::Ours {
