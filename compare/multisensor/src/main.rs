@@ -570,8 +570,7 @@ fn parse_args() -> Result<(Opts, Option<(PathBuf, String)>), String> {
                     .ok_or_else(|| format!("--motion: `{v}` is not discrete or continuous"))?
             }
             "--birth-particles" => {
-                o.tuning.birth_particles =
-                    Some(val()?.parse().map_err(err("--birth-particles"))?)
+                o.tuning.birth_particles = Some(val()?.parse().map_err(err("--birth-particles"))?)
             }
             "--rows" => o.rows = true,
             "--out" => o.out = Some(val()?.into()),
@@ -790,10 +789,16 @@ fn row_order(s: &Spec) -> (usize, usize, usize) {
         Spec::Peer(p) => (
             0,
             0,
-            ["LMB-LBP", "IC-LMB-LBP", "PU-LMB-LBP", "GA-LMB-LBP", "AA-LMB-LBP"]
-                .iter()
-                .position(|q| q == p)
-                .unwrap_or(5),
+            [
+                "LMB-LBP",
+                "IC-LMB-LBP",
+                "PU-LMB-LBP",
+                "GA-LMB-LBP",
+                "AA-LMB-LBP",
+            ]
+            .iter()
+            .position(|q| q == p)
+            .unwrap_or(5),
         ),
         Spec::Ours { rule: r, birth } => (
             1,

@@ -9,11 +9,11 @@
 //! position std σ, velocity std 10 m/s = the static terms' velocity spread).
 
 use crate::{timed, Runner, Scenario, StepOut};
+use rand_distr::{Distribution, StandardNormal};
 use smc_lmb::config::{
     BirthConfig, ClutterConfig, DetectionConfig, FusionConfig, MeasurementConfig, RunConfig,
     SensorConfig, TransitionConfig,
 };
-use rand_distr::{Distribution, StandardNormal};
 use smc_lmb::filter::{
     check_state_dim, BirthTerm, Frame, FusionMethod, LmbConfig, LmbFilter, Measurements,
     ParticleSet, StepContext, TransitionModel,
@@ -106,7 +106,10 @@ impl TransitionModel for ContinuousWhiteNoiseCv {
     ) -> smc_lmb::Result<()> {
         check_state_dim(&self.name(), 4, particles)?;
         let dt = ctx.dt;
-        let (sp, sv) = (self.sigma * (dt * dt * dt / 3.0).sqrt(), self.sigma * dt.sqrt());
+        let (sp, sv) = (
+            self.sigma * (dt * dt * dt / 3.0).sqrt(),
+            self.sigma * dt.sqrt(),
+        );
         let half_sqrt3 = 0.5 * 3f64.sqrt();
         let mut comps = particles.components_mut();
         for axis in 0..2 {
