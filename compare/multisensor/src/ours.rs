@@ -144,8 +144,8 @@ fn mode_mean(p: &ParticleSet, cell: f64) -> Vec<f64> {
     let (x, y, w) = (p.component(0), p.component(2), p.weights());
     let key = |i: usize| ((x[i] / cell).floor() as i64, (y[i] / cell).floor() as i64);
     let mut cells: BTreeMap<(i64, i64), f64> = BTreeMap::new();
-    for i in 0..p.len() {
-        *cells.entry(key(i)).or_default() += w[i];
+    for (i, &wi) in w.iter().enumerate() {
+        *cells.entry(key(i)).or_default() += wi;
     }
     let block = |(a, b): (i64, i64)| -> f64 {
         let mut s = 0.0;
@@ -170,14 +170,14 @@ fn mode_mean(p: &ParticleSet, cell: f64) -> Vec<f64> {
     let mut mean = vec![0.0; p.dim()];
     let mut total = 0.0;
     let mut state = vec![0.0; p.dim()];
-    for i in 0..p.len() {
+    for (i, &wi) in w.iter().enumerate() {
         let (ka, kb) = key(i);
         if (ka - a).abs() <= 1 && (kb - b).abs() <= 1 {
             p.state_into(i, &mut state);
             for (m, v) in mean.iter_mut().zip(&state) {
-                *m += w[i] * v;
+                *m += wi * v;
             }
-            total += w[i];
+            total += wi;
         }
     }
     if total <= 0.0 {
