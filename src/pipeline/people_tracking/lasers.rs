@@ -1087,7 +1087,7 @@ mod tests {
         let e = mountings_for_topics(&m, &["/right_scan".into()], path).unwrap_err();
         assert!(e.to_string().contains("m.toml") && e.to_string().contains("/right_scan"), "{e}");
         for (bad, line, what) in [
-            ("[[sensors]]\nname = \"a\"\nmounting = [0, 0]\n", 3, "3 values"),
+            ("[[sensors]]\nname = \"a\"\nmounting = [0, 0]\n", 3, "2 values"),
             ("[[sensors]]\nname = \"a\"\nmounting = [0, x, 0]\n", 3, "mounting"),
             ("[[sensors]]\nname = a\nmounting = [0, 0, 0]\n", 2, "quoted"),
             ("name = \"a\"\n", 1, "before the first"),
@@ -1142,8 +1142,8 @@ mod tests {
         PeopleTrackerConfig::for_scanner(0.02, 0.005, 20.0, FRAC_PI_2, [0.0, 0.0])
     }
 
-    /// A person walks round the robot from behind to its front; the rear laser (facing back)
-    /// sees them first, the front one later. Fused, the track is one person throughout, at
+    /// A person walks past the robot from behind to its front; the rear laser (facing back,
+    /// 200° of view) sees them first, both lasers beside the robot, the front one last. Fused, the track is one person throughout, at
     /// the right place in the world whatever laser measured it.
     fn walk_round(fusion: FusionMethod) -> Vec<Vec<PersonEstimate>> {
         let lasers = vec![
@@ -1151,13 +1151,13 @@ mod tests {
                 name: "front".into(),
                 mounting: Pose2::new(0.3, 0.0, 0.0),
                 max_range: 20.0,
-                half_angle: FRAC_PI_2,
+                half_angle: 1.75,
             },
             LaserMount {
                 name: "rear".into(),
                 mounting: Pose2::new(-0.3, 0.1, PI),
                 max_range: 20.0,
-                half_angle: FRAC_PI_2,
+                half_angle: 1.75,
             },
         ];
         let mut t = LasersTracker::new(config(), lasers.clone(), Fusion::new(fusion)).unwrap();
