@@ -152,7 +152,12 @@ struct Args {
     max_range: f64,
     /// Several lasers of one `--bag`, tracked together (comma separated, e.g.
     /// `/left_scan,/right_scan,/rear_scan`); needs `--mountings`.
-    #[arg(long, value_delimiter = ',', requires = "mountings", conflicts_with = "topic")]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        requires = "mountings",
+        conflicts_with = "topic"
+    )]
     topics: Vec<String>,
     /// The lasers' mounting poses: the `[[sensors]]` tables `examples/laser_mounting.rs`
     /// prints (name = topic without its `/`, mounting = [x, y, heading] on the robot).
@@ -808,7 +813,10 @@ mod lasers {
     /// people per frame from the 10th frame on.
     pub fn run_bag(args: &Args) -> Result<(PeopleRun, Option<f64>)> {
         let bag = args.bag.as_ref().context("--topics needs --bag")?;
-        let mountings = args.mountings.as_ref().context("--topics needs --mountings")?;
+        let mountings = args
+            .mountings
+            .as_ref()
+            .context("--topics needs --mountings")?;
         let recordings = read_bag_lasers(bag, &args.topics, mountings, args.max_range)?;
         let first = &recordings[0];
         let mut cfg = smc_lmb::pipeline::people_tracking::config_for_scans(
@@ -844,7 +852,12 @@ mod lasers {
             .scans
             .iter()
             .skip(FIRST_SCORED_SCAN)
-            .map(|s| s.people.iter().filter(|p| p.visibility >= min_visibility).count())
+            .map(|s| {
+                s.people
+                    .iter()
+                    .filter(|p| p.visibility >= min_visibility)
+                    .count()
+            })
             .collect();
         let false_people = scored.iter().sum::<usize>() as f64 / scored.len().max(1) as f64;
         println!(

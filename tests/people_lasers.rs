@@ -62,15 +62,15 @@ fn fused_lasers_find_people_at_least_as_well_as_the_best_laser_alone() {
     let singles: Vec<LasersScore> = (0..3)
         .map(|j| score(&s, seed, &[j], FusionMethod::IteratedCorrector))
         .collect();
-    let best_f1 = singles
-        .iter()
-        .map(|r| r.detection.f1())
-        .fold(0.0, f64::max);
+    let best_f1 = singles.iter().map(|r| r.detection.f1()).fold(0.0, f64::max);
     let best_ospa = singles
         .iter()
         .map(|r| r.mean_ospa)
         .fold(f64::INFINITY, f64::min);
-    for m in [FusionMethod::IteratedCorrector, FusionMethod::ParallelUpdate] {
+    for m in [
+        FusionMethod::IteratedCorrector,
+        FusionMethod::ParallelUpdate,
+    ] {
         let fused = score(&s, seed, &[0, 1, 2], m);
         eprintln!(
             "{}: F1 {:.3} (best single {best_f1:.3}), OSPA {:.3} (best single {best_ospa:.3})",
@@ -92,15 +92,17 @@ fn fused_output_does_not_depend_on_the_thread_count() {
         .lasers
         .iter()
         .zip(&run.lasers)
-        .map(|(l, stream)| smc_lmb::pipeline::people_tracking::lasers::LaserRecording {
-            mount: smc_lmb::pipeline::people_tracking::lasers::LaserMount::for_scan(
-                l.name.clone(),
-                l.mounting_pose(),
-                &stream.scans[0],
-                l.scanner.range_max,
-            ),
-            scans: stream.scans.clone(),
-        })
+        .map(
+            |(l, stream)| smc_lmb::pipeline::people_tracking::lasers::LaserRecording {
+                mount: smc_lmb::pipeline::people_tracking::lasers::LaserMount::for_scan(
+                    l.name.clone(),
+                    l.mounting_pose(),
+                    &stream.scans[0],
+                    l.scanner.range_max,
+                ),
+                scans: stream.scans.clone(),
+            },
+        )
         .collect();
     let people = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()
@@ -204,7 +206,10 @@ fn bad_mountings_and_topics_are_named() {
     let e = read_bag_lasers(&bag, &topics, &malformed, 15.0)
         .unwrap_err()
         .to_string();
-    assert!(e.contains("malformed.toml:3") && e.contains("mounting"), "{e}");
+    assert!(
+        e.contains("malformed.toml:3") && e.contains("mounting"),
+        "{e}"
+    );
 
     let absent = vec!["/training_scan".to_string(), "/rear_scan".to_string()];
     let e = read_bag_lasers(&bag, &absent, &good, 15.0)

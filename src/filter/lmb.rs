@@ -490,7 +490,10 @@ fn most_probable_rows(
     lik: &[TrackLikelihoods],
     marg: &[TrackMarginals],
 ) -> Vec<Option<(usize, f64)>> {
-    lik.iter().zip(marg).map(|(l, mg)| mg.most_probable(l)).collect()
+    lik.iter()
+        .zip(marg)
+        .map(|(l, mg)| mg.most_probable(l))
+        .collect()
 }
 
 /// The measurements of `scans` (in sensor order) one after another; borrowed when there is
@@ -911,7 +914,10 @@ impl LmbFilter {
                 if p.to_homogeneous().iter().any(|x| !x.is_finite()) {
                     return Err(Error::invalid(
                         what(),
-                        format!("the platform pose of sensor {s} ({:?}) is not finite", sensor.name),
+                        format!(
+                            "the platform pose of sensor {s} ({:?}) is not finite",
+                            sensor.name
+                        ),
                     ));
                 }
             }

@@ -31,8 +31,8 @@
 //! Not for: estimating the mountings ([`crate::laser2d::mounting`]), the single-laser tracker
 //! ([`super::PeopleTracker`], which stays as it was), reading recordings.
 
-use super::birth::{ConfirmedPeople, ConfirmedPerson, Doubted, LaserOrigin, LaserOrigins};
 use super::birth::PeopleBirth;
+use super::birth::{ConfirmedPeople, ConfirmedPerson, Doubted, LaserOrigin, LaserOrigins};
 use super::front_end::{adapt_tracker_config, FrontEnd, PersonFrontEnd};
 use super::models::{
     BeamView, DetectabilityDetection, DetectabilityTransition, ManoeuvringVelocity, Neighbours,
@@ -44,9 +44,8 @@ use super::tracker::{PeopleTrackerConfig, PersonEstimate};
 use crate::config::{BirthConfig, DetectionConfig, MeasurementConfig, TransitionConfig};
 use crate::error::{Error, Result};
 use crate::filter::{
-    DetectionModel, Frame, Fusion, FusionMethod, Label, LmbFilter, Measurements,
-    MeasurementModel, ParticleSet, Scan as FilterScan, Sensor, StepContext, StepData,
-    SurvivalModel, TransitionModel,
+    DetectionModel, Frame, Fusion, FusionMethod, Label, LmbFilter, MeasurementModel, Measurements,
+    ParticleSet, Scan as FilterScan, Sensor, StepContext, StepData, SurvivalModel, TransitionModel,
 };
 use crate::geometry::pose2::{between, compose, inverse};
 use crate::geometry::{platform_isometry, wrap_angle, Pose2};
@@ -75,8 +74,8 @@ impl LaserMount {
     /// from the scan's bearings (plus half a beam either side, at most a full turn), the
     /// range from its `range_max` capped at `max_range`.
     pub fn for_scan(name: impl Into<String>, mounting: Pose2, scan: &Scan, max_range: f64) -> Self {
-        let half = 0.5 * (scan.angle_max() - scan.angle_min).abs()
-            + 0.5 * scan.angle_increment.abs();
+        let half =
+            0.5 * (scan.angle_max() - scan.angle_min).abs() + 0.5 * scan.angle_increment.abs();
         let range = if scan.range_max.is_finite() {
             scan.range_max.min(max_range)
         } else {
@@ -132,7 +131,9 @@ impl SurvivalModel for LasersSurvival {
             .iter()
             .filter_map(|o| {
                 let (s, c) = o.pose.theta.sin_cos();
-                self.fovs.get(o.laser).map(|f| (f, o.pose.x, o.pose.y, c, s))
+                self.fovs
+                    .get(o.laser)
+                    .map(|f| (f, o.pose.x, o.pose.y, c, s))
             })
             .collect();
         let cloud = CloudBox::of(particles);
@@ -178,13 +179,19 @@ impl LasersTracker {
     /// A tracker of `lasers` (at least one) with the people models and tuning of `config`
     /// (its field of view, range and mounting are replaced by each laser's), their updates
     /// combined by `fusion`.
-    pub fn new(config: PeopleTrackerConfig, lasers: Vec<LaserMount>, fusion: Fusion) -> Result<Self> {
+    pub fn new(
+        config: PeopleTrackerConfig,
+        lasers: Vec<LaserMount>,
+        fusion: Fusion,
+    ) -> Result<Self> {
         if lasers.is_empty() {
             return Err(Error::invalid("people lasers", "no laser given"));
         }
         for l in &lasers {
             let m = l.mounting;
-            if !([m.x, m.y, m.theta, l.half_angle].iter().all(|v| v.is_finite())
+            if !([m.x, m.y, m.theta, l.half_angle]
+                .iter()
+                .all(|v| v.is_finite())
                 && l.max_range > 0.0
                 && l.half_angle > 0.0)
             {
@@ -292,7 +299,9 @@ impl LasersTracker {
                 Box::new(sensor)
             };
             let detect: Box<dyn DetectionModel> = match mode {
-                Some((chain, mode)) => Box::new(DetectabilityDetection::new(resolution, chain, mode)?),
+                Some((chain, mode)) => {
+                    Box::new(DetectabilityDetection::new(resolution, chain, mode)?)
+                }
                 None => Box::new(resolution),
             };
             let clutter = UniformClutter::new(rate, 2.0 * l.half_angle * l.max_range)?;
@@ -361,7 +370,11 @@ impl LasersTracker {
             let Some(laser) = self.lasers.get(i.laser) else {
                 return Err(Error::invalid(
                     "people lasers frame",
-                    format!("a scan of laser {}, but there are {}", i.laser, self.lasers.len()),
+                    format!(
+                        "a scan of laser {}, but there are {}",
+                        i.laser,
+                        self.lasers.len()
+                    ),
                 ));
             };
             if k > 0 && inputs[k - 1].laser == i.laser {
@@ -385,7 +398,10 @@ impl LasersTracker {
             if !i.measurements.is_empty() && i.measurements.dim() != 2 {
                 return Err(Error::invalid(
                     format!("measurements of laser {:?}", laser.name),
-                    format!("have {} components, range and bearing expected", i.measurements.dim()),
+                    format!(
+                        "have {} components, range and bearing expected",
+                        i.measurements.dim()
+                    ),
                 ));
             }
         }
@@ -464,8 +480,10 @@ impl LasersTracker {
             let e = evidence.map_or(1.0, |e| e.get(m.measurement).copied().unwrap_or(0.0));
             *self.evidence.entry(m.label).or_insert(0.0) += m.probability * e;
         }
-        self.evidence.retain(|l, _| tracks.iter().any(|t| t.label == *l));
-        self.confirmed.retain(|l| tracks.iter().any(|t| t.label == *l));
+        self.evidence
+            .retain(|l, _| tracks.iter().any(|t| t.label == *l));
+        self.confirmed
+            .retain(|l| tracks.iter().any(|t| t.label == *l));
         let (confirm, detections, needed) = (
             self.config.confirm_existence,
             self.config.confirm_detections,
@@ -544,7 +562,12 @@ fn track_summary(p: &ParticleSet, existence: f64, dt: f64) -> ([f64; 2], [f64; 2
         .zip(p.component(0).iter().zip(p.component(2)))
         .map(|(w, (px, py))| w * ((px - x).powi(2) + (py - y).powi(2)))
         .sum();
-    ([x, y], [x + vx * dt, y + vy * dt], existence, (0.5 * var).sqrt())
+    (
+        [x, y],
+        [x + vx * dt, y + vy * dt],
+        existence,
+        (0.5 * var).sqrt(),
+    )
 }
 
 /// The people's motion: the configured transition, with manoeuvres when configured (as
@@ -610,7 +633,9 @@ pub fn group_scans(times: &[Vec<f64>]) -> Result<(usize, Vec<LaserFrame>)> {
             ));
         }
     }
-    let Some(anchor) = (0..times.len()).max_by(|&a, &b| times[a].len().cmp(&times[b].len()).then(b.cmp(&a))) else {
+    let Some(anchor) =
+        (0..times.len()).max_by(|&a, &b| times[a].len().cmp(&times[b].len()).then(b.cmp(&a)))
+    else {
         return Err(Error::invalid("scan grouping", "no laser"));
     };
     let at = &times[anchor];
@@ -647,7 +672,8 @@ pub fn group_scans(times: &[Vec<f64>]) -> Result<(usize, Vec<LaserFrame>)> {
         .zip(chosen)
         .enumerate()
         .map(|(i, (&time, others))| {
-            let mut scans: Vec<(usize, usize)> = others.into_iter().map(|(j, (_, k))| (j, k)).collect();
+            let mut scans: Vec<(usize, usize)> =
+                others.into_iter().map(|(j, (_, k))| (j, k)).collect();
             scans.push((anchor, i));
             scans.sort_unstable();
             LaserFrame {
@@ -687,13 +713,15 @@ pub struct LaserRecording {
 
 /// Runs a [`LasersTracker`] over the recordings of several lasers of one robot: every scan
 /// through its own laser's front end `front_end`, grouped into frames by [`group_scans`].
-/// The robot's pose of a frame is the anchor scan's odometry or, without one, the pose the
-/// anchor laser's front end corrects (its scan-to-scan alignments, moved back from the laser
-/// to the robot by its mounting); each other laser's scan gets the robot's pose at its own
-/// time (its odometry, or the anchor's pose moved on at the robot's last velocity) composed
-/// with its mounting. `config` gives the people models and tuning (adapted to the front end
-/// here); the result has one [`ScanPeople`] per frame (`scan` = the anchor scan's index,
-/// `detections` = the anchor laser's people in its own frame).
+/// The robot's pose of a frame is the pose the anchor laser's front end corrects, when it
+/// does (its moving-object detector's ICP, or without odometry the legs detector's
+/// scan-to-scan alignments; moved back from the laser to the robot by its mounting), else the
+/// anchor scan's odometry; each other laser's scan gets the robot's pose at its own time (the
+/// anchor's pose moved on by the odometry's motion between the two scans, or without odometry
+/// at the robot's last velocity) composed with its mounting. `config` gives the people
+/// models and tuning (adapted to the front end here); the result has one [`ScanPeople`] per
+/// frame (`scan` = the anchor scan's index, `detections` = the anchor laser's people in its
+/// own frame).
 pub fn track_lasers(
     recordings: &[LaserRecording],
     mut config: PeopleTrackerConfig,
@@ -737,6 +765,7 @@ pub fn track_lasers(
             order.sort_by_key(|&(j, _)| j != anchor);
             let mut inputs = Vec::with_capacity(order.len());
             let mut robot = None;
+            let mut anchor_odometry = None;
             let mut detections = Vec::new();
             for (j, k) in order {
                 let rec = &recordings[j];
@@ -745,11 +774,9 @@ pub fn track_lasers(
                 let laser_odometry = scan.odometry.map(|o| compose(o, mount));
                 let out = front_ends[j].measure(scan, laser_odometry).map_err(at)?;
                 let laser_pose = if j == anchor {
-                    let laser = out
-                        .corrected_pose
-                        .or(laser_odometry)
-                        .unwrap_or(mount);
+                    let laser = out.corrected_pose.or(laser_odometry).unwrap_or(mount);
                     robot = Some(compose(laser, inverse(mount)));
+                    anchor_odometry = scan.odometry;
                     detections = (0..out.measurements.len())
                         .map(|i| {
                             let z = out.measurements.get(i);
@@ -758,12 +785,11 @@ pub fn track_lasers(
                         .collect();
                     laser
                 } else {
-                    match scan.odometry {
-                        Some(o) => compose(o, mount),
-                        None => {
-                            let r = robot.expect("the anchor comes first");
-                            compose(extrapolate(r, frame.time, previous, scan.time), mount)
-                        }
+                    let r = robot.expect("the anchor comes first");
+                    match (anchor_odometry, scan.odometry) {
+                        // the odometry's motion since the anchor scan, from the anchor's pose
+                        (Some(a), Some(o)) => compose(compose(r, between(a, o)), mount),
+                        _ => compose(extrapolate(r, frame.time, previous, scan.time), mount),
                     }
                 };
                 let (measurements, evidence) = match out.weighed {
@@ -854,7 +880,11 @@ pub fn parse_mountings(text: &str, path: &std::path::Path) -> Result<Vec<NamedMo
         };
         let (key, value) = (key.trim(), value.trim());
         let Some(table) = out.last_mut() else {
-            return Err(err(n, key, "a key before the first [[sensors]] table".into()));
+            return Err(err(
+                n,
+                key,
+                "a key before the first [[sensors]] table".into(),
+            ));
         };
         match key {
             "name" => {
@@ -1085,7 +1115,10 @@ mod tests {
             mountings_for_topics(&m, &["/rear_scan".into(), "/left_scan".into()], path).unwrap();
         assert_eq!(poses[0], m[1].mounting);
         let e = mountings_for_topics(&m, &["/right_scan".into()], path).unwrap_err();
-        assert!(e.to_string().contains("m.toml") && e.to_string().contains("/right_scan"), "{e}");
+        assert!(
+            e.to_string().contains("m.toml") && e.to_string().contains("/right_scan"),
+            "{e}"
+        );
         for (bad, line, what) in [
             ("[[sensors]]\nname = \"a\"\nmounting = [0, 0]\n", 3, "2 values"),
             ("[[sensors]]\nname = \"a\"\nmounting = [0, x, 0]\n", 3, "mounting"),
@@ -1233,7 +1266,9 @@ mod tests {
             pose: Pose2::new(0.0, 0.0, 0.0),
         };
         assert!(t.step(vec![input(1, None)], 0.0, None).is_err());
-        assert!(t.step(vec![input(0, None), input(0, None)], 0.0, None).is_err());
+        assert!(t
+            .step(vec![input(0, None), input(0, None)], 0.0, None)
+            .is_err());
         let e = t.step(vec![input(0, Some(vec![]))], 0.0, None).unwrap_err();
         assert!(e.to_string().contains("evidence"), "{e}");
         assert!(t.step(vec![input(0, Some(vec![0.5]))], 0.0, None).is_ok());

@@ -88,7 +88,11 @@ pub fn evaluate_lasers(
     if run.lasers.len() != rig.lasers.len() {
         return Err(Error::invalid(
             "laser evaluation",
-            format!("the run has {} lasers, the rig {}", run.lasers.len(), rig.lasers.len()),
+            format!(
+                "the run has {} lasers, the rig {}",
+                run.lasers.len(),
+                rig.lasers.len()
+            ),
         ));
     }
     let mut recordings = Vec::with_capacity(use_lasers.len());
@@ -99,9 +103,10 @@ pub fn evaluate_lasers(
                 format!("no laser {j} in a rig of {}", rig.lasers.len()),
             ));
         };
-        let first = stream.scans.first().ok_or_else(|| {
-            Error::invalid(format!("laser {:?}", laser.name), "has no scan")
-        })?;
+        let first = stream
+            .scans
+            .first()
+            .ok_or_else(|| Error::invalid(format!("laser {:?}", laser.name), "has no scan"))?;
         recordings.push(LaserRecording {
             mount: LaserMount::for_scan(
                 laser.name.clone(),
@@ -131,7 +136,9 @@ pub fn evaluate_lasers(
     for frame in &people.scans {
         let k = frame.scan;
         let true_pose = stream.robot_truth[k];
-        let given = frame.pose.map(|[x, y, th]| crate::geometry::Pose2::new(x, y, th));
+        let given = frame
+            .pose
+            .map(|[x, y, th]| crate::geometry::Pose2::new(x, y, th));
         let seen = seen_at(run, frame.time);
         let (truth, unseen): (Vec<(u64, Vec<f64>)>, Vec<(u64, Vec<f64>)>) = stream.people_truth[k]
             .iter()
@@ -248,7 +255,11 @@ pub fn summarise_variant(variant: LaserVariant, runs: Vec<LasersScore>) -> Resul
         mean_ospa: mean(&|r| r.mean_ospa),
         ospa2: mean(&|r| r.ospa2),
         label_switches: runs.iter().map(|r| r.label_switches).sum(),
-        frames_per_second: if secs > 0.0 { frames as f64 / secs } else { 0.0 },
+        frames_per_second: if secs > 0.0 {
+            frames as f64 / secs
+        } else {
+            0.0
+        },
         variant,
         per_run: runs,
     })

@@ -27,7 +27,9 @@ pub mod run;
 pub mod score;
 pub mod tracker;
 
-pub use birth::{ConfirmedPeople, ConfirmedPerson, Doubted, LaserOrigin, LaserOrigins, PeopleBirth};
+pub use birth::{
+    ConfirmedPeople, ConfirmedPerson, Doubted, LaserOrigin, LaserOrigins, PeopleBirth,
+};
 pub use motion_state::{probability_moving, MotionClassifier, MotionConfig};
 #[cfg(feature = "plot")]
 pub use plot::{write_people_plot, PeoplePlotCounts, PeoplePlotOptions};
