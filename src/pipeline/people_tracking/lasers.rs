@@ -18,8 +18,11 @@
 //!
 //! The confirmation evidence, the doubted-measurement gate and the most-probable measurement
 //! bookkeeping of [`super::PeopleTracker`] work here on the concatenated measurements (the
-//! filter's [`LmbFilter::most_probable_measurements_all`]): a track collects evidence from
-//! every laser that saw it. A person's visibility is the largest over the lasers that reported.
+//! filter's [`LmbFilter::most_probable_measurements_all`]). Confirmation counts frames, not
+//! lasers: per frame a track collects the mean evidence of the lasers that could explain
+//! a measurement by it and the largest probability that it made its most probable
+//! measurement (which stands for the filter's expected detections, summed over lasers), so
+//! three lasers seeing one person confirm it no sooner than one would. A person's visibility is the largest over the lasers that reported.
 //!
 //! # Asynchronous lasers
 //!
@@ -170,6 +173,11 @@ pub struct LasersTracker {
     suppress_existence: f64,
     confirmed: BTreeSet<Label>,
     evidence: BTreeMap<Label, f64>,
+    /// Frames in which each track was detected: the sum over frames of the largest
+    /// probability over the lasers that it made its most probable measurement (stands for
+    /// the filter's expected detections, which add up over the lasers of a frame). The
+    /// evidence above is likewise the sum over frames of the lasers' mean.
+    detected: BTreeMap<Label, f64>,
     last_time: Option<f64>,
     /// The range-bearing model of a laser at the origin (doubted gate).
     sensor: RangeBearing,
@@ -335,6 +343,7 @@ impl LasersTracker {
             suppress_existence,
             confirmed: BTreeSet::new(),
             evidence: BTreeMap::new(),
+            detected: BTreeMap::new(),
             last_time: None,
             sensor,
         })
@@ -476,11 +485,25 @@ impl LasersTracker {
         }
         let estimates = self.filter.step(&frame, &mut self.rng)?;
         let tracks = self.filter.tracks();
+        // Per frame, over the lasers that could explain some measurement by each track: the
+        // mean of their evidence (a laser that doubts counts against one that believes) and
+        // the largest probability that the track made its most probable measurement; several
+        // lasers seeing one person in one frame confirm it no sooner than one laser would.
+        let mut views: BTreeMap<Label, (f64, usize, f64)> = BTreeMap::new();
         for m in self.filter.most_probable_measurements_all() {
             let e = evidence.map_or(1.0, |e| e.get(m.measurement).copied().unwrap_or(0.0));
-            *self.evidence.entry(m.label).or_insert(0.0) += m.probability * e;
+            let v = views.entry(m.label).or_insert((0.0, 0, 0.0));
+            v.0 += m.probability * e;
+            v.1 += 1;
+            v.2 = v.2.max(m.probability);
+        }
+        for (label, (e, n, d)) in views {
+            *self.evidence.entry(label).or_insert(0.0) += e / n as f64;
+            *self.detected.entry(label).or_insert(0.0) += d;
         }
         self.evidence
+            .retain(|l, _| tracks.iter().any(|t| t.label == *l));
+        self.detected
             .retain(|l, _| tracks.iter().any(|t| t.label == *l));
         self.confirmed
             .retain(|l| tracks.iter().any(|t| t.label == *l));
@@ -489,13 +512,13 @@ impl LasersTracker {
             self.config.confirm_detections,
             self.config.confirm_evidence,
         );
-        let evidence_of = &self.evidence;
+        let (evidence_of, detected) = (&self.evidence, &self.detected);
         self.confirmed.extend(
             tracks
                 .iter()
                 .filter(|t| {
                     t.existence >= confirm
-                        && t.expected_detections >= detections
+                        && detected.get(&t.label).copied().unwrap_or(0.0) >= detections
                         && (needed <= 0.0
                             || evidence_of.get(&t.label).copied().unwrap_or(0.0) >= needed)
                 })
@@ -693,7 +716,7 @@ pub fn extrapolate(pose: Pose2, time: f64, previous: Option<(Pose2, f64)>, t: f6
         return pose;
     };
     let dt = time - t0;
-    if !(dt > 1e-6) || t == time {
+    if dt.is_nan() || dt <= 1e-6 || t == time {
         return pose;
     }
     let d = between(before, pose);
@@ -858,10 +881,8 @@ pub fn parse_mountings(text: &str, path: &std::path::Path) -> Result<Vec<NamedMo
     for (i, raw) in text.lines().enumerate() {
         let n = i + 1;
         let line = match raw.find('#') {
-            // no `#` inside the quoted names these files hold
-            Some(c) if !raw[..c].contains('"') || raw[..c].matches('"').count() % 2 == 0 => {
-                &raw[..c]
-            }
+            // a `#` outside quotes starts a comment (the first `#` is taken)
+            Some(c) if raw[..c].matches('"').count() % 2 == 0 => &raw[..c],
             _ => raw,
         }
         .trim();
