@@ -34,6 +34,17 @@
 //!     --truth-topic /leg_cluster_positions
 //! cargo run --release --example laser2d -- --bag negative_2.bag --topic /right_scan --empty
 //! ```
+//!
+//! Several lasers (`pipeline::people_tracking::lasers`, `docs/results/people_lasers.md`):
+//! `--topics` of one bag at their `--mountings` (the `[[sensors]]` tables of
+//! `examples/laser_mounting.rs`) fused by `--fusion ic|pu|ga|aa`, and `--lasers`, the
+//! simulated robot with three lasers, each alone against the rules of `--fusion` fused:
+//!
+//! ```text
+//! cargo run --release --example laser2d -- --bag negative_2.bag --topics /left_scan,/right_scan,/rear_scan \
+//!     --mountings negative_2_mountings.toml --front-end legs --fusion pu --empty
+//! cargo run --release --example laser2d -- --lasers --scenario one --runs 8 --fusion ic,pu,ga,aa
+//! ```
 
 use anyhow::{Context, Result};
 use clap::Parser;

@@ -481,15 +481,15 @@ struct SensorUpdates {
     assigned: Vec<f64>,
     /// With several sensors: for each sensor, each track's most probable measurement of that
     /// sensor's scan with its probability (empty with one sensor).
-    most_probable_by_sensor: Vec<(usize, Vec<Option<(usize, f64)>>)>,
+    most_probable_by_sensor: Vec<(usize, Vec<MostProbableRow>)>,
 }
+
+/// A track's most probable measurement of one sensor's scan and its probability, if any.
+type MostProbableRow = Option<(usize, f64)>;
 
 /// Each track's most probable measurement by the rows of one sensor's likelihoods and
 /// marginals.
-fn most_probable_rows(
-    lik: &[TrackLikelihoods],
-    marg: &[TrackMarginals],
-) -> Vec<Option<(usize, f64)>> {
+fn most_probable_rows(lik: &[TrackLikelihoods], marg: &[TrackMarginals]) -> Vec<MostProbableRow> {
     lik.iter()
         .zip(marg)
         .map(|(l, mg)| mg.most_probable(l))

@@ -24,6 +24,9 @@ use crate::metrics::{ospa, ospa2, tracks_from_frames, LabelConsistency};
 use crate::sim::people2d::lasers::{LaserRig, MultiLaserRun};
 use serde::Serialize;
 
+/// A person of one frame: id and position.
+type Person = (u64, Vec<f64>);
+
 /// OSPA cut-off (m) and order of [`evaluate_lasers`].
 pub const OSPA_CUTOFF: f64 = 2.0;
 /// OSPA order.
@@ -140,7 +143,7 @@ pub fn evaluate_lasers(
             .pose
             .map(|[x, y, th]| crate::geometry::Pose2::new(x, y, th));
         let seen = seen_at(run, frame.time);
-        let (truth, unseen): (Vec<(u64, Vec<f64>)>, Vec<(u64, Vec<f64>)>) = stream.people_truth[k]
+        let (truth, unseen): (Vec<Person>, Vec<Person>) = stream.people_truth[k]
             .iter()
             .map(|(id, pos, _)| {
                 let q = given.map_or(*pos, |g| relocate(*pos, true_pose, g));
