@@ -34,6 +34,17 @@
 //!     --truth-topic /leg_cluster_positions
 //! cargo run --release --example laser2d -- --bag negative_2.bag --topic /right_scan --empty
 //! ```
+//!
+//! Several lasers (`pipeline::people_tracking::lasers`, `docs/results/people_lasers.md`):
+//! `--topics` of one bag at their `--mountings` (the `[[sensors]]` tables of
+//! `examples/laser_mounting.rs`) fused by `--fusion ic|pu|ga|aa`, and `--lasers`, the
+//! simulated robot with three lasers, each alone against the rules of `--fusion` fused:
+//!
+//! ```text
+//! cargo run --release --example laser2d -- --bag negative_2.bag --topics /left_scan,/right_scan,/rear_scan \
+//!     --mountings negative_2_mountings.toml --front-end legs --fusion pu --empty
+//! cargo run --release --example laser2d -- --lasers --scenario one --runs 8 --fusion ic,pu,ga,aa
+//! ```
 
 use anyhow::{Context, Result};
 use clap::Parser;
@@ -150,10 +161,37 @@ struct Args {
     /// People farther than this (m) are not tracked in recordings.
     #[arg(long, default_value_t = 15.0)]
     max_range: f64,
+    /// Several lasers of one `--bag`, tracked together (comma separated, e.g.
+    /// `/left_scan,/right_scan,/rear_scan`); needs `--mountings`.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        requires = "mountings",
+        conflicts_with = "topic"
+    )]
+    topics: Vec<String>,
+    /// The lasers' mounting poses: the `[[sensors]]` tables `examples/laser_mounting.rs`
+    /// prints (name = topic without its `/`, mounting = [x, y, heading] on the robot).
+    #[arg(long)]
+    mountings: Option<std::path::PathBuf>,
+    /// How several lasers combine: `ic`, `pu`, `ga` or `aa` (with `--lasers`, a comma
+    /// separated list of the fused runs to compare with each laser alone).
+    #[arg(long, default_value = "ic")]
+    fusion: String,
+    /// Simulate the robot with three lasers (`LaserRig::three_lasers`) in `--scenario` and
+    /// compare each laser alone with the lasers fused by each rule of `--fusion`.
+    #[arg(long)]
+    lasers: bool,
 }
 
 fn main() -> Result<()> {
     let args = Args::parse();
+    if !args.topics.is_empty() {
+        return lasers::run_bag(&args).map(|_| ());
+    }
+    if args.lasers {
+        return lasers::run_simulated(&args);
+    }
     if args.carmen.is_some() || args.bag.is_some() {
         return recording::run(&args).map(|_| ());
     }
@@ -765,6 +803,154 @@ mod recording {
             scans.len()
         );
         Ok(scans[a..b].to_vec())
+    }
+}
+
+/// Several lasers: `--topics` of a bag at their `--mountings`, or the simulated rig of
+/// `--lasers`; the work is `smc_lmb::pipeline::people_tracking::lasers`'.
+mod lasers {
+    use super::Args;
+    use anyhow::{Context, Result};
+    use smc_lmb::filter::Fusion;
+    use smc_lmb::pipeline::people_tracking::lasers::{parse_fusion, read_bag_lasers, track_lasers};
+    use smc_lmb::pipeline::people_tracking::lasers_eval::{
+        evaluate_lasers, summarise_variant, LaserVariant, VariantSummary,
+    };
+    use smc_lmb::pipeline::people_tracking::score::FIRST_SCORED_SCAN;
+    use smc_lmb::pipeline::people_tracking::{write_people_json, PeopleRun};
+    use smc_lmb::sim::people2d::lasers::LaserRig;
+
+    /// Tracks `--topics` of `--bag` together; with `--empty` prints (and returns) the false
+    /// people per frame from the 10th frame on.
+    pub fn run_bag(args: &Args) -> Result<(PeopleRun, Option<f64>)> {
+        let bag = args.bag.as_ref().context("--topics needs --bag")?;
+        let mountings = args
+            .mountings
+            .as_ref()
+            .context("--topics needs --mountings")?;
+        let recordings = read_bag_lasers(bag, &args.topics, mountings, args.max_range)?;
+        let first = &recordings[0];
+        let mut cfg = smc_lmb::pipeline::people_tracking::config_for_scans(
+            &first.scans,
+            args.sigma_range,
+            args.sigma_bearing,
+            args.max_range,
+            [0.0, 0.0],
+        )?;
+        cfg.filter.seed = args.seed;
+        super::apply_lmb_args(args, &mut cfg);
+        let min_visibility = cfg.min_visibility;
+        let fe = super::front_end(args)?;
+        let fusion = parse_fusion(&args.fusion)?;
+        let t0 = std::time::Instant::now();
+        let run = track_lasers(&recordings, cfg, fe, Fusion::new(fusion))?;
+        let secs = t0.elapsed().as_secs_f64();
+        if let Some(path) = &args.out {
+            write_people_json(path, &run).with_context(|| format!("writing {}", path.display()))?;
+        }
+        let scans: usize = recordings.iter().map(|r| r.scans.len()).sum();
+        println!(
+            "lasers {} (front end {}, fusion {}): {} frames from {scans} scans, tracked in {secs:.2} s",
+            args.topics.join(","),
+            fe.name(),
+            fusion.short_name(),
+            run.scans.len()
+        );
+        if !args.empty {
+            return Ok((run, None));
+        }
+        let scored: Vec<usize> = run
+            .scans
+            .iter()
+            .skip(FIRST_SCORED_SCAN)
+            .map(|s| {
+                s.people
+                    .iter()
+                    .filter(|p| p.visibility >= min_visibility)
+                    .count()
+            })
+            .collect();
+        let false_people = scored.iter().sum::<usize>() as f64 / scored.len().max(1) as f64;
+        println!(
+            "empty recording: {} frames scored, {} people reported, false people per frame {false_people:.4}; tracks visible in ≥ 8 frames: {}",
+            scored.len(),
+            scored.iter().sum::<usize>(),
+            run.tracks_with(8).count()
+        );
+        Ok((run, Some(false_people)))
+    }
+
+    /// Each laser of the three-laser rig alone and the lasers fused by each rule of
+    /// `--fusion`, on `--runs` seeds of `--scenario`; prints the means.
+    pub fn run_simulated(args: &Args) -> Result<()> {
+        let scenario = match args.scenario.as_str() {
+            "one" => smc_lmb::sim::PeopleScenario::one(),
+            "two" => smc_lmb::sim::PeopleScenario::two(),
+            other => anyhow::bail!("unknown scenario `{other}` (expected one or two)"),
+        };
+        anyhow::ensure!(args.runs > 0, "--runs must be at least 1");
+        let rig = LaserRig::three_lasers(scenario.scanner);
+        let rules = args
+            .fusion
+            .split(',')
+            .map(|r| parse_fusion(r.trim()))
+            .collect::<smc_lmb::Result<Vec<_>>>()?;
+        let variants = LaserVariant::singles_and_fused(&rig, &rules);
+        let fe = super::front_end(args)?;
+        let mut per_variant = vec![Vec::new(); variants.len()];
+        for r in 0..args.runs {
+            let seed = args.seed + r as u64;
+            let run = scenario.generate_lasers(&rig, seed)?;
+            for (v, scores) in variants.iter().zip(per_variant.iter_mut()) {
+                let mut cfg = super::lmb_config(args, &scenario, seed, fe);
+                cfg.filter.seed = seed;
+                let s = evaluate_lasers(&run, &rig, &v.lasers, &cfg, fe, Fusion::new(v.fusion))
+                    .with_context(|| format!("{} on seed {seed}", v.name))?;
+                if !args.json {
+                    eprintln!(
+                        "seed {seed} {}: F1 {:.3}, OSPA {:.3}, OSPA(2) {:.3}, label switches {}",
+                        v.name,
+                        s.detection.f1(),
+                        s.mean_ospa,
+                        s.ospa2,
+                        s.label_switches
+                    );
+                }
+                scores.push(s);
+            }
+        }
+        let summaries: Vec<VariantSummary> = variants
+            .into_iter()
+            .zip(per_variant)
+            .map(|(v, s)| summarise_variant(v, s))
+            .collect::<smc_lmb::Result<_>>()?;
+        if args.json {
+            println!("{}", serde_json::to_string_pretty(&summaries)?);
+            return Ok(());
+        }
+        println!(
+            "scenario {}, three lasers, {} run(s) from seed {}, front end {}; means over runs (OSPA c = 2 m, p = 1)",
+            args.scenario,
+            args.runs,
+            args.seed,
+            fe.name()
+        );
+        println!("| lasers | F1 | precision | recall | OSPA (m) | OSPA(2) (m) | label switches | frames/s |");
+        println!("|---|---|---|---|---|---|---|---|");
+        for s in &summaries {
+            println!(
+                "| {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {} | {:.0} |",
+                s.variant.name,
+                s.f1,
+                s.precision,
+                s.recall,
+                s.mean_ospa,
+                s.ospa2,
+                s.label_switches,
+                s.frames_per_second
+            );
+        }
+        Ok(())
     }
 }
 

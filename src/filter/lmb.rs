@@ -396,6 +396,7 @@ impl LmbFilterBuilder {
             previous: None,
             unmoved_detection: Vec::new(),
             most_probable: Vec::new(),
+            most_probable_all: Vec::new(),
             keep_predicted: false,
             predicted: Vec::new(),
             particle_caps: HashMap::new(),
@@ -478,6 +479,21 @@ struct SensorUpdates {
     /// For every measurement of every sensor, in sensor order, the probability that some
     /// track generated it.
     assigned: Vec<f64>,
+    /// With several sensors: for each sensor, each track's most probable measurement of that
+    /// sensor's scan with its probability (empty with one sensor).
+    most_probable_by_sensor: Vec<(usize, Vec<MostProbableRow>)>,
+}
+
+/// A track's most probable measurement of one sensor's scan and its probability, if any.
+type MostProbableRow = Option<(usize, f64)>;
+
+/// Each track's most probable measurement by the rows of one sensor's likelihoods and
+/// marginals.
+fn most_probable_rows(lik: &[TrackLikelihoods], marg: &[TrackMarginals]) -> Vec<MostProbableRow> {
+    lik.iter()
+        .zip(marg)
+        .map(|(l, mg)| mg.most_probable(l))
+        .collect()
 }
 
 /// The measurements of `scans` (in sensor order) one after another; borrowed when there is
@@ -512,8 +528,14 @@ impl SensorScan<'_> {
     }
 }
 
-/// A scan as the update takes it: sensor index, measurements, the scan's own data if any.
-type ScanRef<'a> = (usize, &'a Measurements, Option<&'a StepData>);
+/// A scan as the update takes it: sensor index, measurements, the scan's own data and
+/// platform pose if any.
+type ScanRef<'a> = (
+    usize,
+    &'a Measurements,
+    Option<&'a StepData>,
+    Option<Isometry3<f64>>,
+);
 
 /// Per-sensor vectors joined in sensor order.
 fn in_sensor_order(mut by_sensor: Vec<(usize, Vec<f64>)>) -> Vec<f64> {
@@ -551,6 +573,8 @@ pub struct LmbFilter {
     /// Each track's most probable measurement of the last step (tracks that could explain
     /// some measurement).
     most_probable: Vec<MostProbableMeasurement>,
+    /// … of every sensor's scan, indexed among all sensors' measurements in sensor order.
+    most_probable_all: Vec<MostProbableMeasurement>,
     /// Whether to keep the predicted particle sets of each step (consistency checks).
     keep_predicted: bool,
     /// The predicted particle sets of the last step (births as drawn), when kept.
@@ -610,6 +634,7 @@ impl LmbFilter {
         self.previous = None;
         self.unmoved_detection.clear();
         self.most_probable.clear();
+        self.most_probable_all.clear();
         self.predicted.clear();
         self.pending = None;
     }
@@ -618,6 +643,15 @@ impl LmbFilter {
     /// association probability (tracks that could explain no measurement are left out).
     pub fn most_probable_measurements(&self) -> &[MostProbableMeasurement] {
         &self.most_probable
+    }
+
+    /// Each track's most probable measurement of the last step in the scan of every sensor
+    /// that reported (with one sensor, [`LmbFilter::most_probable_measurements`]): a track
+    /// appears once per sensor whose measurements it could explain, and
+    /// [`MostProbableMeasurement::measurement`] indexes the measurements of all sensors one
+    /// after another in sensor order (those the births and [`BirthEvidence`] see).
+    pub fn most_probable_measurements_all(&self) -> &[MostProbableMeasurement] {
+        &self.most_probable_all
     }
 
     /// Keeps (or stops keeping) a copy of every track's predicted particle set in each step,
@@ -670,7 +704,7 @@ impl LmbFilter {
         let scans: Vec<ScanRef> = frame
             .scans
             .iter()
-            .map(|s| (s.sensor, &s.measurements, Some(&s.data)))
+            .map(|s| (s.sensor, &s.measurements, Some(&s.data), s.platform))
             .collect();
         self.check_scans(&scans)?;
         self.predict_phase(
@@ -678,7 +712,7 @@ impl LmbFilter {
             frame.platform,
             frame.data.clone(),
             rng,
-            scans.iter().any(|(_, z, _)| !z.is_empty()),
+            scans.iter().any(|(_, z, _, _)| !z.is_empty()),
         )?;
         self.update_scans(&scans, StepData::new())
     }
@@ -716,7 +750,7 @@ impl LmbFilter {
         measurements: &Measurements,
         data: StepData,
     ) -> Result<Vec<Estimate>> {
-        let scans: [ScanRef; 1] = [(0, measurements, None)];
+        let scans: [ScanRef; 1] = [(0, measurements, None, None)];
         self.check_scans(&scans)?;
         self.update_scans(&scans, data)
     }
@@ -727,7 +761,7 @@ impl LmbFilter {
     pub fn update_step_scans(&mut self, scans: &[Scan], data: StepData) -> Result<Vec<Estimate>> {
         let scans: Vec<ScanRef> = scans
             .iter()
-            .map(|s| (s.sensor, &s.measurements, Some(&s.data)))
+            .map(|s| (s.sensor, &s.measurements, Some(&s.data), s.platform))
             .collect();
         self.check_scans(&scans)?;
         self.update_scans(&scans, data)
@@ -766,17 +800,25 @@ impl LmbFilter {
         // the context its models see.
         let mut scans: Vec<SensorScan> = scans
             .iter()
-            .map(|&(sensor, z, own)| SensorScan {
+            .map(|&(sensor, z, own, platform)| SensorScan {
                 sensor,
                 z: match self.models.sensors[sensor].mounting {
                     Some(m) => Cow::Owned(m.to_platform(z)),
                     None => Cow::Borrowed(z),
                 },
-                own: own.filter(|d| !d.is_empty()).map(|d| {
-                    let mut c = ctx.clone();
-                    c.data.extend(d.clone());
-                    c
-                }),
+                own: match (own.filter(|d| !d.is_empty()), platform) {
+                    (None, None) => None,
+                    (d, p) => {
+                        let mut c = ctx.clone();
+                        if let Some(d) = d {
+                            c.data.extend(d.clone());
+                        }
+                        if p.is_some() {
+                            c.platform = p;
+                        }
+                        Some(c)
+                    }
+                },
             })
             .collect();
         scans.sort_by_key(|s| s.sensor);
@@ -799,7 +841,16 @@ impl LmbFilter {
             ),
         };
         let resampled = self.resample(seed, &merged);
-        self.record_diagnostics(predicted, first, &resampled);
+        // Where each sensor's measurements start among all of them (sensor order).
+        let offsets: Vec<(usize, usize)> = scans
+            .iter()
+            .scan(0, |at, s| {
+                let here = *at;
+                *at += s.z.len();
+                Some((s.sensor, here))
+            })
+            .collect();
+        self.record_diagnostics(predicted, first, &resampled, &offsets);
         self.prune();
         let estimates = map_estimates(&self.tracks);
 
@@ -848,7 +899,7 @@ impl LmbFilter {
     fn check_scans(&self, scans: &[ScanRef]) -> Result<()> {
         let sensors = &self.models.sensors;
         let what = || format!("measurements of step {}", self.step);
-        for (k, &(s, z, _)) in scans.iter().enumerate() {
+        for (k, &(s, z, _, platform)) in scans.iter().enumerate() {
             let Some(sensor) = sensors.get(s) else {
                 return Err(Error::invalid(
                     what(),
@@ -859,7 +910,18 @@ impl LmbFilter {
                     ),
                 ));
             };
-            if scans[..k].iter().any(|&(o, _, _)| o == s) {
+            if let Some(p) = platform {
+                if p.to_homogeneous().iter().any(|x| !x.is_finite()) {
+                    return Err(Error::invalid(
+                        what(),
+                        format!(
+                            "the platform pose of sensor {s} ({:?}) is not finite",
+                            sensor.name
+                        ),
+                    ));
+                }
+            }
+            if scans[..k].iter().any(|&(o, _, _, _)| o == s) {
                 return Err(Error::invalid(
                     what(),
                     format!("two scans of sensor {s} ({:?}) in one frame", sensor.name),
@@ -1075,6 +1137,7 @@ impl LmbFilter {
             .fusion
             .ordered(&scans.iter().map(|s| s.sensor).collect::<Vec<_>>());
         let mut assigned_by_sensor: Vec<(usize, Vec<f64>)> = Vec::with_capacity(order.len());
+        let mut most_probable_by_sensor = Vec::new();
         let mut first = None;
         let mut summaries = summaries;
         for (k, &s) in order.iter().enumerate() {
@@ -1101,6 +1164,9 @@ impl LmbFilter {
                     apply_posterior(t, post)
                 });
             assigned_by_sensor.push((s, assigned(&lik, &marg, z.len())));
+            if order.len() > 1 {
+                most_probable_by_sensor.push((s, most_probable_rows(&lik, &marg)));
+            }
             if k + 1 < order.len() {
                 self.resample_collapsed(seed ^ sensor_key(s + 1));
                 summaries = self
@@ -1119,6 +1185,7 @@ impl LmbFilter {
             marginals,
             only: order.len() == 1,
             assigned: in_sensor_order(assigned_by_sensor),
+            most_probable_by_sensor,
         })
     }
 
@@ -1170,12 +1237,18 @@ impl LmbFilter {
             .zip(scans)
             .map(|((lik, marg), scan)| (scan.sensor, assigned(lik, marg, scan.z.len())))
             .collect();
+        let most_probable_by_sensor = per_sensor
+            .iter()
+            .zip(scans)
+            .map(|((lik, marg), scan)| (scan.sensor, most_probable_rows(lik, marg)))
+            .collect();
         let (likelihoods, marginals) = per_sensor.into_iter().next().expect("several scans");
         Ok(SensorUpdates {
             likelihoods,
             marginals,
             only: false,
             assigned: in_sensor_order(assigned_by_sensor),
+            most_probable_by_sensor,
         })
     }
 
@@ -1290,14 +1363,31 @@ impl LmbFilter {
         predicted: Vec<(Label, ParticleSet)>,
         first: Option<SensorUpdates>,
         resampled: &[bool],
+        offsets: &[(usize, usize)],
     ) {
         self.predicted.clear();
         self.predicted.extend(predicted);
         self.most_probable.clear();
+        self.most_probable_all.clear();
         self.unmoved_detection.clear();
         let Some(first) = first else {
             return;
         };
+        for (sensor, rows) in &first.most_probable_by_sensor {
+            let offset = offsets
+                .iter()
+                .find(|(s, _)| s == sensor)
+                .map_or(0, |&(_, o)| o);
+            for (t, row) in self.tracks.iter().zip(rows) {
+                if let Some((j, probability)) = *row {
+                    self.most_probable_all.push(MostProbableMeasurement {
+                        label: t.label,
+                        measurement: offset + j,
+                        probability,
+                    });
+                }
+            }
+        }
         for ((t, l), mg) in self
             .tracks
             .iter()
@@ -1311,6 +1401,9 @@ impl LmbFilter {
                     probability,
                 });
             }
+        }
+        if first.most_probable_by_sensor.is_empty() {
+            self.most_probable_all.clone_from(&self.most_probable);
         }
         if !first.only {
             return;

@@ -11,6 +11,7 @@
 use super::{Measurements, StepData};
 use crate::error::{Error, Result};
 use crate::filter::{ClutterModel, DetectionModel, MeasurementModel};
+use nalgebra::Isometry3;
 
 /// The name of the one sensor of a filter built without [`Sensor`]s.
 pub const DEFAULT_SENSOR: &str = "default";
@@ -146,6 +147,14 @@ pub struct Scan {
     /// the frame's data, replacing values of the same types, for this sensor's measurement,
     /// detection and clutter models. Empty by default.
     pub data: StepData,
+    /// Where the platform stood for this sensor's models, when not at the frame's pose: a
+    /// sensor that measured at another time than the frame's (an asynchronous laser), or one
+    /// whose models are written for measurements about the sensor itself (range and bearing
+    /// from a laser at its own pose: give its world pose here and its models no offset). The
+    /// sensor's measurement, detection and clutter models see it as the step's platform
+    /// ([`crate::filter::StepContext::platform`]); the other models of the step, and the
+    /// births, see the frame's. `None` by default.
+    pub platform: Option<Isometry3<f64>>,
 }
 
 impl Scan {
@@ -155,12 +164,20 @@ impl Scan {
             sensor,
             measurements,
             data: StepData::new(),
+            platform: None,
         }
     }
 
     /// The same scan with `data` for its sensor's models.
     pub fn with_data(mut self, data: StepData) -> Self {
         self.data = data;
+        self
+    }
+
+    /// The same scan with the platform at `platform` for its sensor's models (see
+    /// [`Scan::platform`]).
+    pub fn at(mut self, platform: Isometry3<f64>) -> Self {
+        self.platform = Some(platform);
         self
     }
 }

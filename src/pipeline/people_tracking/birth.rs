@@ -52,6 +52,43 @@ pub struct ConfirmedPerson {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Doubted(pub Vec<bool>);
 
+/// Where the measurements of a frame with several lasers come from: one entry per laser that
+/// reported, in the filter's sensor order, with the laser's world pose at its scan and how
+/// many of the frame's measurements (all lasers' one after another, as the births see them)
+/// are its own. With it [`PeopleBirth`] reads each measurement about its own laser (its sensor
+/// model then has no mounting offset); without it, about the frame's platform. Handed with the
+/// frame ([`crate::filter::Frame::data`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LaserOrigins(pub Vec<LaserOrigin>);
+
+/// One laser of [`LaserOrigins`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LaserOrigin {
+    /// The laser's index among the filter's sensors.
+    pub laser: usize,
+    /// Its world pose at its scan.
+    pub pose: crate::geometry::Pose2,
+    /// Its number of measurements in the frame.
+    pub measurements: usize,
+}
+
+impl LaserOrigins {
+    /// For each laser, the end (exclusive) of its measurements among the frame's and a
+    /// context like `ctx` with the platform at the laser's pose.
+    pub fn contexts(&self, ctx: &StepContext) -> Vec<(usize, StepContext)> {
+        let mut end = 0;
+        self.0
+            .iter()
+            .map(|o| {
+                end += o.measurements;
+                let mut c = ctx.clone();
+                c.platform = Some(crate::geometry::platform_isometry(o.pose));
+                (end, c)
+            })
+            .collect()
+    }
+}
+
 /// Measurement-driven birth with suppression near confirmed tracks (module documentation).
 #[derive(Clone, Debug)]
 pub struct PeopleBirth {
@@ -180,6 +217,19 @@ impl BirthModel for PeopleBirth {
             .data
             .get::<Doubted>()
             .map_or(&[][..], |d| &d.0[..]);
+        // with several lasers each measurement about its own laser
+        let origins = ev
+            .context
+            .data
+            .get::<LaserOrigins>()
+            .map(|o| o.contexts(ev.context));
+        let context_of = |j: usize| match &origins {
+            Some(o) => o
+                .iter()
+                .find(|(end, _)| j < *end)
+                .map_or(ev.context, |(_, c)| c),
+            None => ev.context,
+        };
         ev.measurements
             .iter()
             .zip(ev.assigned)
@@ -190,14 +240,15 @@ impl BirthModel for PeopleBirth {
                     return None;
                 }
                 let zz = [z[0], z[1]];
-                let p = self.sensor.to_cartesian(zz, ev.context);
+                let at = context_of(j);
+                let p = self.sensor.to_cartesian(zz, at);
                 let near = confirmed.iter().any(|(c, r2)| {
                     let (dx, dy) = (c[0] - p[0], c[1] - p[1]);
                     dx * dx + dy * dy < *r2
                 });
                 (!near).then(|| BirthTrack {
                     existence: r,
-                    particles: self.sample(zz, ev.context, rng),
+                    particles: self.sample(zz, at, rng),
                     at_previous_step: true,
                 })
             })

@@ -263,7 +263,7 @@ pub fn evaluate_run_with(
 
 /// The estimates left after removing those that the optimal gated pairing of all present
 /// people (`seen` then `unseen`) gives to an unseen person.
-fn drop_unseen(
+pub(crate) fn drop_unseen(
     seen: &[Person],
     unseen: &[Person],
     estimates: Vec<(Label, Vec<f64>)>,
@@ -292,7 +292,7 @@ fn drop_unseen(
 }
 
 /// The world point `p` seen from robot pose `from`, placed at the same spot relative to `to`.
-fn relocate(p: [f64; 2], from: Pose2, to: Pose2) -> [f64; 2] {
+pub(crate) fn relocate(p: [f64; 2], from: Pose2, to: Pose2) -> [f64; 2] {
     let (s, c) = from.theta.sin_cos();
     let (dx, dy) = (p[0] - from.x, p[1] - from.y);
     let local = [c * dx + s * dy, -s * dx + c * dy];

@@ -17,6 +17,8 @@ pub mod birth;
 pub mod evaluate;
 pub mod front_end;
 pub mod innovation;
+pub mod lasers;
+pub mod lasers_eval;
 pub mod models;
 pub mod motion_state;
 #[cfg(feature = "plot")]
@@ -25,7 +27,9 @@ pub mod run;
 pub mod score;
 pub mod tracker;
 
-pub use birth::{ConfirmedPeople, ConfirmedPerson, Doubted, PeopleBirth};
+pub use birth::{
+    ConfirmedPeople, ConfirmedPerson, Doubted, LaserOrigin, LaserOrigins, PeopleBirth,
+};
 pub use motion_state::{probability_moving, MotionClassifier, MotionConfig};
 #[cfg(feature = "plot")]
 pub use plot::{write_people_plot, PeoplePlotCounts, PeoplePlotOptions};

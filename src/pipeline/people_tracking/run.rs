@@ -207,7 +207,7 @@ fn track_all(
     Ok(run)
 }
 
-fn summarise(scans: &[ScanPeople], min_visibility: f64) -> Vec<PersonTrack> {
+pub(crate) fn summarise(scans: &[ScanPeople], min_visibility: f64) -> Vec<PersonTrack> {
     struct Acc {
         n: usize,
         first: (f64, [f64; 2]),
