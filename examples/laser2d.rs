@@ -811,8 +811,8 @@ mod recording {
 mod lasers {
     use super::Args;
     use anyhow::{Context, Result};
-    use smc_lmb::filter::Fusion;
-    use smc_lmb::pipeline::people_tracking::lasers::{parse_fusion, read_bag_lasers, track_lasers};
+    use smc_lmb::filter::{Fusion, FusionMethod};
+    use smc_lmb::pipeline::people_tracking::lasers::{read_bag_lasers, track_lasers};
     use smc_lmb::pipeline::people_tracking::lasers_eval::{
         evaluate_lasers, summarise_variant, LaserVariant, VariantSummary,
     };
@@ -841,7 +841,7 @@ mod lasers {
         super::apply_lmb_args(args, &mut cfg);
         let min_visibility = cfg.min_visibility;
         let fe = super::front_end(args)?;
-        let fusion = parse_fusion(&args.fusion)?;
+        let fusion = FusionMethod::from_short_name(&args.fusion)?;
         let t0 = std::time::Instant::now();
         let run = track_lasers(&recordings, cfg, fe, Fusion::new(fusion))?;
         let secs = t0.elapsed().as_secs_f64();
@@ -893,7 +893,7 @@ mod lasers {
         let rules = args
             .fusion
             .split(',')
-            .map(|r| parse_fusion(r.trim()))
+            .map(|r| FusionMethod::from_short_name(r.trim()))
             .collect::<smc_lmb::Result<Vec<_>>>()?;
         let variants = LaserVariant::singles_and_fused(&rig, &rules);
         let fe = super::front_end(args)?;

@@ -58,6 +58,20 @@ impl FusionMethod {
             FusionMethod::ArithmeticAverage => "aa",
         }
     }
+
+    /// The rule of a short name ([`FusionMethod::short_name`]); an error naming the accepted
+    /// names otherwise.
+    pub fn from_short_name(name: &str) -> Result<Self> {
+        [
+            FusionMethod::IteratedCorrector,
+            FusionMethod::ParallelUpdate,
+            FusionMethod::GeometricAverage,
+            FusionMethod::ArithmeticAverage,
+        ]
+        .into_iter()
+        .find(|m| m.short_name() == name)
+        .ok_or_else(|| Error::invalid("fusion", format!("`{name}` (expected ic, pu, ga or aa)")))
+    }
 }
 
 /// How a filter with several sensors combines them: the rule, the fusion weights of GA and AA,

@@ -592,7 +592,7 @@ mod tests {
         let s = room_scan(Pose2::new(0.0, 0.0, 0.0), 0.0);
         assert!(matches!(
             estimate_mounting(
-                &[s.clone()],
+                std::slice::from_ref(&s),
                 &[s.clone(), s.clone()],
                 &MountingConfig::default()
             ),
@@ -606,7 +606,7 @@ mod tests {
             ..MountingConfig::default()
         };
         assert!(matches!(
-            estimate_mounting(&[s.clone(), s.clone()], &[s.clone()], &bad),
+            estimate_mounting(&[s.clone(), s.clone()], std::slice::from_ref(&s), &bad),
             Err(MountingError::Config {
                 field: "MountingConfig::windows",
                 ..

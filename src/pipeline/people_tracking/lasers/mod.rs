@@ -1,7 +1,7 @@
 //! The people tracker fed by several lasers at their mounting poses on one robot: each laser is
 //! one sensor of the filter ([`crate::filter::Sensor`]), and their updates combine by the
 //! chosen fusion rule (iterated corrector, parallel update, geometric or arithmetic average;
-//! [`FusionMethod`]).
+//! [`crate::filter::FusionMethod`]).
 //!
 //! # Each laser about itself
 //!
@@ -47,8 +47,8 @@ use super::tracker::{PeopleTrackerConfig, PersonEstimate};
 use crate::config::{BirthConfig, DetectionConfig, MeasurementConfig, TransitionConfig};
 use crate::error::{Error, Result};
 use crate::filter::{
-    DetectionModel, Frame, Fusion, FusionMethod, Label, LmbFilter, MeasurementModel, Measurements,
-    ParticleSet, Scan as FilterScan, Sensor, StepContext, StepData, SurvivalModel, TransitionModel,
+    DetectionModel, Frame, Fusion, Label, LmbFilter, MeasurementModel, Measurements, ParticleSet,
+    Scan as FilterScan, Sensor, StepContext, StepData, SurvivalModel, TransitionModel,
 };
 use crate::geometry::pose2::{between, compose, inverse};
 use crate::geometry::{platform_isometry, wrap_angle, Pose2};
@@ -612,22 +612,6 @@ fn people_motion(config: &PeopleTrackerConfig) -> Result<Box<dyn TransitionModel
     )?))
 }
 
-/// A fusion rule by its short name: `ic`, `pu`, `ga` or `aa`.
-pub fn parse_fusion(name: &str) -> Result<FusionMethod> {
-    Ok(match name {
-        "ic" => FusionMethod::IteratedCorrector,
-        "pu" => FusionMethod::ParallelUpdate,
-        "ga" => FusionMethod::GeometricAverage,
-        "aa" => FusionMethod::ArithmeticAverage,
-        other => {
-            return Err(Error::invalid(
-                "fusion",
-                format!("`{other}` (expected ic, pu, ga or aa)"),
-            ))
-        }
-    })
-}
-
 mod frames;
 mod mountings;
 mod recording;
@@ -639,6 +623,7 @@ pub use recording::{read_bag_lasers, track_lasers, LaserRecording};
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::filter::FusionMethod;
     use std::f64::consts::{FRAC_PI_2, PI};
     use std::path::Path;
 
@@ -714,7 +699,10 @@ mod tests {
             assert!(e.starts_with(&format!("m.toml:{line}:")), "{bad:?}: {e}");
             assert!(e.contains(what), "{bad:?}: {e}");
         }
-        assert!(parse_fusion("pu").is_ok() && parse_fusion("xx").is_err());
+        assert!(
+            FusionMethod::from_short_name("pu").is_ok()
+                && FusionMethod::from_short_name("xx").is_err()
+        );
     }
 
     /// A person (disc of radius 0.2 m) at world `person` seen by a laser at world pose `laser`
