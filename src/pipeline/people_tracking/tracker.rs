@@ -234,6 +234,130 @@ pub fn centre_noise(sigma_range: f64, sigma_bearing: f64) -> (f64, f64) {
     (sigma_range.max(0.05), sigma_bearing.max(0.005))
 }
 
+/// The people's motion: the filter's transition, with manoeuvres when configured.
+pub(super) fn people_motion(config: &PeopleTrackerConfig) -> Result<Box<dyn TransitionModel>> {
+    if config.manoeuvre_probability == 0.0 {
+        return config.filter.transition.model();
+    }
+    let TransitionConfig::ConstantVelocity { dims, sigma_accel } = config.filter.transition else {
+        return Err(Error::invalid(
+            "people tracker config field `manoeuvre_probability`",
+            "manoeuvres need a constant-velocity `filter.transition`",
+        ));
+    };
+    Ok(Box::new(ManoeuvringVelocity::new(
+        ConstantVelocity::new(dims, sigma_accel)?,
+        config.manoeuvre_probability,
+        config.manoeuvre_sigma,
+    )?))
+}
+
+/// What the people models are built from in a tracker's filter configuration: the field of
+/// view, the adaptive birth and the range-bearing likelihood (an error naming the field when
+/// one is of another kind).
+pub(super) struct FilterParts {
+    pub(super) p_inside: f64,
+    pub(super) p_outside: f64,
+    pub(super) max_range: f64,
+    pub(super) half_angle: f64,
+    pub(super) fov_offset: [f64; 2],
+    expected_births: f64,
+    max_existence: f64,
+    particles: usize,
+    position_std: f64,
+    velocity_std: f64,
+    sigma_range: f64,
+    sigma_bearing: f64,
+    pub(super) sensor_offset: [f64; 2],
+    convention: BearingConvention,
+}
+
+impl FilterParts {
+    pub(super) fn of(config: &PeopleTrackerConfig) -> Result<Self> {
+        let Some(DetectionConfig::FieldOfView {
+            p_inside,
+            p_outside,
+            max_range,
+            half_angle,
+            offset: fov_offset,
+        }) = config.filter.detection
+        else {
+            return Err(Error::invalid(
+                "people tracker config field `filter.detection`",
+                "must be FieldOfView (occlusion is added on top)",
+            ));
+        };
+        let BirthConfig::Adaptive {
+            expected_births,
+            max_existence,
+            particles,
+            position_std,
+            velocity_std,
+            ..
+        } = config.filter.birth
+        else {
+            return Err(Error::invalid(
+                "people tracker config field `filter.birth`",
+                "must be Adaptive",
+            ));
+        };
+        let Some(MeasurementConfig::RangeBearing {
+            sigma_range,
+            sigma_bearing,
+            offset: sensor_offset,
+            convention,
+        }) = config.filter.measurement
+        else {
+            return Err(Error::invalid(
+                "people tracker config field `filter.measurement`",
+                "must be RangeBearing",
+            ));
+        };
+        Ok(FilterParts {
+            p_inside,
+            p_outside,
+            max_range,
+            half_angle,
+            fov_offset,
+            expected_births,
+            max_existence,
+            particles,
+            position_std,
+            velocity_std,
+            sigma_range,
+            sigma_bearing,
+            sensor_offset,
+            convention,
+        })
+    }
+
+    /// The range-bearing likelihood about the sensor (no offset).
+    pub(super) fn range_bearing(&self) -> Result<RangeBearing> {
+        Ok(RangeBearing::new(self.sigma_range, self.sigma_bearing)?
+            .with_convention(self.convention))
+    }
+
+    /// The people birth drawing through `sensor`.
+    pub(super) fn birth(
+        &self,
+        sensor: RangeBearing,
+        config: &PeopleTrackerConfig,
+    ) -> Result<PeopleBirth> {
+        let mut birth = PeopleBirth::new(
+            sensor,
+            self.expected_births,
+            self.max_existence,
+            self.particles,
+            self.position_std,
+            self.velocity_std,
+            config.birth_suppress_radius,
+        )?;
+        birth.with_detectability = config.detectability.is_some();
+        birth.suppress_spread = config.birth_suppress_spread;
+        Ok(birth)
+    }
+}
+
 /// One person in one scan's output.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PersonEstimate {
@@ -283,64 +407,22 @@ pub struct PeopleTracker {
 impl PeopleTracker {
     /// A tracker; the filter's random stream is seeded from `config.filter.seed`.
     pub fn new(config: PeopleTrackerConfig) -> Result<Self> {
-        let Some(DetectionConfig::FieldOfView {
-            p_inside,
-            p_outside,
-            max_range,
-            half_angle,
-            offset,
-        }) = config.filter.detection
-        else {
-            return Err(Error::invalid(
-                "people tracker config field `filter.detection`",
-                "must be FieldOfView (occlusion is added on top)",
-            ));
-        };
-        let BirthConfig::Adaptive {
-            expected_births,
-            max_existence,
-            particles,
-            position_std,
-            velocity_std,
-            ..
-        } = config.filter.birth
-        else {
-            return Err(Error::invalid(
-                "people tracker config field `filter.birth`",
-                "must be Adaptive",
-            ));
-        };
-        let Some(MeasurementConfig::RangeBearing {
-            sigma_range,
-            sigma_bearing,
-            offset: sensor_offset,
-            convention,
-        }) = config.filter.measurement
-        else {
-            return Err(Error::invalid(
-                "people tracker config field `filter.measurement`",
-                "must be RangeBearing",
-            ));
-        };
-        let fov = FieldOfViewDetection::new(p_inside, p_outside, max_range, half_angle)?
-            .with_offset(offset[0], offset[1])?;
+        let parts = FilterParts::of(&config)?;
+        let (fov_offset, sensor_offset) = (parts.fov_offset, parts.sensor_offset);
+        let fov = FieldOfViewDetection::new(
+            parts.p_inside,
+            parts.p_outside,
+            parts.max_range,
+            parts.half_angle,
+        )?
+        .with_offset(fov_offset[0], fov_offset[1])?;
         let detection =
             OcclusionDetection::new(fov, config.body_radius.max(1e-3), config.occlusion_margin)?
                 .with_min_returns(config.min_points as u32);
-        let sensor = RangeBearing::new(sigma_range, sigma_bearing)?
-            .with_offset(sensor_offset[0], sensor_offset[1])?
-            .with_convention(convention);
-        let mut birth = PeopleBirth::new(
-            sensor,
-            expected_births,
-            max_existence,
-            particles,
-            position_std,
-            velocity_std,
-            config.birth_suppress_radius,
-        )?;
-        birth.with_detectability = config.detectability.is_some();
-        birth.suppress_spread = config.birth_suppress_spread;
+        let sensor = parts
+            .range_bearing()?
+            .with_offset(sensor_offset[0], sensor_offset[1])?;
+        let birth = parts.birth(sensor, &config)?;
         let survival =
             FieldOfViewSurvival::new(fov, config.filter.survival, config.survival_outside)?;
         let resolution = ResolutionDetection::new(
@@ -359,7 +441,7 @@ impl PeopleTracker {
                 resolution.clone(),
             )?);
         }
-        let motion = Self::transition(&config)?;
+        let motion = people_motion(&config)?;
         let detectability = match config.detectability {
             Some(chain) => {
                 let transition = DetectabilityTransition::new(motion, chain)?;
@@ -393,25 +475,6 @@ impl PeopleTracker {
             innovations: None,
             view: BeamView::EMPTY,
         })
-    }
-
-    /// The people's motion: the filter's transition, with manoeuvres when configured.
-    fn transition(config: &PeopleTrackerConfig) -> Result<Box<dyn TransitionModel>> {
-        if config.manoeuvre_probability == 0.0 {
-            return config.filter.transition.model();
-        }
-        let TransitionConfig::ConstantVelocity { dims, sigma_accel } = config.filter.transition
-        else {
-            return Err(Error::invalid(
-                "people tracker config field `manoeuvre_probability`",
-                "manoeuvres need a constant-velocity `filter.transition`",
-            ));
-        };
-        Ok(Box::new(ManoeuvringVelocity::new(
-            ConstantVelocity::new(dims, sigma_accel)?,
-            config.manoeuvre_probability,
-            config.manoeuvre_sigma,
-        )?))
     }
 
     /// Records (or stops recording) the innovation of every reported person's most probable

@@ -34,28 +34,27 @@
 //! Not for: estimating the mountings ([`crate::laser2d::mounting`]), the single-laser tracker
 //! ([`super::PeopleTracker`], which stays as it was), reading recordings.
 
-use super::birth::PeopleBirth;
 use super::birth::{ConfirmedPeople, ConfirmedPerson, Doubted, LaserOrigin, LaserOrigins};
 use super::front_end::{adapt_tracker_config, FrontEnd, PersonFrontEnd};
 use super::models::{
-    BeamView, DetectabilityDetection, DetectabilityTransition, ManoeuvringVelocity, Neighbours,
-    OcclusionDetection, ResolutionDetection, ResolutionLikelihood,
+    BeamView, DetectabilityDetection, DetectabilityTransition, Neighbours, OcclusionDetection,
+    ResolutionDetection, ResolutionLikelihood,
 };
 use super::motion_state::{probability_moving, MotionClassifier};
 use super::run::{PeopleRun, ScanPeople};
-use super::tracker::{PeopleTrackerConfig, PersonEstimate};
-use crate::config::{BirthConfig, DetectionConfig, MeasurementConfig, TransitionConfig};
+use super::tracker::{people_motion, FilterParts, PeopleTrackerConfig, PersonEstimate};
+use crate::config::{DetectionConfig, MeasurementConfig};
 use crate::error::{Error, Result};
 use crate::filter::{
     DetectionModel, Frame, Fusion, Label, LmbFilter, MeasurementModel, Measurements, ParticleSet,
-    Scan as FilterScan, Sensor, StepContext, StepData, SurvivalModel, TransitionModel,
+    Scan as FilterScan, Sensor, StepContext, StepData, SurvivalModel,
 };
 use crate::geometry::pose2::{between, compose, inverse};
 use crate::geometry::{platform_isometry, wrap_angle, Pose2};
 use crate::laser2d::Scan;
 use crate::models::cloud_bounds::CloudBox;
 use crate::models::detection::FieldOfViewDetection;
-use crate::models::{ConstantVelocity, RangeBearing, UniformClutter};
+use crate::models::{RangeBearing, UniformClutter};
 use crate::rng::{seeded, FilterRng};
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -213,57 +212,12 @@ impl LasersTracker {
                 ));
             }
         }
-        let Some(DetectionConfig::FieldOfView {
-            p_inside,
-            p_outside,
-            ..
-        }) = config.filter.detection
-        else {
-            return Err(Error::invalid(
-                "people tracker config field `filter.detection`",
-                "must be FieldOfView (occlusion is added on top)",
-            ));
-        };
-        let BirthConfig::Adaptive {
-            expected_births,
-            max_existence,
-            particles,
-            position_std,
-            velocity_std,
-            ..
-        } = config.filter.birth
-        else {
-            return Err(Error::invalid(
-                "people tracker config field `filter.birth`",
-                "must be Adaptive",
-            ));
-        };
-        let Some(MeasurementConfig::RangeBearing {
-            sigma_range,
-            sigma_bearing,
-            convention,
-            ..
-        }) = config.filter.measurement
-        else {
-            return Err(Error::invalid(
-                "people tracker config field `filter.measurement`",
-                "must be RangeBearing",
-            ));
-        };
+        let parts = FilterParts::of(&config)?;
+        let (p_inside, p_outside) = (parts.p_inside, parts.p_outside);
         let rate = config.filter.clutter.as_ref().map_or(1.0, |c| c.rate);
         // Every laser about itself: no offsets; the scan's platform is the laser's pose.
-        let sensor = RangeBearing::new(sigma_range, sigma_bearing)?.with_convention(convention);
-        let mut birth = PeopleBirth::new(
-            sensor,
-            expected_births,
-            max_existence,
-            particles,
-            position_std,
-            velocity_std,
-            config.birth_suppress_radius,
-        )?;
-        birth.with_detectability = config.detectability.is_some();
-        birth.suppress_spread = config.birth_suppress_spread;
+        let sensor = parts.range_bearing()?;
+        let birth = parts.birth(sensor, &config)?;
         let motion = people_motion(&config)?;
         let mut builder = LmbFilter::builder()
             .config(config.filter.filter.clone())
@@ -591,25 +545,6 @@ fn track_summary(p: &ParticleSet, existence: f64, dt: f64) -> ([f64; 2], [f64; 2
         existence,
         (0.5 * var).sqrt(),
     )
-}
-
-/// The people's motion: the configured transition, with manoeuvres when configured (as
-/// [`super::PeopleTracker`]).
-fn people_motion(config: &PeopleTrackerConfig) -> Result<Box<dyn TransitionModel>> {
-    if config.manoeuvre_probability == 0.0 {
-        return config.filter.transition.model();
-    }
-    let TransitionConfig::ConstantVelocity { dims, sigma_accel } = config.filter.transition else {
-        return Err(Error::invalid(
-            "people tracker config field `manoeuvre_probability`",
-            "manoeuvres need a constant-velocity `filter.transition`",
-        ));
-    };
-    Ok(Box::new(ManoeuvringVelocity::new(
-        ConstantVelocity::new(dims, sigma_accel)?,
-        config.manoeuvre_probability,
-        config.manoeuvre_sigma,
-    )?))
 }
 
 mod frames;
