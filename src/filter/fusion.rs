@@ -293,6 +293,23 @@ mod tests {
     use super::*;
     use crate::rng::seeded;
 
+    #[test]
+    fn rules_are_found_by_their_short_names_only() {
+        for m in [
+            FusionMethod::IteratedCorrector,
+            FusionMethod::ParallelUpdate,
+            FusionMethod::GeometricAverage,
+            FusionMethod::ArithmeticAverage,
+        ] {
+            assert_eq!(FusionMethod::from_short_name(m.short_name()).unwrap(), m);
+        }
+        let err = FusionMethod::from_short_name("PU").unwrap_err().to_string();
+        assert!(
+            err.contains("`PU`") && err.contains("ic, pu, ga or aa"),
+            "{err}"
+        );
+    }
+
     fn post(r: f64, f: Option<Vec<f64>>) -> SensorPosterior {
         SensorPosterior {
             existence: r,
