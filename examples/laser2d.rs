@@ -331,6 +331,24 @@ fn lmb_config(
 }
 
 /// The command line's LMB settings: manoeuvre share and particles per track.
+/// The people tracker's configuration for a recording's `scans`, with the command line's
+/// noise, range, seed and filter settings.
+fn recording_config(
+    args: &Args,
+    scans: &[smc_lmb::laser2d::Scan],
+) -> smc_lmb::Result<PeopleTrackerConfig> {
+    let mut cfg = smc_lmb::pipeline::people_tracking::config_for_scans(
+        scans,
+        args.sigma_range,
+        args.sigma_bearing,
+        args.max_range,
+        [0.0, 0.0],
+    )?;
+    cfg.filter.seed = args.seed;
+    apply_lmb_args(args, &mut cfg);
+    Ok(cfg)
+}
+
 fn apply_lmb_args(args: &Args, cfg: &mut PeopleTrackerConfig) {
     if let Some(p) = args.manoeuvre {
         cfg.manoeuvre_probability = p;
@@ -477,7 +495,7 @@ mod recording {
         truth_for_scans, DetectionScore, TrackScore, TrackScoreSummary, FIRST_SCORED_SCAN,
     };
     use smc_lmb::pipeline::people_tracking::{
-        centre_noise, config_for_scans, track_scans_with_model, write_people_json, PeopleRun,
+        centre_noise, track_scans_with_model, write_people_json, PeopleRun,
     };
     use smc_lmb::pipeline::people_tracking::{write_people_plot, PeoplePlotOptions};
     use std::path::Path;
@@ -504,15 +522,7 @@ mod recording {
         let scans = window(args, load(args)?)?;
         let read_s = t_read.elapsed().as_secs_f64();
         anyhow::ensure!(!scans.is_empty(), "the recording holds no scan");
-        let mut cfg = config_for_scans(
-            &scans,
-            args.sigma_range,
-            args.sigma_bearing,
-            args.max_range,
-            [0.0, 0.0],
-        )?;
-        cfg.filter.seed = args.seed;
-        super::apply_lmb_args(args, &mut cfg);
+        let cfg = super::recording_config(args, &scans)?;
         let min_visibility = cfg.min_visibility;
         let clutter_volume = cfg.filter.clutter.as_ref().map_or(0.0, |c| c.volume);
         let t0 = Instant::now();
@@ -830,15 +840,7 @@ mod lasers {
             .context("--topics needs --mountings")?;
         let recordings = read_bag_lasers(bag, &args.topics, mountings, args.max_range)?;
         let first = &recordings[0];
-        let mut cfg = smc_lmb::pipeline::people_tracking::config_for_scans(
-            &first.scans,
-            args.sigma_range,
-            args.sigma_bearing,
-            args.max_range,
-            [0.0, 0.0],
-        )?;
-        cfg.filter.seed = args.seed;
-        super::apply_lmb_args(args, &mut cfg);
+        let cfg = super::recording_config(args, &first.scans)?;
         let min_visibility = cfg.min_visibility;
         let fe = super::front_end(args)?;
         let fusion = FusionMethod::from_short_name(&args.fusion)?;

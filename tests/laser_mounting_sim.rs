@@ -1,5 +1,5 @@
 //! Mounting estimation (`laser2d::mounting`) on the simulated people world with three lasers
-//! (`sim::people2d::lasers`): the lobby of seed 000's second experiment, people walking, the
+//! (`sim::people2d::lasers`): the lobby of the second experiment of Bahraini, Bozorg & Rad (2018), people walking, the
 //! robot driving at up to 2 m/s, the lasers at 8, 8 and 5 Hz with time offsets. The estimated
 //! poses of the front-right and rear lasers in the front-left laser's frame must be the true
 //! ones within the tolerances below.

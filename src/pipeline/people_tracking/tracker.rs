@@ -25,7 +25,7 @@ use crate::error::{Error, Result};
 use crate::filter::{
     AssociationMethod, Estimate, Frame, Label, LmbConfig, LmbFilter, Measurements, StepData,
 };
-use crate::filter::{DetectionModel, StepContext, TransitionModel};
+use crate::filter::{DetectionModel, ParticleSet, StepContext, TransitionModel};
 use crate::laser2d::person_groups::{person_groups, PersonGrouping};
 use crate::laser2d::{BreakpointConfig, Scan};
 use crate::models::{BearingConvention, ConstantVelocity, FieldOfViewDetection, RangeBearing};
@@ -232,6 +232,57 @@ impl PeopleTrackerConfig {
 /// one (0.2 m, 2° beams) the measured spread of the centres is 0.10 m and 0.017 rad.
 pub fn centre_noise(sigma_range: f64, sigma_bearing: f64) -> (f64, f64) {
     (sigma_range.max(0.05), sigma_bearing.max(0.005))
+}
+
+/// A track's position, its position predicted `dt` ahead, its existence and its position
+/// spread σ.
+pub(super) type TrackSummary = ([f64; 2], [f64; 2], f64, f64);
+
+/// [`TrackSummary`] of a track of particles `p` (state `[x, vx, y, vy, ...]`).
+pub(super) fn track_summary(p: &ParticleSet, existence: f64, dt: f64) -> TrackSummary {
+    let w = p.weights();
+    let mut mean = [0.0; 4];
+    p.mean_into(&mut mean);
+    let [x, vx, y, vy] = mean;
+    let var: f64 = w
+        .iter()
+        .zip(p.component(0).iter().zip(p.component(2)))
+        .map(|(w, (px, py))| w * ((px - x).powi(2) + (py - y).powi(2)))
+        .sum();
+    (
+        [x, y],
+        [x + vx * dt, y + vy * dt],
+        existence,
+        (0.5 * var).sqrt(),
+    )
+}
+
+/// What the people models need of a step besides the scan: the tracks (`confirmed`, with
+/// existence at least `min_existence`) births keep away from and p_D is lowered near, the
+/// tracks with their spread, and which measurements may not start a track (evidence ≤ 0).
+pub(super) fn people_data(
+    confirmed: &[TrackSummary],
+    min_existence: f64,
+    evidence: Option<&[f64]>,
+) -> StepData {
+    let neighbours = confirmed
+        .iter()
+        .filter(|c| c.2 >= min_existence)
+        .map(|&(_, next, _, _)| next)
+        .collect();
+    let people = confirmed
+        .iter()
+        .map(|&(position, _, existence, spread)| ConfirmedPerson {
+            position,
+            existence,
+            spread,
+        })
+        .collect();
+    let doubted = evidence.map_or_else(Vec::new, |e| e.iter().map(|&v| v <= 0.0).collect());
+    StepData::new()
+        .with(Neighbours(neighbours))
+        .with(ConfirmedPeople(people))
+        .with(Doubted(doubted))
 }
 
 /// The people's motion: the filter's transition, with manoeuvres when configured.
@@ -589,25 +640,12 @@ impl PeopleTracker {
         }
         let dt = self.last_time.map_or(0.0, |t0| (time - t0).max(0.0));
         self.last_time = Some(time);
-        let confirmed = self.filter.tracks().iter().map(|t| {
-            let p = &t.particles;
-            let w = p.weights();
-            let mut mean = [0.0; 4];
-            p.mean_into(&mut mean);
-            let [x, vx, y, vy] = mean;
-            let var: f64 = w
-                .iter()
-                .zip(p.component(0).iter().zip(p.component(2)))
-                .map(|(w, (px, py))| w * ((px - x).powi(2) + (py - y).powi(2)))
-                .sum();
-            (
-                [x, y],
-                [x + vx * dt, y + vy * dt],
-                t.existence,
-                (0.5 * var).sqrt(),
-            )
-        });
-        let confirmed: Vec<_> = confirmed.collect();
+        let confirmed: Vec<_> = self
+            .filter
+            .tracks()
+            .iter()
+            .map(|t| track_summary(&t.particles, t.existence, dt))
+            .collect();
         // Doubted measurements (evidence ≤ 0) only near a likely track.
         let mut kept_evidence = Vec::new();
         let (measurements, evidence) = match evidence {
@@ -636,26 +674,8 @@ impl PeopleTracker {
         // What the models need of this step: the scan, the tracks births keep away from and
         // p_D is lowered near, and which of these measurements may not start a track (the
         // next step's births come from them).
-        let min_r = self.birth.suppress_existence;
-        let neighbours = confirmed
-            .iter()
-            .filter(|c| c.2 >= min_r)
-            .map(|&(_, next, _, _)| next)
-            .collect();
-        let people = confirmed
-            .iter()
-            .map(|&(position, _, existence, spread)| ConfirmedPerson {
-                position,
-                existence,
-                spread,
-            })
-            .collect();
-        let doubted = evidence.map_or_else(Vec::new, |e| e.iter().map(|&v| v <= 0.0).collect());
-        let data = StepData::new()
-            .with(self.view.clone())
-            .with(Neighbours(neighbours))
-            .with(ConfirmedPeople(people))
-            .with(Doubted(doubted));
+        let data = people_data(&confirmed, self.birth.suppress_existence, evidence)
+            .with(self.view.clone());
         let recorded = self.innovations.is_some().then(|| measurements.clone());
         let mut frame = Frame::new(time, measurements).with_data(data.clone());
         frame.platform = platform;

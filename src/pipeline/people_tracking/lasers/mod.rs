@@ -34,15 +34,17 @@
 //! Not for: estimating the mountings ([`crate::laser2d::mounting`]), the single-laser tracker
 //! ([`super::PeopleTracker`], which stays as it was), reading recordings.
 
-use super::birth::{ConfirmedPeople, ConfirmedPerson, Doubted, LaserOrigin, LaserOrigins};
+use super::birth::{LaserOrigin, LaserOrigins};
 use super::front_end::{adapt_tracker_config, FrontEnd, PersonFrontEnd};
 use super::models::{
-    BeamView, DetectabilityDetection, DetectabilityTransition, Neighbours, OcclusionDetection,
+    BeamView, DetectabilityDetection, DetectabilityTransition, OcclusionDetection,
     ResolutionDetection, ResolutionLikelihood,
 };
 use super::motion_state::{probability_moving, MotionClassifier};
 use super::run::{PeopleRun, ScanPeople};
-use super::tracker::{people_motion, FilterParts, PeopleTrackerConfig, PersonEstimate};
+use super::tracker::{
+    people_data, people_motion, track_summary, FilterParts, PeopleTrackerConfig, PersonEstimate,
+};
 use crate::config::{DetectionConfig, MeasurementConfig};
 use crate::error::{Error, Result};
 use crate::filter::{
@@ -413,25 +415,8 @@ impl LasersTracker {
             );
         }
         let evidence = any_evidence.then_some(&all_evidence[..]);
-        let neighbours = confirmed
-            .iter()
-            .filter(|c| c.2 >= self.suppress_existence)
-            .map(|&(_, next, _, _)| next)
-            .collect();
-        let people = confirmed
-            .iter()
-            .map(|&(position, _, existence, spread)| ConfirmedPerson {
-                position,
-                existence,
-                spread,
-            })
-            .collect();
-        let doubted = evidence.map_or_else(Vec::new, |e| e.iter().map(|&v| v <= 0.0).collect());
-        let data = StepData::new()
-            .with(Neighbours(neighbours))
-            .with(ConfirmedPeople(people))
-            .with(Doubted(doubted))
-            .with(LaserOrigins(origins));
+        let data =
+            people_data(&confirmed, self.suppress_existence, evidence).with(LaserOrigins(origins));
         let mut frame = Frame::at_time(time).with_data(data.clone());
         frame.platform = robot.map(platform_isometry);
         for s in scans {
@@ -524,27 +509,6 @@ impl LasersTracker {
         self.motion.retain(|l| tracks.iter().any(|t| t.label == l));
         Ok(out)
     }
-}
-
-/// A track's position, its position predicted `dt` ahead, its existence and its position
-/// spread σ.
-fn track_summary(p: &ParticleSet, existence: f64, dt: f64) -> ([f64; 2], [f64; 2], f64, f64) {
-    let w = p.weights();
-    let mut mean = [0.0; 5];
-    let dim = p.dim().min(5);
-    p.mean_into(&mut mean[..dim]);
-    let [x, vx, y, vy, _] = mean;
-    let var: f64 = w
-        .iter()
-        .zip(p.component(0).iter().zip(p.component(2)))
-        .map(|(w, (px, py))| w * ((px - x).powi(2) + (py - y).powi(2)))
-        .sum();
-    (
-        [x, y],
-        [x + vx * dt, y + vy * dt],
-        existence,
-        (0.5 * var).sqrt(),
-    )
 }
 
 mod frames;
